@@ -1,0 +1,42 @@
+# All third-party packages come from Debian. Each is wrapped in one target so that modules link
+# what they use and nothing else.
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(Threads REQUIRED)
+find_package(Boost 1.74 REQUIRED)
+
+# PCL: find_package(PCL) appends VTK, Qt, OpenNI and every other optional dependency to
+# PCL_LIBRARIES. We link only the component libraries we use, so binaries do not drag VTK in.
+find_package(PCL 1.12 REQUIRED COMPONENTS common io search kdtree filters sample_consensus segmentation octree)
+add_library(scenewatch_pcl INTERFACE)
+target_include_directories(scenewatch_pcl SYSTEM INTERFACE ${PCL_INCLUDE_DIRS})
+target_link_libraries(scenewatch_pcl INTERFACE
+  ${PCL_COMMON_LIBRARIES} ${PCL_IO_LIBRARIES} ${PCL_SEARCH_LIBRARIES} ${PCL_KDTREE_LIBRARIES}
+  ${PCL_FILTERS_LIBRARIES} ${PCL_SAMPLE_CONSENSUS_LIBRARIES} ${PCL_SEGMENTATION_LIBRARIES}
+  ${PCL_OCTREE_LIBRARIES} Eigen3::Eigen)
+add_library(scenewatch::pcl ALIAS scenewatch_pcl)
+
+find_package(octomap 1.9 REQUIRED)
+add_library(scenewatch_octomap INTERFACE)
+target_include_directories(scenewatch_octomap SYSTEM INTERFACE ${OCTOMAP_INCLUDE_DIRS})
+target_link_libraries(scenewatch_octomap INTERFACE ${OCTOMAP_LIBRARIES})
+add_library(scenewatch::octomap ALIAS scenewatch_octomap)
+
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs)
+add_library(scenewatch_opencv INTERFACE)
+target_include_directories(scenewatch_opencv SYSTEM INTERFACE ${OpenCV_INCLUDE_DIRS})
+target_link_libraries(scenewatch_opencv INTERFACE opencv_core opencv_imgproc opencv_imgcodecs)
+add_library(scenewatch::opencv ALIAS scenewatch_opencv)
+
+find_package(Protobuf 3 REQUIRED)
+find_package(yaml-cpp REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(tsl-robin-map REQUIRED)
+
+if(SCENEWATCH_BUILD_TESTS)
+  find_package(GTest REQUIRED)
+  include(GoogleTest)
+endif()
+if(SCENEWATCH_BUILD_BENCHMARKS)
+  find_package(benchmark REQUIRED)
+endif()

@@ -1,0 +1,26 @@
+# Common properties of every scenewatch target: C++17, warnings on.
+function(scenewatch_target_properties target)
+  target_compile_features(${target} PUBLIC cxx_std_17)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wno-unused-parameter)
+endfunction()
+
+# scenewatch_add_module(NAME SOURCES ... DEPS ... PRIVATE_DEPS ...)
+# Public headers live in lib/<name>/include/scenewatch/<name>/, sources in lib/<name>/src/.
+function(scenewatch_add_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(scenewatch_${name} STATIC ${ARG_SOURCES})
+  add_library(scenewatch::${name} ALIAS scenewatch_${name})
+  target_include_directories(scenewatch_${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_link_libraries(scenewatch_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
+  set_target_properties(scenewatch_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON)
+  scenewatch_target_properties(scenewatch_${name})
+endfunction()
+
+# scenewatch_add_test(NAME SOURCES ... DEPS ...): one GoogleTest executable per module.
+function(scenewatch_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_DEPS} scenewatch_test_support GTest::gtest_main)
+  scenewatch_target_properties(${name})
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+endfunction()

@@ -1,0 +1,81 @@
+#include <cmath>
+#include <sstream>
+
+#include "scenewatch/core/cloud.h"
+#include "scenewatch/core/event.h"
+#include "scenewatch/core/geometry.h"
+#include "scenewatch/core/result.h"
+
+namespace scenewatch {
+
+const char* to_string(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::kInvalidArgument: return "invalid_argument";
+    case ErrorCode::kNotFound: return "not_found";
+    case ErrorCode::kIoError: return "io_error";
+    case ErrorCode::kPermissionDenied: return "permission_denied";
+    case ErrorCode::kUnavailable: return "unavailable";
+    case ErrorCode::kInternal: return "internal";
+  }
+  return "unknown";
+}
+
+const char* to_string(EventLevel level) {
+  switch (level) {
+    case EventLevel::kMismatch: return "MISMATCH";
+    case EventLevel::kPrediction: return "PREDICTION";
+    case EventLevel::kImplausibility: return "IMPLAUSIBILITY";
+  }
+  return "UNKNOWN";
+}
+
+const char* to_string(EventKind kind) {
+  switch (kind) {
+    case EventKind::kObjectAppeared: return "OBJECT_APPEARED";
+    case EventKind::kObjectGone: return "OBJECT_GONE";
+    case EventKind::kAppearanceChange: return "APPEARANCE_CHANGE";
+    case EventKind::kObjectAdded: return "OBJECT_ADDED";
+    case EventKind::kObjectRemoved: return "OBJECT_REMOVED";
+    case EventKind::kObjectMoved: return "OBJECT_MOVED";
+    case EventKind::kFrozenDofMotion: return "FROZEN_DOF_MOTION";
+  }
+  return "UNKNOWN";
+}
+
+Status validate_rigid(const Eigen::Matrix4d& m, double tolerance) {
+  if (!m.allFinite()) return invalid_argument("pose has non-finite entries");
+  const Eigen::RowVector4d last_row = m.row(3);
+  if ((last_row - Eigen::RowVector4d(0, 0, 0, 1)).cwiseAbs().maxCoeff() > tolerance) {
+    return invalid_argument("pose last row is not [0 0 0 1]");
+  }
+  const Eigen::Matrix3d r = m.topLeftCorner<3, 3>();
+  const double orthonormality = (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+  if (orthonormality > tolerance) {
+    std::ostringstream os;
+    os << "pose is not rigid: rotation is not orthonormal (max |R^T R - I| = " << orthonormality << ")";
+    return invalid_argument(os.str());
+  }
+  if (r.determinant() < 0) return invalid_argument("pose is not rigid: rotation is a reflection (det < 0)");
+  return {};
+}
+
+Pose pose_from_matrix(const Eigen::Matrix4d& m) {
+  Pose pose = Pose::Identity();
+  pose.linear() = Eigen::Quaterniond(m.topLeftCorner<3, 3>()).normalized().toRotationMatrix();
+  pose.translation() = m.topRightCorner<3, 1>();
+  return pose;
+}
+
+Aabb OrientedBox::aabb() const {
+  const Eigen::Matrix3d r = rotation.toRotationMatrix();
+  const Eigen::Vector3d half = 0.5 * (r.cwiseAbs() * extents);
+  return {center - half, center + half};
+}
+
+std::size_t count_valid(const Cloud& cloud) {
+  std::size_t n = 0;
+  for (const auto& p : cloud.points) n += is_valid(p) ? 1 : 0;
+  return n;
+}
+
+}  // namespace scenewatch
