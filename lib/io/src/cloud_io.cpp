@@ -1,0 +1,207 @@
+// PCD and PLY reading through PCL's readers, with checks of our own before and after so that a bad
+// file gets a message naming the file and the problem instead of PCL's console output.
+#include <pcl/PCLPointCloud2.h>
+#include <pcl/common/io.h>
+#include <pcl/console/print.h>
+#include <pcl/conversions.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <system_error>
+
+#include "scenewatch/io/cloud_io.h"
+
+namespace scenewatch::io {
+namespace fs = std::filesystem;
+
+namespace {
+
+// PCL reports through its console; we report through Result. Silence it once.
+void quiet_pcl() {
+  static std::once_flag once;
+  std::call_once(once, [] { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); });
+}
+
+std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+Status check_readable_file(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return not_found(quoted(path) + ": no such file");
+  if (!fs::is_regular_file(path, ec)) return invalid_argument(quoted(path) + ": not a regular file");
+  std::ifstream probe(path, std::ios::binary);
+  if (!probe) return io_error(quoted(path) + ": cannot open for reading");
+  return {};
+}
+
+const pcl::PCLPointField* find_field(const pcl::PCLPointCloud2& cloud, const std::string& name) {
+  for (const auto& f : cloud.fields) {
+    if (f.name == name) return &f;
+  }
+  return nullptr;
+}
+
+// Checks the data section against the header before PCL reads it: PCL's own checks vary by format
+// and version, and some truncations would otherwise be read as garbage.
+Status check_pcd_body(const fs::path& path, const pcl::PCLPointCloud2& header, int data_type,
+                      unsigned int data_idx) {
+  const std::uint64_t file_size = fs::file_size(path);
+  const std::uint64_t points = static_cast<std::uint64_t>(header.width) * header.height;
+  const std::uint64_t body_bytes = points * header.point_step;
+  if (data_type == 1) {  // binary
+    if (data_idx + body_bytes > file_size) {
+      return invalid_argument(quoted(path) + ": truncated binary PCD: header declares " + std::to_string(points) +
+                              " points of " + std::to_string(header.point_step) + " bytes (" +
+                              std::to_string(body_bytes) + " bytes of data) but the file holds only " +
+                              std::to_string(file_size - std::min<std::uint64_t>(file_size, data_idx)));
+    }
+  } else if (data_type == 2) {  // binary_compressed: two uint32 sizes, then LZF data
+    if (data_idx + 8 > file_size) return invalid_argument(quoted(path) + ": truncated compressed PCD: no size header");
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(data_idx);
+    std::uint32_t sizes[2] = {0, 0};
+    in.read(reinterpret_cast<char*>(sizes), sizeof(sizes));
+    if (!in) return invalid_argument(quoted(path) + ": truncated compressed PCD: cannot read size header");
+    if (data_idx + 8ull + sizes[0] > file_size) {
+      return invalid_argument(quoted(path) + ": truncated compressed PCD: " + std::to_string(sizes[0]) +
+                              " compressed bytes declared, " + std::to_string(file_size - data_idx - 8) + " present");
+    }
+    if (sizes[1] != body_bytes) {
+      return invalid_argument(quoted(path) + ": compressed PCD header disagrees with the data: " +
+                              std::to_string(points) + " points x " + std::to_string(header.point_step) +
+                              " bytes = " + std::to_string(body_bytes) + ", but " + std::to_string(sizes[1]) +
+                              " uncompressed bytes declared");
+    }
+  }
+  return {};
+}
+
+Result<pcl::PCLPointCloud2> read_blob(const fs::path& path, Eigen::Vector4f& origin, Eigen::Quaternionf& orientation) {
+  quiet_pcl();
+  if (auto st = check_readable_file(path); !st) return st.error();
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  pcl::PCLPointCloud2 blob;
+  if (ext == ".pcd") {
+    pcl::PCDReader reader;
+    pcl::PCLPointCloud2 header;
+    int version = 0, data_type = 0;
+    unsigned int data_idx = 0;
+    if (fs::file_size(path) == 0) return invalid_argument(quoted(path) + ": empty file");
+    if (reader.readHeader(path.string(), header, origin, orientation, version, data_type, data_idx) < 0) {
+      return invalid_argument(quoted(path) + ": not a valid PCD header (fields, sizes, width x height = points?)");
+    }
+    // PCL's readHeader accepts some garbage as an empty header, and read() then crashes on it.
+    if (header.fields.empty() || header.point_step == 0) {
+      return invalid_argument(quoted(path) + ": not a PCD file (no FIELDS/SIZE in the header)");
+    }
+    if (static_cast<std::uint64_t>(header.width) * header.height == 0) {
+      return invalid_argument(quoted(path) + ": header declares no points (WIDTH x HEIGHT = 0)");
+    }
+    if (data_type < 0 || data_type > 2) return invalid_argument(quoted(path) + ": unknown DATA type in the header");
+    if (auto st = check_pcd_body(path, header, data_type, data_idx); !st) return st.error();
+    if (reader.read(path.string(), blob, origin, orientation, version) < 0) {
+      return invalid_argument(quoted(path) + ": PCD data could not be parsed (truncated or corrupt)");
+    }
+  } else if (ext == ".ply") {
+    pcl::PLYReader reader;
+    int version = 0;
+    if (reader.read(path.string(), blob, origin, orientation, version) < 0) {
+      return invalid_argument(quoted(path) + ": PLY file could not be parsed (malformed header or truncated data)");
+    }
+  } else {
+    return invalid_argument(quoted(path) + ": unknown extension '" + ext + "' (expected .pcd or .ply)");
+  }
+  const std::uint64_t points = static_cast<std::uint64_t>(blob.width) * blob.height;
+  if (points == 0) return invalid_argument(quoted(path) + ": the file holds no points");
+  if (blob.data.size() < points * blob.point_step) {
+    return invalid_argument(quoted(path) + ": data shorter than the header declares (" +
+                            std::to_string(blob.data.size()) + " bytes for " + std::to_string(points) + " points)");
+  }
+  return blob;
+}
+
+}  // namespace
+
+Result<CloudFile> read_cloud(const fs::path& path) {
+  Eigen::Vector4f origin = Eigen::Vector4f::Zero();
+  Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();
+  auto blob = read_blob(path, origin, orientation);
+  if (!blob) return blob.error();
+
+  for (const char* axis : {"x", "y", "z"}) {
+    const auto* field = find_field(*blob, axis);
+    if (field == nullptr) return invalid_argument(quoted(path) + ": no '" + axis + "' field");
+    if (field->datatype != pcl::PCLPointField::FLOAT32) {
+      return invalid_argument(quoted(path) + ": field '" + axis + "' is not float32 (type " +
+                              std::to_string(field->datatype) + "); only float32 coordinates are supported");
+    }
+  }
+  const bool has_color = find_field(*blob, "rgb") != nullptr || find_field(*blob, "rgba") != nullptr;
+
+  CloudFile out;
+  out.cloud = std::make_shared<Cloud>();
+  // PCL's field mapping matches 'rgb' with 'rgba' and ignores fields the point type lacks (label).
+  pcl::fromPCLPointCloud2(*blob, *out.cloud);
+  Cloud& cloud = *out.cloud;
+  std::size_t valid = 0;
+  for (auto& p : cloud.points) {
+    if (!has_color) p.r = p.g = p.b = 128;
+    if (is_valid(p)) {
+      ++valid;
+    } else {
+      // Inf counts as invalid as NaN does; downstream code tests std::isfinite only.
+      p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  if (valid == 0) return invalid_argument(quoted(path) + ": no valid points (all " + std::to_string(cloud.size()) +
+                                          " points are NaN or non-finite)");
+  cloud.is_dense = valid == cloud.size();
+  out.has_color = has_color;
+  out.organized = cloud.height > 1;
+  out.valid_points = valid;
+  out.sensor_origin = origin.head<3>().cast<double>();
+  cloud.sensor_origin_ = origin;
+  cloud.sensor_orientation_ = orientation;
+  return out;
+}
+
+Result<std::vector<std::uint32_t>> read_pcd_labels(const fs::path& path) {
+  Eigen::Vector4f origin;
+  Eigen::Quaternionf orientation;
+  auto blob = read_blob(path, origin, orientation);
+  if (!blob) return blob.error();
+  const auto* field = find_field(*blob, "label");
+  if (field == nullptr) return invalid_argument(quoted(path) + ": no 'label' field");
+  if (field->datatype != pcl::PCLPointField::UINT32 && field->datatype != pcl::PCLPointField::INT32) {
+    return invalid_argument(quoted(path) + ": field 'label' is not a 32-bit integer");
+  }
+  const std::size_t n = static_cast<std::size_t>(blob->width) * blob->height;
+  std::vector<std::uint32_t> labels(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::memcpy(&labels[i], &blob->data[i * blob->point_step + field->offset], sizeof(std::uint32_t));
+  }
+  return labels;
+}
+
+Status write_pcd(const fs::path& path, const Cloud& cloud) {
+  quiet_pcl();
+  if (cloud.empty()) return invalid_argument(quoted(path) + ": refusing to write an empty cloud");
+  std::error_code ec;
+  if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
+  const fs::path tmp = path.string() + ".tmp";
+  pcl::PCDWriter writer;
+  if (writer.writeBinary(tmp.string(), cloud) < 0) {
+    fs::remove(tmp, ec);
+    return io_error(quoted(path) + ": cannot write");
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) return io_error(quoted(path) + ": cannot rename into place: " + ec.message());
+  return {};
+}
+
+}  // namespace scenewatch::io

@@ -1,0 +1,368 @@
+// Ingestion: PCD/PLY in every encoding, PNG, RGB-D, intrinsics, poses, TUM, sequences; and every
+// kind of bad file, each with a message that names the file and the problem.
+#include <gtest/gtest.h>
+#include <pcl/io/pcd_io.h>
+#include <pcl/io/ply_io.h>
+
+#include <fstream>
+#include <limits>
+
+#include "scenewatch/io/cloud_io.h"
+#include "scenewatch/io/image_io.h"
+#include "scenewatch/io/rgbd.h"
+#include "scenewatch/io/sequence.h"
+#include "test_data.h"
+
+namespace scenewatch::io {
+namespace {
+namespace fs = std::filesystem;
+
+class IoTest : public ::testing::Test {
+ protected:
+  void SetUp() override { dir_ = test::make_temp_dir("io"); }
+  void TearDown() override { fs::remove_all(dir_); }
+  fs::path write_text(const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name, std::ios::binary) << text;
+    return dir_ / name;
+  }
+  fs::path dir_;
+};
+
+Cloud small_cloud() {
+  Cloud c;
+  for (int i = 0; i < 50; ++i) {
+    PointT p;
+    p.x = 0.01f * i;
+    p.y = -0.02f * i;
+    p.z = 1.0f + 0.001f * i;
+    p.r = static_cast<std::uint8_t>(i);
+    p.g = 200;
+    p.b = static_cast<std::uint8_t>(255 - i);
+    c.push_back(p);
+  }
+  return c;
+}
+
+void expect_error_mentions(const Error& e, const std::vector<std::string>& words) {
+  for (const auto& w : words) EXPECT_NE(e.message.find(w), std::string::npos) << "'" << e.message << "' lacks '" << w << "'";
+}
+
+TEST_F(IoTest, PcdAllEncodingsRoundTrip) {
+  const Cloud c = small_cloud();
+  pcl::PCDWriter w;
+  ASSERT_EQ(w.writeASCII((dir_ / "a.pcd").string(), c), 0);
+  ASSERT_EQ(w.writeBinary((dir_ / "b.pcd").string(), c), 0);
+  ASSERT_EQ(w.writeBinaryCompressed((dir_ / "c.pcd").string(), c), 0);
+  for (const char* name : {"a.pcd", "b.pcd", "c.pcd"}) {
+    auto r = read_cloud(dir_ / name);
+    ASSERT_TRUE(r.ok()) << name << ": " << r.error().message;
+    ASSERT_EQ(r->cloud->size(), c.size());
+    EXPECT_TRUE(r->has_color);
+    EXPECT_FALSE(r->organized);
+    EXPECT_EQ(r->valid_points, c.size());
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      EXPECT_NEAR(r->cloud->points[i].x, c[i].x, 1e-5);
+      EXPECT_EQ(r->cloud->points[i].r, c[i].r);
+      EXPECT_EQ(r->cloud->points[i].b, c[i].b);
+    }
+  }
+}
+
+TEST_F(IoTest, XyzOnlyPcdGetsGreyAndNoColourFlag) {
+  pcl::PointCloud<pcl::PointXYZ> c;
+  for (int i = 0; i < 10; ++i) c.push_back(pcl::PointXYZ(i, 0, 1));
+  ASSERT_EQ(pcl::io::savePCDFileBinary((dir_ / "xyz.pcd").string(), c), 0);
+  auto r = read_cloud(dir_ / "xyz.pcd");
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_FALSE(r->has_color);
+  EXPECT_EQ(r->cloud->points[3].g, 128);
+}
+
+TEST_F(IoTest, PlyAsciiAndBinary) {
+  const Cloud c = small_cloud();
+  ASSERT_EQ(pcl::io::savePLYFileBinary((dir_ / "b.ply").string(), c), 0);
+  ASSERT_EQ(pcl::io::savePLYFileASCII((dir_ / "a.ply").string(), c), 0);
+  for (const char* name : {"a.ply", "b.ply"}) {
+    auto r = read_cloud(dir_ / name);
+    ASSERT_TRUE(r.ok()) << name << ": " << r.error().message;
+    EXPECT_EQ(r->cloud->size(), c.size());
+    EXPECT_TRUE(r->has_color);
+    EXPECT_NEAR(r->cloud->points[49].z, c[49].z, 1e-5);
+  }
+  // A hand-written PLY with only x y z.
+  auto p = write_text("hand.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                                  "property float z\nend_header\n0 0 1\n1 0 1\n0 1 1\n");
+  auto r = read_cloud(p);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(r->cloud->size(), 3u);
+  EXPECT_FALSE(r->has_color);
+}
+
+TEST_F(IoTest, RealMosdCloudWithLabelField) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
+  const auto path = test::data_dir() / "mosd/learn/learn0.pcd";
+  auto r = read_cloud(path);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(r->cloud->width, 640u);
+  EXPECT_EQ(r->cloud->height, 480u);
+  EXPECT_TRUE(r->organized);
+  EXPECT_TRUE(r->has_color);
+  EXPECT_GT(r->valid_points, 100000u);
+  EXPECT_LT(r->valid_points, 640u * 480u) << "invalid Kinect pixels are NaN";
+  auto labels = read_pcd_labels(path);
+  ASSERT_TRUE(labels.ok()) << labels.error().message;
+  ASSERT_EQ(labels->size(), 640u * 480u);
+  EXPECT_GT(std::count(labels->begin(), labels->end(), 1u), 10000) << "label 1 is the table";
+  // Organized Kinect geometry: x / z at pixel u matches fx = 525, cx = 319.5.
+  const PointT& p = r->cloud->at(400, 300);
+  ASSERT_TRUE(is_valid(p));
+  EXPECT_NEAR(525.0 * p.x / p.z + 319.5, 400.0, 1.0);
+}
+
+TEST_F(IoTest, MissingFileIsNotFound) {
+  auto r = read_cloud(dir_ / "nope.pcd");
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.error().code, ErrorCode::kNotFound);
+  expect_error_mentions(r.error(), {"nope.pcd", "no such file"});
+}
+
+TEST_F(IoTest, TruncatedBinaryPcd) {
+  ASSERT_EQ(pcl::PCDWriter().writeBinary((dir_ / "t.pcd").string(), small_cloud()), 0);
+  fs::resize_file(dir_ / "t.pcd", fs::file_size(dir_ / "t.pcd") - 100);
+  auto r = read_cloud(dir_ / "t.pcd");
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"t.pcd", "truncated"});
+}
+
+TEST_F(IoTest, TruncatedCompressedPcd) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
+  const auto src = test::data_dir() / "mosd/learn/learn0.pcd";
+  fs::copy_file(src, dir_ / "cut.pcd");
+  fs::resize_file(dir_ / "cut.pcd", fs::file_size(src) / 2);
+  auto r = read_cloud(dir_ / "cut.pcd");
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"cut.pcd", "truncated"});
+}
+
+TEST_F(IoTest, HeaderThatDisagreesWithData) {
+  auto p = write_text("bad.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 5\nHEIGHT 1\n"
+                                 "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 10\nDATA ascii\n0 0 1\n0 0 1\n");
+  auto r = read_cloud(p);
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"bad.pcd"});
+  // An ascii body shorter than the header says.
+  auto q = write_text("short.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 4\nHEIGHT 1\n"
+                                   "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4\nDATA ascii\n0 0 1\n0 0 1\n");
+  auto s = read_cloud(q);
+  ASSERT_FALSE(s.ok()) << "2 of 4 declared points must not pass";
+  expect_error_mentions(s.error(), {"short.pcd"});
+}
+
+TEST_F(IoTest, GarbageAndEmptyFiles) {
+  auto g = write_text("garbage.pcd", std::string("\x89\x01\x02 this is not a point cloud \xff\xfe", 35));
+  auto r = read_cloud(g);
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"garbage.pcd"});
+  auto e = write_text("empty.pcd", "");
+  r = read_cloud(e);
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"empty.pcd", "empty"});
+  auto ply = write_text("bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n");
+  r = read_cloud(ply);
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"bad.ply"});
+  r = read_cloud(write_text("cloud.xyz", "1 2 3\n"));
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"cloud.xyz", "extension"});
+}
+
+TEST_F(IoTest, AllNanAndInfinite) {
+  Cloud c = small_cloud();
+  for (auto& p : c.points) p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+  c.is_dense = false;
+  ASSERT_EQ(pcl::PCDWriter().writeBinary((dir_ / "nan.pcd").string(), c), 0);
+  auto r = read_cloud(dir_ / "nan.pcd");
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"nan.pcd", "no valid points"});
+
+  Cloud inf = small_cloud();
+  inf.points[0].x = std::numeric_limits<float>::infinity();
+  inf.points[1].z = -std::numeric_limits<float>::infinity();
+  ASSERT_EQ(pcl::PCDWriter().writeBinary((dir_ / "inf.pcd").string(), inf), 0);
+  auto s = read_cloud(dir_ / "inf.pcd");
+  ASSERT_TRUE(s.ok()) << s.error().message;
+  EXPECT_EQ(s->valid_points, inf.size() - 2);
+  EXPECT_TRUE(std::isnan(s->cloud->points[0].y)) << "non-finite points become NaN throughout";
+}
+
+TEST_F(IoTest, WritePcdRoundTripAndRefusesEmpty) {
+  ASSERT_TRUE(write_pcd(dir_ / "sub/out.pcd", small_cloud()).ok());
+  auto r = read_cloud(dir_ / "sub/out.pcd");
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(r->cloud->size(), 50u);
+  EXPECT_FALSE(write_pcd(dir_ / "e.pcd", Cloud()).ok());
+}
+
+TEST_F(IoTest, PngRoundTripAndDepthMustBe16Bit) {
+  ColorImage c{4, 3, {}};
+  for (int i = 0; i < 36; ++i) c.rgb.push_back(static_cast<std::uint8_t>(7 * i));
+  ASSERT_TRUE(write_color_png(dir_ / "c.png", c).ok());
+  auto rc = read_color_png(dir_ / "c.png");
+  ASSERT_TRUE(rc.ok()) << rc.error().message;
+  EXPECT_EQ(rc->rgb, c.rgb);
+  DepthImage d{4, 3, {0, 1, 500, 1000, 2000, 65535, 3, 4, 5, 6, 7, 8}};
+  ASSERT_TRUE(write_depth_png(dir_ / "d.png", d).ok());
+  auto rd = read_depth_png(dir_ / "d.png");
+  ASSERT_TRUE(rd.ok());
+  EXPECT_EQ(rd->depth_mm, d.depth_mm);
+  // The colour image as depth: 3 channels, 8 bit.
+  auto wrong = read_depth_png(dir_ / "c.png");
+  ASSERT_FALSE(wrong.ok());
+  expect_error_mentions(wrong.error(), {"c.png", "one channel"});
+  EXPECT_FALSE(write_depth_png(dir_ / "x.png", DepthImage{4, 3, {1, 2}}).ok()) << "buffer smaller than 4x3";
+  auto bad = read_color_png(write_text("bad.png", "\x89PNG\r\n\x1a\n truncated"));
+  ASSERT_FALSE(bad.ok());
+  expect_error_mentions(bad.error(), {"bad.png", "decode"});
+}
+
+TEST_F(IoTest, RgbdBackProjection) {
+  ColorImage c{4, 2, std::vector<std::uint8_t>(24, 100)};
+  DepthImage d{4, 2, {0, 1000, 2000, 65535, 1500, 1500, 1500, 1500}};
+  Intrinsics K{100, 100, 1.5, 0.5, 4, 2};
+  auto cloud = rgbd_to_cloud(c, d, K);
+  ASSERT_TRUE(cloud.ok()) << cloud.error().message;
+  EXPECT_EQ((*cloud)->width, 4u);
+  EXPECT_EQ((*cloud)->height, 2u);
+  EXPECT_FALSE(is_valid((*cloud)->at(0, 0))) << "0 is no depth";
+  EXPECT_FALSE(is_valid((*cloud)->at(3, 0))) << "65535 is no depth (7-Scenes)";
+  const PointT& p = (*cloud)->at(2, 0);  // u = 2, v = 0, z = 2 m
+  EXPECT_NEAR(p.z, 2.0, 1e-6);
+  EXPECT_NEAR(p.x, (2 - 1.5) * 2.0 / 100, 1e-6);
+  EXPECT_NEAR(p.y, (0 - 0.5) * 2.0 / 100, 1e-6);
+
+  ColorImage small{2, 2, std::vector<std::uint8_t>(12, 0)};
+  auto mismatch = rgbd_to_cloud(small, d, K);
+  ASSERT_FALSE(mismatch.ok());
+  expect_error_mentions(mismatch.error(), {"2x2", "4x2", "differ"});
+  DepthImage zeros{4, 2, std::vector<std::uint16_t>(8, 0)};
+  EXPECT_FALSE(rgbd_to_cloud(c, zeros, K).ok());
+  Intrinsics other{100, 100, 1.5, 0.5, 640, 480};
+  EXPECT_FALSE(rgbd_to_cloud(c, d, other).ok());
+}
+
+TEST_F(IoTest, IntrinsicsPosesAndTum) {
+  SCENEWATCH_REQUIRE_DATA("redkitchen/camera-intrinsics.txt");
+  auto K = read_intrinsics(test::data_dir() / "redkitchen/camera-intrinsics.txt");
+  ASSERT_TRUE(K.ok()) << K.error().message;
+  EXPECT_DOUBLE_EQ(K->fx, 585);
+  EXPECT_DOUBLE_EQ(K->cy, 240);
+  auto T = read_pose_matrix(test::data_dir() / "redkitchen/frame-000150.pose.txt");
+  ASSERT_TRUE(T.ok()) << T.error().message;
+  EXPECT_NEAR(T->translation().x(), -0.91287065, 1e-6);
+
+  auto skew = read_pose_matrix(write_text("skew.txt", "1 0.5 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"));
+  ASSERT_FALSE(skew.ok());
+  expect_error_mentions(skew.error(), {"skew.txt", "rigid"});
+  auto nan = read_pose_matrix(write_text("nan.txt", "1 0 0 nan\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"));
+  ASSERT_FALSE(nan.ok());
+  expect_error_mentions(nan.error(), {"nan.txt", "non-finite"});
+  auto mirror = read_pose_matrix(write_text("mirror.txt", "-1 0 0 0\n0 1 0 0\n0 0 1 0\n0 0 0 1\n"));
+  ASSERT_FALSE(mirror.ok());
+  expect_error_mentions(mirror.error(), {"reflection"});
+  EXPECT_FALSE(read_intrinsics(write_text("k.txt", "1 2 3\n")).ok());
+
+  std::vector<StampedPose> poses(3);
+  for (int i = 0; i < 3; ++i) {
+    poses[i].stamp_s = 0.5 * i;
+    poses[i].T_world_camera = Eigen::Translation3d(i, 2, 3) * Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d::UnitZ());
+  }
+  ASSERT_TRUE(write_tum(dir_ / "traj.txt", poses).ok());
+  auto back = read_tum(dir_ / "traj.txt");
+  ASSERT_TRUE(back.ok()) << back.error().message;
+  ASSERT_EQ(back->size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR((*back)[i].stamp_s, poses[i].stamp_s, 1e-6);
+    EXPECT_TRUE((*back)[i].T_world_camera.isApprox(poses[i].T_world_camera, 1e-9));
+  }
+  auto bad = read_tum(write_text("bad_traj.txt", "# header\n0 0 0 0 0 0 0 1\n1 0 0 0 0 0\n"));
+  ASSERT_FALSE(bad.ok());
+  expect_error_mentions(bad.error(), {"bad_traj.txt", "line 3"});
+  auto notunit = read_tum(write_text("q.txt", "0 0 0 0 0 0 0 2\n"));
+  ASSERT_FALSE(notunit.ok());
+  expect_error_mentions(notunit.error(), {"unit"});
+}
+
+TEST_F(IoTest, RedkitchenSequence) {
+  SCENEWATCH_REQUIRE_DATA("redkitchen/frame-000150.color.png");
+  const auto dir = test::data_dir() / "redkitchen";
+  EXPECT_TRUE(is_sequence_dir(dir));
+  auto seq = open_sequence(dir);
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  EXPECT_EQ(seq->frames.size(), 50u);
+  EXPECT_EQ(seq->frames.front().name, "frame-000150");
+  ASSERT_TRUE(seq->frames.front().T_world_camera.has_value());
+  auto frame = load_sequence_frame(*seq, 0);
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  EXPECT_EQ(frame->cloud->width, 640u);
+  EXPECT_EQ(frame->cloud->height, 480u);
+  EXPECT_GT(count_valid(*frame->cloud), 100000u);
+  ASSERT_TRUE(frame->intrinsics.has_value());
+  EXPECT_EQ(frame->intrinsics->width, 640);
+  EXPECT_FALSE(load_sequence_frame(*seq, 50).ok());
+}
+
+TEST_F(IoTest, TumSequenceAndItsErrors) {
+  ColorImage c{4, 2, std::vector<std::uint8_t>(24, 90)};
+  DepthImage d{4, 2, std::vector<std::uint16_t>(8, 1200)};
+  for (int i = 0; i < 2; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "frame-%06d", i);
+    ASSERT_TRUE(write_color_png(dir_ / (std::string(name) + ".color.png"), c).ok());
+    ASSERT_TRUE(write_depth_png(dir_ / (std::string(name) + ".depth.png"), d).ok());
+  }
+  auto missing_k = open_sequence(dir_);
+  ASSERT_FALSE(missing_k.ok());
+  expect_error_mentions(missing_k.error(), {"camera-intrinsics.txt"});
+  ASSERT_TRUE(write_intrinsics(dir_ / "camera-intrinsics.txt", Intrinsics{100, 100, 2, 1, 0, 0}).ok());
+  std::vector<StampedPose> poses(3);
+  ASSERT_TRUE(write_tum(dir_ / "trajectory.txt", poses).ok());
+  auto wrong_count = open_sequence(dir_);
+  ASSERT_FALSE(wrong_count.ok());
+  expect_error_mentions(wrong_count.error(), {"3 poses for 2 frames"});
+  poses.resize(2);
+  poses[1].stamp_s = 0.25;
+  poses[1].T_world_camera.translation() = Eigen::Vector3d(0, 0, 1);
+  ASSERT_TRUE(write_tum(dir_ / "trajectory.txt", poses).ok());
+  auto seq = open_sequence(dir_);
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  EXPECT_DOUBLE_EQ(seq->frames[1].stamp_s, 0.25);
+  auto f = load_sequence_frame(*seq, 1);
+  ASSERT_TRUE(f.ok()) << f.error().message;
+  EXPECT_NEAR(f->T_world_camera->translation().z(), 1.0, 1e-9);
+
+  fs::remove(dir_ / "frame-000001.depth.png");
+  auto no_depth = open_sequence(dir_);
+  ASSERT_FALSE(no_depth.ok());
+  expect_error_mentions(no_depth.error(), {"frame-000001.depth.png"});
+  EXPECT_FALSE(open_sequence(dir_ / "absent").ok());
+}
+
+TEST_F(IoTest, CloudFrameUsesThePcdViewpoint) {
+  Cloud c = small_cloud();
+  c.sensor_origin_ = Eigen::Vector4f(1, 2, 3, 0);
+  ASSERT_EQ(pcl::PCDWriter().writeBinary((dir_ / "vp.pcd").string(), c), 0);
+  auto f = load_cloud_frame(dir_ / "vp.pcd");
+  ASSERT_TRUE(f.ok()) << f.error().message;
+  ASSERT_TRUE(f->T_world_camera.has_value());
+  // World points (the file's) are recovered by the pose.
+  const Eigen::Vector3d w = *f->T_world_camera * f->cloud->points[5].getVector3fMap().cast<double>();
+  EXPECT_NEAR(w.x(), c[5].x, 1e-5);
+  EXPECT_NEAR(w.z(), c[5].z, 1e-5);
+  ASSERT_TRUE(write_pcd(dir_ / "plain.pcd", small_cloud()).ok());
+  auto g = load_cloud_frame(dir_ / "plain.pcd");
+  ASSERT_TRUE(g.ok());
+  EXPECT_FALSE(g->T_world_camera.has_value());
+}
+
+}  // namespace
+}  // namespace scenewatch::io
