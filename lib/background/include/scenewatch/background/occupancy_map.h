@@ -1,0 +1,85 @@
+#pragma once
+/// The background: an OctoMap ColorOcTree with free space from ray casting. OctoMap stays inside
+/// this module; callers see points, boxes and states.
+#include <filesystem>
+#include <memory>
+
+#include "scenewatch/core/cloud.h"
+#include "scenewatch/core/geometry.h"
+#include "scenewatch/core/result.h"
+
+namespace scenewatch::background {
+
+struct Config {
+  double resolution_m = 0.02;   ///< voxel edge
+  double max_range_m = 5.0;     ///< rays are cut here; endpoints beyond are not occupied (<= 0: none)
+  double prob_hit = 0.7;        ///< OctoMap sensor model
+  double prob_miss = 0.4;
+  double clamp_min = 0.12;
+  double clamp_max = 0.97;
+  /// true: batched ray casting from voxel-discretized endpoints (fast). false: OctoMap's plain
+  /// insertPointCloud, one ray per point (the reference).
+  bool fast_insertion = true;
+};
+
+/// Validates ranges; the message names the key (e.g. "background.resolution_m").
+Status validate(const Config& config);
+
+enum class Occupancy { kUnknown, kFree, kOccupied };
+const char* to_string(Occupancy occupancy);
+
+/// Summary of a box query.
+struct BoxOccupancy {
+  Occupancy state = Occupancy::kUnknown;  ///< occupied if any voxel is, else unknown if any is, else free
+  std::size_t occupied_voxels = 0, free_voxels = 0, unknown_voxels = 0;  ///< at map resolution
+};
+
+struct InsertStats {
+  std::size_t points = 0;          ///< valid points in the frame
+  std::size_t occupied_updates = 0;
+  std::size_t free_updates = 0;
+};
+
+/// Occupancy map of the static background. NOT thread safe: the owner serialises access.
+class OccupancyMap {
+ public:
+  explicit OccupancyMap(const Config& config = {});
+  ~OccupancyMap();
+  OccupancyMap(OccupancyMap&&) noexcept;
+  OccupancyMap& operator=(OccupancyMap&&) noexcept;
+
+  /// Inserts a cloud given in the camera frame, placed with T_world_camera; rays start at the
+  /// camera origin. Invalid points are skipped.
+  InsertStats insert(const Cloud& points_camera, const Pose& T_world_camera);
+
+  Occupancy query(const Eigen::Vector3d& p_world) const;
+  /// True when the last insert() cast a ray through the voxel of p (and did not end in it): the
+  /// frame saw through that space, whatever the map's accumulated belief.
+  bool freed_by_last_insert(const Eigen::Vector3d& p_world) const;
+  BoxOccupancy query_box(const Aabb& box_world) const;
+  /// Marks every known voxel in the box free (clamped), as octomap_server's clear_bbx does;
+  /// unknown voxels stay unknown. Returns the number of voxels changed.
+  std::size_t clear_box(const Aabb& box_world);
+  void reset();
+
+  /// .ot keeps colour; .bt keeps occupancy only. Written to a temporary file then renamed.
+  Status save(const std::filesystem::path& path) const;
+  /// Reads .ot (ColorOcTree or OcTree) or .bt; the resolution comes from the file.
+  Status load(const std::filesystem::path& path);
+
+  double resolution() const;
+  std::size_t num_leaf_nodes() const;
+  std::size_t num_occupied_leaves() const;
+  std::size_t memory_bytes() const;
+  const Config& config() const { return config_; }
+
+  /// Centres of occupied leaves (expanded to the finest resolution), for comparisons and export.
+  std::vector<Eigen::Vector3d> occupied_voxel_centers() const;
+
+ private:
+  struct Impl;
+  Config config_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace scenewatch::background

@@ -1,0 +1,401 @@
+// The background occupancy map over OctoMap's ColorOcTree.
+//
+// Fast insertion follows OctoMap's own discretized update (OccupancyOcTreeBase::computeDiscreteUpdate):
+// endpoints are first reduced to one per voxel, rays are cast from the sensor to the voxel centres,
+// and cells both hit and passed through count as hit. We keep the key sets in robin-hood hash sets,
+// update the leaves with lazy evaluation in Morton order (neighbouring keys share tree paths), and
+// refresh the inner nodes once per frame.
+#include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
+#include <tsl/robin_map.h>
+#include <tsl/robin_set.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <system_error>
+
+#include "scenewatch/background/occupancy_map.h"
+
+namespace scenewatch::background {
+namespace fs = std::filesystem;
+
+namespace {
+
+using octomap::OcTreeKey;
+
+std::uint64_t pack(const OcTreeKey& k) {
+  return (static_cast<std::uint64_t>(k[0]) << 32) | (static_cast<std::uint64_t>(k[1]) << 16) | k[2];
+}
+OcTreeKey unpack(std::uint64_t v) {
+  return OcTreeKey(static_cast<octomap::key_type>(v >> 32), static_cast<octomap::key_type>((v >> 16) & 0xffff),
+                   static_cast<octomap::key_type>(v & 0xffff));
+}
+
+// Packed keys differ in low bits only; mix them so that power-of-two tables spread them.
+struct KeyHash {
+  std::size_t operator()(std::uint64_t x) const {
+    x ^= x >> 33;
+    x *= 0xff51afd7ed558ccdULL;
+    x ^= x >> 33;
+    return static_cast<std::size_t>(x);
+  }
+};
+
+// Interleaves the 16-bit key components so that sorting visits the tree depth-first.
+std::uint64_t morton(std::uint64_t packed) {
+  auto spread = [](std::uint64_t v) {
+    v &= 0xffff;
+    v = (v | (v << 16)) & 0x0000ff0000ffULL;
+    v = (v | (v << 8)) & 0x00f00f00f00fULL;
+    v = (v | (v << 4)) & 0x0c30c30c30c3ULL;
+    v = (v | (v << 2)) & 0x249249249249ULL;
+    return v;
+  };
+  return spread(packed >> 32) | (spread(packed >> 16) << 1) | (spread(packed) << 2);
+}
+
+struct ColorSum {
+  std::uint32_t r = 0, g = 0, b = 0, n = 0;
+};
+
+std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
+
+// ColorOcTree::updateInnerOccupancy() dereferences the root without checking it (OctoMap 1.9.7):
+// on an empty tree it crashes.
+void refresh_inner(octomap::ColorOcTree& tree) {
+  if (tree.getRoot() != nullptr) tree.updateInnerOccupancy();
+}
+
+}  // namespace
+
+struct OccupancyMap::Impl {
+  explicit Impl(const Config& c) : tree(c.resolution_m) { apply(c); }
+  void apply(const Config& c) {
+    tree.setProbHit(c.prob_hit);
+    tree.setProbMiss(c.prob_miss);
+    tree.setClampingThresMin(c.clamp_min);
+    tree.setClampingThresMax(c.clamp_max);
+  }
+  octomap::ColorOcTree tree;
+  // Scratch buffers kept between frames to avoid reallocation.
+  tsl::robin_map<std::uint64_t, ColorSum, KeyHash> endpoints;
+  tsl::robin_set<std::uint64_t, KeyHash> clipped_ends;
+  tsl::robin_set<std::uint64_t, KeyHash> free_cells;   // of the last insert, without its endpoints
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> order;  // (morton, packed)
+  octomap::KeyRay ray;
+};
+
+Status validate(const Config& c) {
+  auto bad = [](const std::string& key, const std::string& why) { return invalid_argument("background." + key + ": " + why); };
+  if (!(c.resolution_m >= 0.001 && c.resolution_m <= 1.0)) return bad("resolution_m", "must be in [0.001, 1] m, got " + std::to_string(c.resolution_m));
+  if (!std::isfinite(c.max_range_m)) return bad("max_range_m", "must be finite");
+  if (!(c.prob_hit > 0.5 && c.prob_hit < 1.0)) return bad("prob_hit", "must be in (0.5, 1), got " + std::to_string(c.prob_hit));
+  if (!(c.prob_miss > 0.0 && c.prob_miss < 0.5)) return bad("prob_miss", "must be in (0, 0.5), got " + std::to_string(c.prob_miss));
+  if (!(c.clamp_min > 0.0 && c.clamp_min < 0.5)) return bad("clamp_min", "must be in (0, 0.5), got " + std::to_string(c.clamp_min));
+  if (!(c.clamp_max > 0.5 && c.clamp_max < 1.0)) return bad("clamp_max", "must be in (0.5, 1), got " + std::to_string(c.clamp_max));
+  return {};
+}
+
+const char* to_string(Occupancy o) {
+  switch (o) {
+    case Occupancy::kUnknown: return "unknown";
+    case Occupancy::kFree: return "free";
+    case Occupancy::kOccupied: return "occupied";
+  }
+  return "unknown";
+}
+
+OccupancyMap::OccupancyMap(const Config& config) : config_(config), impl_(std::make_unique<Impl>(config)) {}
+OccupancyMap::~OccupancyMap() = default;
+OccupancyMap::OccupancyMap(OccupancyMap&&) noexcept = default;
+OccupancyMap& OccupancyMap::operator=(OccupancyMap&&) noexcept = default;
+
+InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world_camera) {
+  auto& tree = impl_->tree;
+  InsertStats stats;
+  const Eigen::Isometry3f T = T_world_camera.cast<float>();
+  const Eigen::Vector3f origin_f = T.translation();
+  const octomap::point3d origin(origin_f.x(), origin_f.y(), origin_f.z());
+  const double max_range = config_.max_range_m;
+
+  auto& free_cells = impl_->free_cells;
+  free_cells.clear();
+  if (!config_.fast_insertion) {
+    // Reference: OctoMap's plain insertion, one ray per point.
+    octomap::Pointcloud scan;
+    scan.reserve(points_camera.size());
+    for (const auto& p : points_camera.points) {
+      if (!is_valid(p)) continue;
+      const Eigen::Vector3f w = T * p.getVector3fMap();
+      scan.push_back(w.x(), w.y(), w.z());
+    }
+    stats.points = scan.size();
+    // The same key sets OctoMap computes inside insertPointCloud, kept for freed_by_last_insert().
+    octomap::KeySet free_keys, occupied_keys;
+    tree.computeUpdate(scan, origin, free_keys, occupied_keys, max_range > 0 ? max_range : -1.0);
+    for (const auto& k : free_keys) free_cells.insert(pack(k));
+    tree.insertPointCloud(scan, origin, max_range > 0 ? max_range : -1.0, /*lazy_eval=*/false, /*discretize=*/false);
+    for (const auto& p : points_camera.points) {
+      if (!is_valid(p)) continue;
+      const Eigen::Vector3f w = T * p.getVector3fMap();
+      tree.averageNodeColor(w.x(), w.y(), w.z(), p.r, p.g, p.b);
+    }
+    return stats;
+  }
+
+  auto& endpoints = impl_->endpoints;
+  auto& clipped = impl_->clipped_ends;
+  endpoints.clear();
+  clipped.clear();
+
+  // 1. One endpoint per voxel, with the frame's mean colour in it.
+  OcTreeKey key;
+  for (const auto& p : points_camera.points) {
+    if (!is_valid(p)) continue;
+    ++stats.points;
+    Eigen::Vector3f w = T * p.getVector3fMap();
+    const Eigen::Vector3f d = w - origin_f;
+    const float range = d.norm();
+    if (max_range > 0 && range > max_range) {
+      w = origin_f + d * static_cast<float>(max_range / range);
+      if (tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) clipped.insert(pack(key));
+      continue;
+    }
+    if (!tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) continue;
+    ColorSum& c = endpoints[pack(key)];
+    c.r += p.r;
+    c.g += p.g;
+    c.b += p.b;
+    ++c.n;
+  }
+
+  // 2. Rays from the sensor to each endpoint voxel centre; the end voxel itself is not on the ray.
+  auto cast = [&](std::uint64_t end_key) {
+    const octomap::point3d end = tree.keyToCoord(unpack(end_key));
+    if (tree.computeRayKeys(origin, end, impl_->ray)) {
+      for (const auto& k : impl_->ray) free_cells.insert(pack(k));
+    }
+  };
+  for (const auto& [k, c] : endpoints) cast(k);
+  for (std::uint64_t k : clipped) {
+    cast(k);
+    free_cells.insert(k);  // a clipped ray frees its last voxel too: nothing was seen there
+  }
+
+  // 3. Hits win over misses (OctoMap's computeUpdate does the same).
+  auto& order = impl_->order;
+  order.clear();
+  order.reserve(free_cells.size());
+  for (auto it = free_cells.begin(); it != free_cells.end();) {
+    if (endpoints.find(*it) != endpoints.end()) {
+      it = free_cells.erase(it);
+    } else {
+      order.emplace_back(morton(*it), *it);
+      ++it;
+    }
+  }
+  std::sort(order.begin(), order.end());
+  for (const auto& [m, k] : order) tree.updateNode(unpack(k), false, /*lazy_eval=*/true);
+  stats.free_updates = order.size();
+
+  order.clear();
+  for (const auto& [k, c] : endpoints) order.emplace_back(morton(k), k);
+  std::sort(order.begin(), order.end());
+  for (const auto& [m, k] : order) {
+    const OcTreeKey ok = unpack(k);
+    tree.updateNode(ok, true, /*lazy_eval=*/true);
+    const ColorSum& c = endpoints.find(k)->second;
+    tree.averageNodeColor(ok, static_cast<std::uint8_t>(c.r / c.n), static_cast<std::uint8_t>(c.g / c.n),
+                          static_cast<std::uint8_t>(c.b / c.n));
+  }
+  stats.occupied_updates = order.size();
+  refresh_inner(tree);
+  return stats;
+}
+
+Occupancy OccupancyMap::query(const Eigen::Vector3d& p) const {
+  if (!p.allFinite()) return Occupancy::kUnknown;
+  OcTreeKey key;
+  const auto& tree = impl_->tree;
+  if (!tree.coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) return Occupancy::kUnknown;
+  const auto* node = tree.search(key);
+  if (node == nullptr) return Occupancy::kUnknown;
+  return tree.isNodeOccupied(node) ? Occupancy::kOccupied : Occupancy::kFree;
+}
+
+bool OccupancyMap::freed_by_last_insert(const Eigen::Vector3d& p) const {
+  OcTreeKey key;
+  if (!p.allFinite() || !impl_->tree.coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) return false;
+  return impl_->free_cells.count(pack(key)) > 0;
+}
+
+namespace {
+// Finest-level key range [lo, hi] (inclusive) of the voxels a box overlaps; a face lying on a voxel
+// boundary does not take in the voxel beyond it. Computed in double: point3d is float, whose
+// rounding would move boundaries by a voxel.
+bool key_range(const octomap::ColorOcTree& tree, const Aabb& box, OcTreeKey& lo, OcTreeKey& hi) {
+  const double eps = 1e-6 * tree.getResolution();
+  for (int i = 0; i < 3; ++i) {
+    if (!tree.coordToKeyChecked(box.min(i) + eps, lo[i]) || !tree.coordToKeyChecked(box.max(i) - eps, hi[i])) return false;
+  }
+  return true;
+}
+
+// Number of finest voxels of a leaf (centre c, edge `size`) whose keys lie in [lo, hi].
+std::size_t overlap_voxels(const octomap::ColorOcTree& tree, const octomap::point3d& c, double size,
+                           const OcTreeKey& lo, const OcTreeKey& hi) {
+  const double res = tree.getResolution();
+  std::size_t count = 1;
+  for (int i = 0; i < 3; ++i) {
+    const long first = tree.coordToKey(c(i) - size / 2 + res / 2);
+    const long last = tree.coordToKey(c(i) + size / 2 - res / 2);
+    const long a = std::max<long>(first, lo[i]), b = std::min<long>(last, hi[i]);
+    if (b < a) return 0;
+    count *= static_cast<std::size_t>(b - a + 1);
+  }
+  return count;
+}
+}  // namespace
+
+BoxOccupancy OccupancyMap::query_box(const Aabb& box) const {
+  BoxOccupancy out;
+  const auto& tree = impl_->tree;
+  OcTreeKey lo, hi;
+  if (!box.valid() || !key_range(tree, box, lo, hi)) return out;
+  std::size_t total = 1;
+  for (int i = 0; i < 3; ++i) total *= static_cast<std::size_t>(hi[i] - lo[i] + 1);
+  for (auto it = tree.begin_leafs_bbx(lo, hi), end = tree.end_leafs_bbx(); it != end; ++it) {
+    const std::size_t n = overlap_voxels(tree, it.getCoordinate(), it.getSize(), lo, hi);
+    (tree.isNodeOccupied(*it) ? out.occupied_voxels : out.free_voxels) += n;
+  }
+  out.unknown_voxels = total - std::min(total, out.occupied_voxels + out.free_voxels);
+  out.state = out.occupied_voxels > 0 ? Occupancy::kOccupied
+              : out.unknown_voxels > 0 ? Occupancy::kUnknown
+                                       : Occupancy::kFree;
+  return out;
+}
+
+std::size_t OccupancyMap::clear_box(const Aabb& box) {
+  auto& tree = impl_->tree;
+  OcTreeKey lo, hi;
+  if (!box.valid() || !key_range(tree, box, lo, hi)) return 0;
+  const float free_log = tree.getClampingThresMinLog();
+  // Collect first: changing values while iterating would invalidate the iterator.
+  std::vector<OcTreeKey> keys;
+  for (auto it = tree.begin_leafs_bbx(lo, hi), end = tree.end_leafs_bbx(); it != end; ++it) {
+    const octomap::point3d c = it.getCoordinate();
+    const double size = it.getSize(), res = tree.getResolution();
+    // Only the part of a coarse leaf inside the box is cleared: visit its finest keys.
+    OcTreeKey k;
+    const long first[3] = {tree.coordToKey(c(0) - size / 2 + res / 2), tree.coordToKey(c(1) - size / 2 + res / 2),
+                           tree.coordToKey(c(2) - size / 2 + res / 2)};
+    const long last[3] = {tree.coordToKey(c(0) + size / 2 - res / 2), tree.coordToKey(c(1) + size / 2 - res / 2),
+                          tree.coordToKey(c(2) + size / 2 - res / 2)};
+    for (long x = std::max<long>(first[0], lo[0]); x <= std::min<long>(last[0], hi[0]); ++x)
+      for (long y = std::max<long>(first[1], lo[1]); y <= std::min<long>(last[1], hi[1]); ++y)
+        for (long z = std::max<long>(first[2], lo[2]); z <= std::min<long>(last[2], hi[2]); ++z) {
+          k[0] = static_cast<octomap::key_type>(x);
+          k[1] = static_cast<octomap::key_type>(y);
+          k[2] = static_cast<octomap::key_type>(z);
+          keys.push_back(k);
+        }
+  }
+  for (const auto& k : keys) tree.setNodeValue(k, free_log, /*lazy_eval=*/true);
+  refresh_inner(tree);
+  return keys.size();
+}
+
+void OccupancyMap::reset() {
+  impl_->tree.clear();
+  impl_->free_cells.clear();
+}
+
+Status OccupancyMap::save(const fs::path& path) const {
+  std::string ext = path.extension().string();
+  if (ext != ".ot" && ext != ".bt") return invalid_argument(quoted(path) + ": map files end in .ot or .bt");
+  std::error_code ec;
+  if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
+  const fs::path tmp = path.string() + ".tmp";
+  bool ok = false;
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) return io_error(quoted(tmp) + ": cannot open for writing");
+    ok = ext == ".ot" ? impl_->tree.write(out) : impl_->tree.writeBinaryConst(out);
+    out.flush();
+    ok = ok && static_cast<bool>(out);
+  }
+  if (!ok) {
+    fs::remove(tmp, ec);
+    return io_error(quoted(path) + ": writing the map failed");
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) return io_error(quoted(path) + ": cannot rename into place: " + ec.message());
+  return {};
+}
+
+Status OccupancyMap::load(const fs::path& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return not_found(quoted(path) + ": no such file");
+  const std::string ext = path.extension().string();
+  auto loaded = std::make_unique<Impl>(config_);
+  if (ext == ".bt") {
+    std::ifstream in(path, std::ios::binary);
+    if (!loaded->tree.readBinary(in)) return invalid_argument(quoted(path) + ": not a valid OctoMap binary (.bt) file");
+  } else if (ext == ".ot") {
+    std::ifstream in(path, std::ios::binary);
+    std::unique_ptr<octomap::AbstractOcTree> tree(octomap::AbstractOcTree::read(in));
+    if (!tree) return invalid_argument(quoted(path) + ": not a valid OctoMap (.ot) file");
+    if (auto* color = dynamic_cast<octomap::ColorOcTree*>(tree.get())) {
+      // swapContent swaps the node structure only; the metadata must match first.
+      loaded->tree.setResolution(color->getResolution());
+      loaded->tree.swapContent(*color);
+    } else if (auto* plain = dynamic_cast<octomap::OcTree*>(tree.get())) {
+      loaded->tree.setResolution(plain->getResolution());
+      for (auto it = plain->begin_leafs(), end = plain->end_leafs(); it != end; ++it) {
+        loaded->tree.setNodeValue(it.getKey(), it->getLogOdds(), true);
+      }
+      refresh_inner(loaded->tree);
+    } else {
+      return invalid_argument(quoted(path) + ": holds a " + tree->getTreeType() + ", not an occupancy tree");
+    }
+  } else {
+    return invalid_argument(quoted(path) + ": map files end in .ot or .bt");
+  }
+  config_.resolution_m = loaded->tree.getResolution();
+  loaded->apply(config_);
+  impl_ = std::move(loaded);
+  return {};
+}
+
+double OccupancyMap::resolution() const { return impl_->tree.getResolution(); }
+std::size_t OccupancyMap::num_leaf_nodes() const { return impl_->tree.getNumLeafNodes(); }
+std::size_t OccupancyMap::memory_bytes() const { return impl_->tree.memoryUsage(); }
+
+std::size_t OccupancyMap::num_occupied_leaves() const {
+  std::size_t n = 0;
+  const auto& tree = impl_->tree;
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) n += tree.isNodeOccupied(*it) ? 1 : 0;
+  return n;
+}
+
+std::vector<Eigen::Vector3d> OccupancyMap::occupied_voxel_centers() const {
+  std::vector<Eigen::Vector3d> out;
+  const auto& tree = impl_->tree;
+  const double res = tree.getResolution();
+  for (auto it = tree.begin_leafs(), end = tree.end_leafs(); it != end; ++it) {
+    if (!tree.isNodeOccupied(*it)) continue;
+    const octomap::point3d c = it.getCoordinate();
+    const double size = it.getSize();
+    const int n = std::max(1, static_cast<int>(std::lround(size / res)));
+    for (int x = 0; x < n; ++x)
+      for (int y = 0; y < n; ++y)
+        for (int z = 0; z < n; ++z) {
+          out.emplace_back(c.x() - size / 2 + (x + 0.5) * res, c.y() - size / 2 + (y + 0.5) * res,
+                           c.z() - size / 2 + (z + 0.5) * res);
+        }
+  }
+  return out;
+}
+
+}  // namespace scenewatch::background
