@@ -1,0 +1,45 @@
+#pragma once
+/// Tabletop segmentation: supporting planes by RANSAC, each with its convex hull, and the object
+/// clusters standing on them (points in the prism above the hull, Euclidean clustering).
+#include <optional>
+#include <vector>
+
+#include "scenewatch/core/cloud.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/core/scene.h"
+
+namespace scenewatch::segmentation {
+
+struct Config {
+  double voxel_size_m = 0.01;          ///< working resolution for RANSAC and clustering
+  int max_planes = 3;
+  double plane_distance_m = 0.015;     ///< RANSAC inlier threshold
+  int ransac_iterations = 200;
+  std::uint32_t seed = 42;             ///< RANSAC seed: same seed, same planes
+  double min_plane_area_m2 = 0.05;     ///< smaller planes are not supporting planes
+  double plane_connectivity_m = 0.05;  ///< gaps narrower than this do not split a plane
+  /// Optional up-vector in the cloud's frame: only planes whose normal is within
+  /// max_normal_angle_deg of it are supporting planes.
+  std::optional<Eigen::Vector3d> up;
+  double max_normal_angle_deg = 15.0;
+  double min_object_height_m = 0.01;   ///< points closer to the plane belong to it
+  double max_object_height_m = 0.5;
+  double cluster_tolerance_m = 0.02;
+  int min_cluster_points = 100;        ///< in input points
+  int max_cluster_points = 500000;
+};
+
+/// Validates ranges; the message names the key (e.g. "segmentation.voxel_size_m").
+Status validate(const Config& config);
+
+struct Segmentation {
+  std::vector<Plane> planes;          ///< largest first
+  std::vector<ObjectCluster> objects; ///< largest first
+};
+
+/// Segments one cloud (organized or not). The sensor is at sensor_origin in the cloud's frame;
+/// plane normals point towards it. Reproducible for a given config.seed. Thread safe (no state).
+Segmentation segment(const Cloud& cloud, const Config& config,
+                     const Eigen::Vector3d& sensor_origin = Eigen::Vector3d::Zero());
+
+}  // namespace scenewatch::segmentation

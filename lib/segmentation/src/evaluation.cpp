@@ -1,0 +1,49 @@
+#include "scenewatch/segmentation/evaluation.h"
+
+#include <algorithm>
+#include <map>
+
+namespace scenewatch::segmentation {
+
+std::size_t LabelScore::matched(double t) const {
+  return static_cast<std::size_t>(std::count_if(objects.begin(), objects.end(), [t](const ObjectScore& o) { return o.best_iou >= t; }));
+}
+
+double LabelScore::recall(double t) const { return objects.empty() ? 1.0 : static_cast<double>(matched(t)) / objects.size(); }
+
+LabelScore score_against_labels(const std::vector<std::vector<int>>& clusters, const std::vector<int>& plane_indices,
+                                const std::vector<std::uint32_t>& labels, std::uint32_t table_label, std::uint32_t divisor,
+                                std::size_t min_object_points) {
+  LabelScore score;
+  // Ground-truth object of each point (0 = none).
+  std::map<std::uint32_t, std::size_t> gt_size;
+  std::size_t table_points = 0;
+  for (std::uint32_t l : labels) {
+    if (l == table_label) ++table_points;
+    if (l >= divisor) ++gt_size[l / divisor];
+  }
+  std::size_t table_hits = 0;
+  for (int i : plane_indices) table_hits += labels[i] == table_label ? 1 : 0;
+  const std::size_t table_union = table_points + plane_indices.size() - table_hits;
+  score.table_iou = table_union ? static_cast<double>(table_hits) / table_union : 0.0;
+
+  for (const auto& [id, n] : gt_size) {
+    if (n < min_object_points) continue;
+    ObjectScore o;
+    o.object_id = id;
+    o.points = n;
+    for (std::size_t c = 0; c < clusters.size(); ++c) {
+      std::size_t inter = 0;
+      for (int i : clusters[c]) inter += (labels[i] >= divisor && labels[i] / divisor == id) ? 1 : 0;
+      const double iou = static_cast<double>(inter) / (n + clusters[c].size() - inter);
+      if (iou > o.best_iou) {
+        o.best_iou = iou;
+        o.best_cluster = static_cast<int>(c);
+      }
+    }
+    score.objects.push_back(o);
+  }
+  return score;
+}
+
+}  // namespace scenewatch::segmentation

@@ -1,0 +1,439 @@
+// Tabletop segmentation on a voxel grid:
+//  1. voxelize the valid points (centroid per voxel, point -> voxel map);
+//  2. RANSAC planes on the voxel centroids (seeded, optional up-vector constraint), refined by
+//     least squares; each plane keeps its largest connected part (a 2D grid on the plane bridges
+//     the shadows that objects cast on the table);
+//  3. convex hull of each plane (Andrew's monotone chain in the plane's 2D basis);
+//  4. voxels in the prism above a hull are clustered (Euclidean, union-find over grid
+//     neighbours), and every input point of a cluster voxel at object height joins the object.
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <limits>
+#include <random>
+
+#include "scenewatch/segmentation/tabletop.h"
+#include "voxel_index.h"
+
+namespace scenewatch::segmentation {
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+
+struct PlaneModel {
+  Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+  double d = 0.0;
+  double distance(const Eigen::Vector3f& p) const { return n.dot(p.cast<double>()) + d; }
+};
+
+// Least-squares plane through points (smallest eigenvector of the covariance).
+PlaneModel fit_plane(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& ids) {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int v : ids) mean += centroids[v].cast<double>();
+  mean /= static_cast<double>(ids.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int v : ids) {
+    const Eigen::Vector3d q = centroids[v].cast<double>() - mean;
+    cov += q * q.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  PlaneModel m;
+  m.n = es.eigenvectors().col(0).normalized();
+  m.d = -m.n.dot(mean);
+  return m;
+}
+
+struct RansacResult {
+  bool found = false;
+  PlaneModel model;
+};
+
+// RANSAC over the candidate voxels. Hypotheses are scored on a fixed random subset for speed;
+// the caller recomputes the inliers on all candidates.
+RansacResult ransac_plane(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& candidates,
+                          const Config& cfg, const std::optional<Eigen::Vector3d>& up, std::mt19937& rng) {
+  RansacResult best;
+  if (candidates.size() < 3) return best;
+  constexpr std::size_t kScoreSamples = 3000;
+  std::vector<int> scoring = candidates;
+  if (scoring.size() > kScoreSamples) {
+    std::shuffle(scoring.begin(), scoring.end(), rng);
+    scoring.resize(kScoreSamples);
+  }
+  const double cos_max = std::cos(cfg.max_normal_angle_deg * M_PI / 180.0);
+  std::uniform_int_distribution<std::size_t> pick(0, candidates.size() - 1);
+  std::size_t best_score = 0;
+  for (int it = 0; it < cfg.ransac_iterations; ++it) {
+    const Eigen::Vector3d a = centroids[candidates[pick(rng)]].cast<double>();
+    const Eigen::Vector3d b = centroids[candidates[pick(rng)]].cast<double>();
+    const Eigen::Vector3d c = centroids[candidates[pick(rng)]].cast<double>();
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    const double len = n.norm();
+    if (len < 1e-9) continue;  // collinear or repeated sample
+    n /= len;
+    if (up && std::abs(n.dot(*up)) < cos_max) continue;
+    const double d = -n.dot(a);
+    std::size_t score = 0;
+    for (int v : scoring) score += std::abs(n.dot(centroids[v].cast<double>()) + d) < cfg.plane_distance_m ? 1 : 0;
+    if (score > best_score) {
+      best_score = score;
+      best.found = true;
+      best.model = {n, d};
+    }
+  }
+  return best;
+}
+
+// An orthonormal basis (u, v) of the plane.
+void plane_basis(const Eigen::Vector3d& n, Eigen::Vector3d& u, Eigen::Vector3d& v) {
+  u = n.unitOrthogonal();
+  v = n.cross(u);
+}
+
+double cross2(const Vec2& o, const Vec2& a, const Vec2& b) {
+  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+}
+
+// Andrew's monotone chain; counter-clockwise, no repeated end point.
+std::vector<Vec2> convex_hull(std::vector<Vec2> pts) {
+  std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return pts;
+  std::vector<Vec2> hull(2 * pts.size());
+  std::size_t k = 0;
+  for (const auto& p : pts) {
+    while (k >= 2 && cross2(hull[k - 2], hull[k - 1], p) <= 0) --k;
+    hull[k++] = p;
+  }
+  for (std::size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
+    while (k >= t && cross2(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  hull.resize(k - 1);
+  return hull;
+}
+
+double polygon_area(const std::vector<Vec2>& poly) {
+  double a = 0.0;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec2& p = poly[i];
+    const Vec2& q = poly[(i + 1) % poly.size()];
+    a += p.x() * q.y() - q.x() * p.y();
+  }
+  return 0.5 * std::abs(a);
+}
+
+bool inside_convex(const std::vector<Vec2>& hull, const Vec2& p) {
+  if (hull.size() < 3) return false;
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    if (cross2(hull[i], hull[(i + 1) % hull.size()], p) < 0) return false;
+  }
+  return true;
+}
+
+// Largest 8-connected group of the inlier voxels on a 2D grid of cell `cell_m` in the plane.
+std::vector<int> largest_component(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
+                                   const Eigen::Vector3d& u, const Eigen::Vector3d& v, double cell_m) {
+  struct CellHash {
+    std::size_t operator()(std::uint64_t x) const { return static_cast<std::size_t>(x * 0x9e3779b97f4a7c15ULL >> 17); }
+  };
+  auto key = [](long a, long b) { return (static_cast<std::uint64_t>(a + (1 << 30)) << 32) | static_cast<std::uint64_t>(b + (1 << 30)); };
+  tsl::robin_map<std::uint64_t, int, CellHash> cells;
+  std::vector<std::pair<long, long>> cell_coords;
+  std::vector<int> voxel_cell(inliers.size());
+  for (std::size_t i = 0; i < inliers.size(); ++i) {
+    const Eigen::Vector3d p = centroids[inliers[i]].cast<double>();
+    const long a = static_cast<long>(std::floor(p.dot(u) / cell_m)), b = static_cast<long>(std::floor(p.dot(v) / cell_m));
+    auto [it, inserted] = cells.try_emplace(key(a, b), static_cast<int>(cell_coords.size()));
+    if (inserted) cell_coords.emplace_back(a, b);
+    voxel_cell[i] = it->second;
+  }
+  std::vector<int> comp(cell_coords.size(), -1);
+  std::vector<int> stack;
+  int ncomp = 0;
+  for (std::size_t c = 0; c < cell_coords.size(); ++c) {
+    if (comp[c] >= 0) continue;
+    comp[c] = ncomp;
+    stack.assign(1, static_cast<int>(c));
+    while (!stack.empty()) {
+      const int cur = stack.back();
+      stack.pop_back();
+      for (long da = -1; da <= 1; ++da)
+        for (long db = -1; db <= 1; ++db) {
+          auto it = cells.find(key(cell_coords[cur].first + da, cell_coords[cur].second + db));
+          if (it != cells.end() && comp[it->second] < 0) {
+            comp[it->second] = ncomp;
+            stack.push_back(it->second);
+          }
+        }
+    }
+    ++ncomp;
+  }
+  std::vector<std::size_t> size(ncomp, 0);
+  for (std::size_t i = 0; i < inliers.size(); ++i) ++size[comp[voxel_cell[i]]];
+  const int best = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  std::vector<int> out;
+  out.reserve(size[best]);
+  for (std::size_t i = 0; i < inliers.size(); ++i) {
+    if (comp[voxel_cell[i]] == best) out.push_back(inliers[i]);
+  }
+  return out;
+}
+
+struct UnionFind {
+  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  int find(int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(int a, int b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+  std::vector<int> parent;
+};
+
+struct PlaneFrame {
+  PlaneModel model;
+  Eigen::Vector3d u, v;
+  std::vector<Vec2> hull2d;
+};
+
+// Box with its z axis along the plane normal and the yaw of the minimum-area rectangle around
+// the points' footprint (rotating calipers over the 2D hull; PCA is ambiguous for square shapes).
+OrientedBox box_on_plane(const Cloud& cloud, const std::vector<int>& idx, const Eigen::Vector3d& n) {
+  Eigen::Vector3d u, v;
+  plane_basis(n, u, v);
+  std::vector<Vec2> footprint;
+  footprint.reserve(idx.size());
+  for (int i : idx) {
+    const Eigen::Vector3d p = cloud[i].getVector3fMap().cast<double>();
+    footprint.emplace_back(p.dot(u), p.dot(v));
+  }
+  const std::vector<Vec2> hull = convex_hull(std::move(footprint));
+  Vec2 best_dir(1, 0);
+  double best_area = std::numeric_limits<double>::max();
+  for (std::size_t i = 0; i < hull.size() && hull.size() >= 2; ++i) {
+    const Vec2 e = hull[(i + 1) % hull.size()] - hull[i];
+    if (e.norm() < 1e-9) continue;
+    const Vec2 dx = e.normalized(), dy(-dx.y(), dx.x());
+    double x0 = 1e300, x1 = -1e300, y0 = 1e300, y1 = -1e300;
+    for (const Vec2& h : hull) {
+      x0 = std::min(x0, h.dot(dx));
+      x1 = std::max(x1, h.dot(dx));
+      y0 = std::min(y0, h.dot(dy));
+      y1 = std::max(y1, h.dot(dy));
+    }
+    const double area = (x1 - x0) * (y1 - y0);
+    if (area < best_area) {
+      best_area = area;
+      // The box's x axis is its longer side.
+      best_dir = (x1 - x0) >= (y1 - y0) ? dx : dy;
+    }
+  }
+  const Eigen::Vector3d ax = (best_dir.x() * u + best_dir.y() * v).normalized();
+  const Eigen::Vector3d ay = n.cross(ax);
+  Eigen::Matrix3d R;
+  R << ax, ay, n;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::max());
+  Eigen::Vector3d hi = -lo;
+  for (int i : idx) {
+    const Eigen::Vector3d q = R.transpose() * cloud[i].getVector3fMap().cast<double>();
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  OrientedBox box;
+  box.rotation = Eigen::Quaterniond(R);
+  box.center = R * (0.5 * (lo + hi));
+  box.extents = hi - lo;
+  return box;
+}
+
+}  // namespace
+
+Status validate(const Config& c) {
+  auto bad = [](const std::string& key, const std::string& why) { return invalid_argument("segmentation." + key + ": " + why); };
+  if (!(c.voxel_size_m >= 0.002 && c.voxel_size_m <= 0.2)) return bad("voxel_size_m", "must be in [0.002, 0.2] m, got " + std::to_string(c.voxel_size_m));
+  if (c.max_planes < 0 || c.max_planes > 20) return bad("max_planes", "must be in [0, 20], got " + std::to_string(c.max_planes));
+  if (!(c.plane_distance_m > 0 && c.plane_distance_m < 0.5)) return bad("plane_distance_m", "must be in (0, 0.5) m");
+  if (c.ransac_iterations < 1 || c.ransac_iterations > 100000) return bad("ransac_iterations", "must be in [1, 100000]");
+  if (!(c.min_plane_area_m2 >= 0)) return bad("min_plane_area_m2", "must be >= 0");
+  if (!(c.plane_connectivity_m > 0)) return bad("plane_connectivity_m", "must be > 0");
+  if (c.up && (!c.up->allFinite() || c.up->norm() < 1e-6)) return bad("up_vector", "must be a non-zero finite vector");
+  if (!(c.max_normal_angle_deg > 0 && c.max_normal_angle_deg <= 90)) return bad("max_normal_angle_deg", "must be in (0, 90]");
+  if (!(c.min_object_height_m >= 0 && c.min_object_height_m < c.max_object_height_m))
+    return bad("min_object_height_m", "must be >= 0 and below max_object_height_m");
+  if (!(c.cluster_tolerance_m > 0 && c.cluster_tolerance_m <= 0.5)) return bad("cluster_tolerance_m", "must be in (0, 0.5] m");
+  if (c.min_cluster_points < 1 || c.min_cluster_points > c.max_cluster_points)
+    return bad("min_cluster_points", "must be >= 1 and <= max_cluster_points");
+  return {};
+}
+
+Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3d& sensor_origin) {
+  Segmentation out;
+  const VoxelIndex grid(cloud, cfg.voxel_size_m);
+  const auto& centroids = grid.centroids;
+  const std::size_t nvox = centroids.size();
+  if (nvox < 3) return out;
+
+  std::optional<Eigen::Vector3d> up;
+  if (cfg.up) up = cfg.up->normalized();
+  std::mt19937 rng(cfg.seed);
+
+  // --- planes ---
+  std::vector<char> in_plane(nvox, 0);
+  std::vector<PlaneFrame> frames;
+  std::vector<int> remaining(nvox);
+  std::iota(remaining.begin(), remaining.end(), 0);
+  for (int p = 0; p < cfg.max_planes; ++p) {
+    const RansacResult r = ransac_plane(centroids, remaining, cfg, up, rng);
+    if (!r.found) break;
+    PlaneModel model = r.model;
+    std::vector<int> inliers;
+    for (int refine = 0; refine < 2; ++refine) {
+      inliers.clear();
+      for (int v : remaining) {
+        if (std::abs(model.distance(centroids[v])) < cfg.plane_distance_m) inliers.push_back(v);
+      }
+      if (inliers.size() < 3) break;
+      model = fit_plane(centroids, inliers);
+    }
+    if (inliers.size() < 3) break;
+    // Normals point to where objects stand: along up when given, else towards the sensor.
+    const Eigen::Vector3d towards = up ? *up : (sensor_origin - centroids[inliers[0]].cast<double>());
+    if (model.n.dot(towards) < 0) {
+      model.n = -model.n;
+      model.d = -model.d;
+    }
+    if (up && model.n.dot(*up) < std::cos(cfg.max_normal_angle_deg * M_PI / 180.0)) break;
+
+    PlaneFrame frame;
+    frame.model = model;
+    plane_basis(model.n, frame.u, frame.v);
+    const std::vector<int> part = largest_component(centroids, inliers, frame.u, frame.v, cfg.plane_connectivity_m);
+    std::vector<Vec2> pts2;
+    pts2.reserve(part.size());
+    for (int v : part) {
+      const Eigen::Vector3d q = centroids[v].cast<double>();
+      pts2.emplace_back(q.dot(frame.u), q.dot(frame.v));
+    }
+    frame.hull2d = convex_hull(std::move(pts2));
+    const double area = polygon_area(frame.hull2d);
+    // The largest remaining plane is too small: no further supporting plane can be found.
+    if (frame.hull2d.size() < 3 || area < cfg.min_plane_area_m2) break;
+
+    Plane plane;
+    plane.id = static_cast<int>(out.planes.size());
+    plane.normal = model.n;
+    plane.d = model.d;
+    plane.area_m2 = area;
+    const Eigen::Vector3d origin_on_plane = -model.d * model.n;
+    for (const Vec2& h : frame.hull2d) plane.hull.push_back(origin_on_plane + h.x() * frame.u + h.y() * frame.v);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int v : part) {
+      in_plane[v] = 1;
+      for (const int* it = grid.members_begin(v); it != grid.members_end(v); ++it) {
+        const Eigen::Vector3f q = cloud[*it].getVector3fMap();
+        const double h = model.distance(q);
+        if (std::abs(h) < cfg.plane_distance_m && h < cfg.min_object_height_m) {
+          plane.indices.push_back(*it);
+          sum += q.cast<double>();
+        }
+      }
+    }
+    std::sort(plane.indices.begin(), plane.indices.end());
+    plane.inlier_count = plane.indices.size();
+    plane.centroid = plane.inlier_count > 0 ? Eigen::Vector3d(sum / static_cast<double>(plane.inlier_count)) : origin_on_plane;
+    out.planes.push_back(std::move(plane));
+    frames.push_back(std::move(frame));
+
+    std::vector<int> next;
+    next.reserve(remaining.size());
+    for (int v : remaining) {
+      if (!in_plane[v]) next.push_back(v);
+    }
+    remaining.swap(next);
+  }
+  if (frames.empty()) return out;
+
+  // --- object voxels: in the prism above a hull; the lowest such plane owns the voxel ---
+  std::vector<int> owner(nvox, -1);
+  std::vector<int> object_voxels;
+  for (std::size_t v = 0; v < nvox; ++v) {
+    double best_h = std::numeric_limits<double>::max();
+    for (std::size_t p = 0; p < frames.size(); ++p) {
+      const double h = frames[p].model.distance(centroids[v]);
+      if (h < cfg.min_object_height_m || h > cfg.max_object_height_m || h >= best_h) continue;
+      const Eigen::Vector3d q = centroids[v].cast<double>();
+      if (!inside_convex(frames[p].hull2d, Vec2(q.dot(frames[p].u), q.dot(frames[p].v)))) continue;
+      best_h = h;
+      owner[v] = static_cast<int>(p);
+    }
+    if (owner[v] >= 0) object_voxels.push_back(static_cast<int>(v));
+  }
+
+  // --- Euclidean clustering of object voxels (grid neighbours within the tolerance) ---
+  std::vector<int> local(nvox, -1);
+  for (std::size_t i = 0; i < object_voxels.size(); ++i) local[object_voxels[i]] = static_cast<int>(i);
+  UnionFind uf(object_voxels.size());
+  const int reach = static_cast<int>(std::ceil(cfg.cluster_tolerance_m / cfg.voxel_size_m));
+  const float tol2 = static_cast<float>(cfg.cluster_tolerance_m * cfg.cluster_tolerance_m);
+  for (std::size_t i = 0; i < object_voxels.size(); ++i) {
+    const int v = object_voxels[i];
+    const auto& c = grid.coords[v];
+    for (int dx = -reach; dx <= reach; ++dx)
+      for (int dy = -reach; dy <= reach; ++dy)
+        for (int dz = -reach; dz <= reach; ++dz) {
+          // Each unordered pair once: only neighbours after this voxel in lexicographic order.
+          if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) continue;
+          const int w = grid.find(c[0] + dx, c[1] + dy, c[2] + dz);
+          if (w < 0 || local[w] < 0 || owner[w] != owner[v]) continue;
+          if ((centroids[w] - centroids[v]).squaredNorm() <= tol2) uf.unite(static_cast<int>(i), local[w]);
+        }
+  }
+  std::vector<std::vector<int>> groups;
+  std::vector<int> group_of(object_voxels.size(), -1);
+  for (std::size_t i = 0; i < object_voxels.size(); ++i) {
+    const int root = uf.find(static_cast<int>(i));
+    if (group_of[root] < 0) {
+      group_of[root] = static_cast<int>(groups.size());
+      groups.emplace_back();
+    }
+    groups[group_of[root]].push_back(object_voxels[i]);
+  }
+
+  for (const auto& voxels : groups) {
+    const int p = owner[voxels.front()];
+    const PlaneModel& model = frames[p].model;
+    ObjectCluster obj;
+    obj.plane_id = p;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    Eigen::Vector3d rgb = Eigen::Vector3d::Zero();
+    for (int v : voxels) {
+      for (const int* it = grid.members_begin(v); it != grid.members_end(v); ++it) {
+        const PointT& q = cloud[*it];
+        const double h = model.distance(q.getVector3fMap());
+        if (h < cfg.min_object_height_m || h > cfg.max_object_height_m) continue;
+        obj.indices.push_back(*it);
+        sum += q.getVector3fMap().cast<double>();
+        rgb += Eigen::Vector3d(q.r, q.g, q.b);
+      }
+    }
+    const int n = static_cast<int>(obj.indices.size());
+    if (n < cfg.min_cluster_points || n > cfg.max_cluster_points) continue;
+    std::sort(obj.indices.begin(), obj.indices.end());
+    obj.point_count = obj.indices.size();
+    obj.centroid = sum / n;
+    obj.mean_rgb = (rgb / n).cast<float>();
+    obj.box = box_on_plane(cloud, obj.indices, model.n);
+    out.objects.push_back(std::move(obj));
+  }
+  std::stable_sort(out.objects.begin(), out.objects.end(),
+                   [](const ObjectCluster& a, const ObjectCluster& b) { return a.point_count > b.point_count; });
+  return out;
+}
+
+}  // namespace scenewatch::segmentation

@@ -1,0 +1,47 @@
+#include "voxel_index.h"
+
+#include <cmath>
+
+namespace scenewatch::segmentation {
+
+VoxelIndex::VoxelIndex(const Cloud& cloud, double voxel_size_m) : size(voxel_size_m) {
+  const float inv = static_cast<float>(1.0 / voxel_size_m);
+  point_voxel.assign(cloud.size(), -1);
+  lookup.reserve(cloud.size() / 8 + 16);
+  std::vector<Eigen::Vector3f> sums;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const PointT& p = cloud.points[i];
+    if (!is_valid(p)) continue;
+    const int x = static_cast<int>(std::floor(p.x * inv));
+    const int y = static_cast<int>(std::floor(p.y * inv));
+    const int z = static_cast<int>(std::floor(p.z * inv));
+    auto [it, inserted] = lookup.try_emplace(pack(x, y, z), static_cast<int>(sums.size()));
+    const int v = it->second;
+    if (inserted) {
+      sums.emplace_back(Eigen::Vector3f::Zero());
+      coords.push_back({x, y, z});
+      member_offsets.push_back(0);
+    }
+    sums[v] += p.getVector3fMap();
+    ++member_offsets[v];
+    point_voxel[i] = v;
+  }
+  // Counting sort of the points by voxel (counts become offsets).
+  const std::size_t n = sums.size();
+  centroids.resize(n);
+  for (std::size_t v = 0; v < n; ++v) centroids[v] = sums[v] / static_cast<float>(member_offsets[v]);
+  member_offsets.push_back(0);
+  int running = 0;
+  for (std::size_t v = 0; v <= n; ++v) {
+    const int count = member_offsets[v];
+    member_offsets[v] = running;
+    running += count;
+  }
+  member_points.resize(running);
+  std::vector<int> fill(member_offsets.begin(), member_offsets.end() - 1);
+  for (std::size_t i = 0; i < point_voxel.size(); ++i) {
+    if (point_voxel[i] >= 0) member_points[fill[point_voxel[i]]++] = static_cast<int>(i);
+  }
+}
+
+}  // namespace scenewatch::segmentation

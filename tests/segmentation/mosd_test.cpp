@@ -1,0 +1,101 @@
+// Real data: the labelled Kinect tabletop scenes of mOSD and PCL's mug scene.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "scenewatch/io/cloud_io.h"
+#include "scenewatch/segmentation/evaluation.h"
+#include "scenewatch/segmentation/tabletop.h"
+#include "test_data.h"
+
+namespace scenewatch::segmentation {
+namespace {
+
+struct SceneFigures {
+  std::size_t objects = 0, matched = 0;
+  double table_iou = 0;
+};
+
+SceneFigures run_scene(const std::filesystem::path& path, bool print) {
+  auto file = io::read_cloud(path);
+  EXPECT_TRUE(file.ok()) << (file.ok() ? "" : file.error().message);
+  if (!file.ok()) return {};
+  auto labels = io::read_pcd_labels(path);
+  EXPECT_TRUE(labels.ok());
+  const Segmentation seg = segment(*file->cloud, Config{});
+  std::vector<std::vector<int>> clusters;
+  for (const auto& o : seg.objects) clusters.push_back(o.indices);
+  const std::vector<int> none;
+  const LabelScore score = score_against_labels(clusters, seg.planes.empty() ? none : seg.planes[0].indices, *labels);
+  if (print) {
+    std::printf("  %-12s planes %zu clusters %2zu | table IoU %.3f | objects %zu matched %zu |", path.filename().c_str(),
+                seg.planes.size(), seg.objects.size(), score.table_iou, score.objects.size(), score.matched());
+    for (const auto& o : score.objects) std::printf(" %u:%.2f", o.object_id, o.best_iou);
+    std::printf("\n");
+  }
+  return {score.objects.size(), score.matched(), score.table_iou};
+}
+
+// Every learn scene: the table plane is found (IoU with the table label), and each labelled object
+// is matched by a cluster with point IoU >= 0.5. Figures per scene are printed.
+TEST(Mosd, TableFoundAndObjectsRecalled) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
+  std::size_t objects = 0, matched = 0, tables = 0, scenes = 0;
+  std::size_t by_group_objects[4] = {0, 0, 0, 0}, by_group_matched[4] = {0, 0, 0, 0};
+  for (int i = 0; i <= 44; ++i) {
+    const auto path = test::data_dir() / "mosd/learn" / ("learn" + std::to_string(i) + ".pcd");
+    const SceneFigures f = run_scene(path, true);
+    ++scenes;
+    objects += f.objects;
+    matched += f.matched;
+    tables += f.table_iou >= 0.8 ? 1 : 0;
+    const int group = i <= 16 ? 0 : i <= 24 ? 1 : i <= 32 ? 2 : 3;
+    by_group_objects[group] += f.objects;
+    by_group_matched[group] += f.matched;
+  }
+  const double recall = static_cast<double>(matched) / objects;
+  std::printf("mOSD learn: %zu scenes, table IoU>=0.8 in %zu, object recall (IoU>=0.5) %zu/%zu = %.3f\n", scenes, tables,
+              matched, objects, recall);
+  const char* names[4] = {"boxes", "stacked boxes", "occluded objects", "cylindric objects"};
+  for (int g = 0; g < 4; ++g)
+    std::printf("  %-18s %zu/%zu\n", names[g], by_group_matched[g], by_group_objects[g]);
+  EXPECT_EQ(tables, scenes) << "the table plane must be found in every scene";
+  // Floor: every single box and most cylinders are recovered (38/38 boxes, 32/38 cylinders in
+  // the run this floor was set on, 0.82 overall). Stacked and touching objects are one connected
+  // surface, which a model-free Euclidean clusterer cannot split (mOSD's stated purpose), so the
+  // stacked-box scenes cap the overall recall.
+  EXPECT_GE(recall, 0.80);
+  EXPECT_EQ(by_group_matched[0], by_group_objects[0]) << "every isolated box must be recovered";
+}
+
+// The mug of PCL's stereo scene is one cluster standing on the table plane.
+TEST(Mosd, MugIsOneClusterOnTheTable) {
+  SCENEWATCH_REQUIRE_DATA("pcl/table_scene_mug_stereo_textured.pcd");
+  auto file = io::read_cloud(test::data_dir() / "pcl/table_scene_mug_stereo_textured.pcd");
+  ASSERT_TRUE(file.ok()) << file.error().message;
+  const Segmentation seg = segment(*file->cloud, Config{}, file->sensor_origin);
+  ASSERT_GE(seg.planes.size(), 1u);
+  std::printf("mug scene: %zu planes, %zu clusters\n", seg.planes.size(), seg.objects.size());
+  for (const auto& o : seg.objects) {
+    std::printf("  cluster on plane %d: %zu points, extents %.3f %.3f %.3f, centroid %.3f %.3f %.3f\n", o.plane_id,
+                o.point_count, o.box.extents.x(), o.box.extents.y(), o.box.extents.z(), o.centroid.x(), o.centroid.y(),
+                o.centroid.z());
+  }
+  ASSERT_GE(seg.objects.size(), 1u);
+  // The largest cluster is the mug, handle included: mug-sized, and the only sizeable cluster on
+  // its plane (the stereo data leave a few fragments of some hundred points elsewhere).
+  const ObjectCluster& mug = seg.objects.front();
+  EXPECT_GE(mug.point_count, 5000u);
+  EXPECT_GT(mug.box.extents.maxCoeff(), 0.06);
+  EXPECT_LT(mug.box.extents.maxCoeff(), 0.20);
+  const Plane& table = seg.planes[mug.plane_id];
+  EXPECT_NEAR(table.signed_distance(mug.centroid), 0.5 * mug.box.extents.z(), 0.03) << "the mug stands on its plane";
+  for (std::size_t i = 1; i < seg.objects.size(); ++i) {
+    if (seg.objects[i].plane_id == mug.plane_id) {
+      EXPECT_LT(seg.objects[i].point_count, mug.point_count / 20);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace scenewatch::segmentation
