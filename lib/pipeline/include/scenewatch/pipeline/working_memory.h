@@ -1,0 +1,109 @@
+#pragma once
+/// The facade: WorkingMemory::process(frame) validates the frame, segments it, tracks objects at
+/// cluster level, emits events and updates the background. It owns the modules; the service
+/// talks to it and knows nothing of their insides.
+#include <atomic>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <shared_mutex>
+#include <vector>
+
+#include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/core/event.h"
+#include "scenewatch/core/frame.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/core/scene.h"
+#include "scenewatch/segmentation/tabletop.h"
+
+namespace scenewatch::pipeline {
+
+struct TrackingConfig {
+  double match_distance_m = 0.05;   ///< a cluster matches a known object within this centroid distance
+  /// An unmatched object is gone when this share of its sample points lies in space the frame saw
+  /// through (or that the map already holds free); occluded objects are never gone.
+  double gone_free_fraction = 0.6;
+};
+
+/// Everything the pipeline needs; loaded from YAML by load_config().
+struct Config {
+  background::Config background;
+  segmentation::Config segmentation;
+  TrackingConfig tracking;
+  std::size_t max_event_log = 10000;  ///< events kept in memory for GetEvents
+};
+
+Status validate(const Config& config);
+
+/// What one frame produced.
+struct FrameResult {
+  std::uint64_t frame_index = 0;
+  std::vector<Plane> planes;            ///< world frame
+  std::vector<ObjectCluster> objects;   ///< world frame, indices into the frame's cloud
+  std::vector<Event> events;
+  background::InsertStats insert_stats;
+  double segment_ms = 0, insert_ms = 0, total_ms = 0;
+};
+
+/// An immutable view of the scene, swapped atomically after each frame: readers never wait for
+/// a frame being processed.
+struct SceneSnapshot {
+  std::uint64_t frames_processed = 0;
+  std::vector<Plane> planes;            ///< from the last frame, world frame
+  std::vector<TrackedObject> objects;   ///< tracked objects, world frame
+  double last_stamp_s = 0.0;
+};
+
+struct Stats {
+  std::uint64_t frames_processed = 0;
+  std::uint64_t points_processed = 0;
+  std::uint64_t events_emitted = 0;
+  std::size_t map_leaf_nodes = 0, map_occupied_leaves = 0, map_memory_bytes = 0;
+  double map_resolution_m = 0;
+  double last_frame_ms = 0, mean_frame_ms = 0;
+  std::size_t tracked_objects = 0;
+};
+
+using EventCallback = std::function<void(const Event&)>;
+
+/// Thread safe: process() calls are serialised; queries may run concurrently with them.
+class WorkingMemory {
+ public:
+  explicit WorkingMemory(Config config);
+  ~WorkingMemory();
+
+  /// Validates and processes one frame. On error nothing in the model changes.
+  Result<FrameResult> process(const Frame& frame);
+
+  std::shared_ptr<const SceneSnapshot> snapshot() const;
+  Stats stats() const;
+
+  background::Occupancy query(const Eigen::Vector3d& p_world) const;
+  background::BoxOccupancy query_box(const Aabb& box_world) const;
+  std::size_t clear_box(const Aabb& box_world);
+  void reset();
+
+  /// Model directory: written to a new snapshot folder (write, fsync, rename of a `current`
+  /// link), so a crash never leaves a half-written model.
+  Status save(const std::filesystem::path& model_dir) const;
+  /// Loads the model that `current` points at. A missing directory is an error of kind kNotFound.
+  Status load(const std::filesystem::path& model_dir);
+
+  /// Events are delivered on the thread that runs process(); callbacks must be quick.
+  int subscribe(EventCallback callback);
+  void unsubscribe(int token);
+  /// Events with id > since, oldest first, at most max_count.
+  std::vector<Event> events_since(std::uint64_t since, std::size_t max_count = 1000) const;
+
+  const Config& config() const { return config_; }
+
+ private:
+  struct Impl;
+  Config config_;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace scenewatch::pipeline

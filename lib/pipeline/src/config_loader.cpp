@@ -1,0 +1,118 @@
+#include "scenewatch/pipeline/config_loader.h"
+
+#include <system_error>
+
+namespace scenewatch::pipeline {
+namespace fs = std::filesystem;
+
+YamlSection::YamlSection(const YAML::Node& node, std::string name) : node_(node), name_(std::move(name)) {}
+
+Status YamlSection::check_is_map() const {
+  if (!node_.IsDefined() || node_.IsNull() || node_.IsMap()) return {};
+  return invalid_argument(name_ + ": must be a mapping of keys to values");
+}
+
+Status YamlSection::finish() const {
+  if (!node_.IsDefined() || node_.IsNull() || !node_.IsMap()) return {};
+  for (const auto& kv : node_) {
+    const std::string key = kv.first.as<std::string>();
+    if (seen_.count(key) == 0) return invalid_argument(path(key) + ": unknown key");
+  }
+  return {};
+}
+
+const std::vector<std::string>& pipeline_sections() {
+  static const std::vector<std::string> kSections = {"background", "segmentation", "tracking", "events"};
+  return kSections;
+}
+
+namespace {
+// Reads every key of a section in turn; stops at the first error.
+template <typename... Reads>
+Status read_all(Reads&&... reads) {
+  Status st;
+  ((st.ok() ? (st = reads(), 0) : 0), ...);
+  return st;
+}
+}  // namespace
+
+Status read_pipeline_config(const YAML::Node& root, Config& c) {
+  {
+    YamlSection s(root["background"], "background");
+    auto& b = c.background;
+    if (auto st = s.check_is_map(); !st) return st;
+    if (auto st = read_all([&] { return s.read("resolution_m", b.resolution_m); }, [&] { return s.read("max_range_m", b.max_range_m); },
+                           [&] { return s.read("prob_hit", b.prob_hit); }, [&] { return s.read("prob_miss", b.prob_miss); },
+                           [&] { return s.read("clamp_min", b.clamp_min); }, [&] { return s.read("clamp_max", b.clamp_max); },
+                           [&] { return s.read("fast_insertion", b.fast_insertion); });
+        !st)
+      return st;
+    if (auto st = s.finish(); !st) return st;
+  }
+  {
+    YamlSection s(root["segmentation"], "segmentation");
+    auto& g = c.segmentation;
+    if (auto st = s.check_is_map(); !st) return st;
+    std::vector<double> up;
+    if (auto st = read_all([&] { return s.read("voxel_size_m", g.voxel_size_m); }, [&] { return s.read("max_planes", g.max_planes); },
+                           [&] { return s.read("plane_distance_m", g.plane_distance_m); },
+                           [&] { return s.read("ransac_iterations", g.ransac_iterations); }, [&] { return s.read("seed", g.seed); },
+                           [&] { return s.read("min_plane_area_m2", g.min_plane_area_m2); },
+                           [&] { return s.read("plane_connectivity_m", g.plane_connectivity_m); },
+                           [&] { return s.read("up_vector", up); },
+                           [&] { return s.read("max_normal_angle_deg", g.max_normal_angle_deg); },
+                           [&] { return s.read("min_object_height_m", g.min_object_height_m); },
+                           [&] { return s.read("max_object_height_m", g.max_object_height_m); },
+                           [&] { return s.read("cluster_tolerance_m", g.cluster_tolerance_m); },
+                           [&] { return s.read("min_cluster_points", g.min_cluster_points); },
+                           [&] { return s.read("max_cluster_points", g.max_cluster_points); });
+        !st)
+      return st;
+    if (!up.empty()) {
+      if (up.size() != 3) return invalid_argument("segmentation.up_vector: must be [x, y, z] or null");
+      g.up = Eigen::Vector3d(up[0], up[1], up[2]);
+    }
+    if (auto st = s.finish(); !st) return st;
+  }
+  {
+    YamlSection s(root["tracking"], "tracking");
+    if (auto st = s.check_is_map(); !st) return st;
+    if (auto st = read_all([&] { return s.read("match_distance_m", c.tracking.match_distance_m); },
+                           [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); });
+        !st)
+      return st;
+    if (auto st = s.finish(); !st) return st;
+  }
+  {
+    YamlSection s(root["events"], "events");
+    if (auto st = s.check_is_map(); !st) return st;
+    if (auto st = s.read("max_log", c.max_event_log); !st) return st;
+    if (auto st = s.finish(); !st) return st;
+  }
+  return validate(c);
+}
+
+Result<YAML::Node> load_yaml_file(const fs::path& path, const std::vector<std::string>& known_sections) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) return not_found("'" + path.string() + "': no such config file");
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path.string());
+  } catch (const YAML::ParserException& e) {
+    return invalid_argument("'" + path.string() + "': YAML syntax error at line " + std::to_string(e.mark.line + 1) +
+                            ", column " + std::to_string(e.mark.column + 1) + ": " + e.msg);
+  } catch (const YAML::Exception& e) {
+    return invalid_argument("'" + path.string() + "': " + e.what());
+  }
+  if (root.IsNull()) return root;  // an empty file means all defaults
+  if (!root.IsMap()) return invalid_argument("'" + path.string() + "': the top level must be a mapping of sections");
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    if (std::find(known_sections.begin(), known_sections.end(), key) == known_sections.end()) {
+      return invalid_argument("'" + path.string() + "': unknown section '" + key + "'");
+    }
+  }
+  return root;
+}
+
+}  // namespace scenewatch::pipeline

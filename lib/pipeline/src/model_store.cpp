@@ -1,0 +1,196 @@
+#include "model_store.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <fstream>
+#include <system_error>
+
+namespace scenewatch::pipeline {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+Eigen::Vector3d vec3(const json& j) { return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()}; }
+
+json box_json(const OrientedBox& b) {
+  const Eigen::Quaterniond& q = b.rotation;
+  return {{"center", vec(b.center)}, {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}, {"extents", vec(b.extents)}};
+}
+OrientedBox box_from(const json& j) {
+  OrientedBox b;
+  b.center = vec3(j.at("center"));
+  const auto& q = j.at("rotation_xyzw");
+  b.rotation = Eigen::Quaterniond(q.at(3).get<double>(), q.at(0).get<double>(), q.at(1).get<double>(), q.at(2).get<double>()).normalized();
+  b.extents = vec3(j.at("extents"));
+  return b;
+}
+
+EventLevel level_from(const std::string& s) {
+  for (auto l : {EventLevel::kMismatch, EventLevel::kPrediction, EventLevel::kImplausibility}) {
+    if (s == to_string(l)) return l;
+  }
+  throw std::invalid_argument("unknown event level '" + s + "'");
+}
+EventKind kind_from(const std::string& s) {
+  for (int k = 0; k <= static_cast<int>(EventKind::kFrozenDofMotion); ++k) {
+    if (s == to_string(static_cast<EventKind>(k))) return static_cast<EventKind>(k);
+  }
+  throw std::invalid_argument("unknown event kind '" + s + "'");
+}
+
+template <typename T, typename F>
+Result<T> parse(const char* what, F&& f) {
+  try {
+    return f();
+  } catch (const std::exception& e) {
+    return invalid_argument(std::string("malformed ") + what + ": " + e.what());
+  }
+}
+}  // namespace
+
+json to_json(const Plane& p) {
+  json hull = json::array();
+  for (const auto& h : p.hull) hull.push_back(vec(h));
+  return {{"id", p.id}, {"normal", vec(p.normal)}, {"d", p.d}, {"hull", hull}, {"area_m2", p.area_m2},
+          {"inlier_count", p.inlier_count}, {"centroid", vec(p.centroid)}};
+}
+
+json to_json(const TrackedObject& o) {
+  const ObjectCluster& c = o.cluster;
+  return {{"id", o.id}, {"plane_id", c.plane_id}, {"centroid", vec(c.centroid)}, {"box", box_json(c.box)},
+          {"point_count", c.point_count}, {"mean_rgb", {c.mean_rgb.x(), c.mean_rgb.y(), c.mean_rgb.z()}},
+          {"first_seen_s", o.first_seen_s}, {"last_seen_s", o.last_seen_s}, {"observations", o.observations}};
+}
+
+json to_json(const Event& e) {
+  json j = {{"id", e.id}, {"stamp_s", e.stamp_s}, {"level", to_string(e.level)}, {"kind", to_string(e.kind)},
+            {"score", e.score}, {"box_min", vec(e.box_world.min)}, {"box_max", vec(e.box_world.max)},
+            {"centroid", vec(e.centroid_world)}, {"detail", e.detail}};
+  if (e.object_id) j["object_id"] = *e.object_id;
+  return j;
+}
+
+Result<Plane> plane_from_json(const json& j) {
+  return parse<Plane>("plane", [&] {
+    Plane p;
+    p.id = j.at("id").get<int>();
+    p.normal = vec3(j.at("normal"));
+    p.d = j.at("d").get<double>();
+    for (const auto& h : j.at("hull")) p.hull.push_back(vec3(h));
+    p.area_m2 = j.at("area_m2").get<double>();
+    p.inlier_count = j.at("inlier_count").get<std::size_t>();
+    p.centroid = vec3(j.at("centroid"));
+    return p;
+  });
+}
+
+Result<TrackedObject> object_from_json(const json& j) {
+  return parse<TrackedObject>("object", [&] {
+    TrackedObject o;
+    o.id = j.at("id").get<std::uint64_t>();
+    o.cluster.plane_id = j.at("plane_id").get<int>();
+    o.cluster.centroid = vec3(j.at("centroid"));
+    o.cluster.box = box_from(j.at("box"));
+    o.cluster.point_count = j.at("point_count").get<std::size_t>();
+    const auto& c = j.at("mean_rgb");
+    o.cluster.mean_rgb = Eigen::Vector3f(c.at(0).get<float>(), c.at(1).get<float>(), c.at(2).get<float>());
+    o.first_seen_s = j.at("first_seen_s").get<double>();
+    o.last_seen_s = j.at("last_seen_s").get<double>();
+    o.observations = j.at("observations").get<int>();
+    return o;
+  });
+}
+
+Result<Event> event_from_json(const json& j) {
+  return parse<Event>("event", [&] {
+    Event e;
+    e.id = j.at("id").get<std::uint64_t>();
+    e.stamp_s = j.at("stamp_s").get<double>();
+    e.level = level_from(j.at("level").get<std::string>());
+    e.kind = kind_from(j.at("kind").get<std::string>());
+    e.score = j.at("score").get<double>();
+    e.box_world = {vec3(j.at("box_min")), vec3(j.at("box_max"))};
+    e.centroid_world = vec3(j.at("centroid"));
+    e.detail = j.value("detail", "");
+    if (j.contains("object_id")) e.object_id = j.at("object_id").get<std::uint64_t>();
+    return e;
+  });
+}
+
+Status fsync_path(const fs::path& path, bool directory) {
+  const int fd = ::open(path.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);
+  if (fd < 0) return io_error("'" + path.string() + "': cannot open to sync");
+  const int rc = ::fsync(fd);
+  ::close(fd);
+  if (rc != 0) return io_error("'" + path.string() + "': fsync failed");
+  return {};
+}
+
+Status write_file_synced(const fs::path& path, const std::string& text) {
+  {
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) return io_error("'" + path.string() + "': cannot open for writing");
+    out << text;
+    out.flush();
+    if (!out) return io_error("'" + path.string() + "': write failed");
+  }
+  return fsync_path(path, false);
+}
+
+Result<fs::path> current_snapshot(const fs::path& model_dir) {
+  std::error_code ec;
+  const fs::path link = model_dir / "current";
+  if (!fs::is_symlink(link, ec)) return not_found("'" + model_dir.string() + "': no saved model (no 'current' link)");
+  const fs::path target = model_dir / fs::read_symlink(link, ec);
+  if (ec || !fs::is_directory(target, ec)) {
+    return invalid_argument("'" + link.string() + "': points at a missing snapshot folder");
+  }
+  return target;
+}
+
+Status commit_snapshot(const fs::path& model_dir, const std::function<Status(const fs::path&)>& write_files) {
+  std::error_code ec;
+  fs::create_directories(model_dir, ec);
+  if (ec) return io_error("'" + model_dir.string() + "': cannot create model directory: " + ec.message());
+  // Next snapshot number: one past the highest present.
+  int next = 1;
+  for (const auto& entry : fs::directory_iterator(model_dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("snap-", 0) == 0) next = std::max(next, std::atoi(name.c_str() + 5) + 1);
+  }
+  char name[32];
+  std::snprintf(name, sizeof(name), "snap-%06d", next);
+  const fs::path staging = model_dir / (std::string(name) + ".tmp");
+  const fs::path final_dir = model_dir / name;
+  fs::remove_all(staging, ec);
+  fs::create_directories(staging, ec);
+  if (ec) return io_error("'" + staging.string() + "': cannot create: " + ec.message());
+  if (auto st = write_files(staging); !st) {
+    fs::remove_all(staging, ec);
+    return st;
+  }
+  for (const auto& entry : fs::directory_iterator(staging, ec)) {
+    if (auto st = fsync_path(entry.path(), false); !st) return st;
+  }
+  if (auto st = fsync_path(staging, true); !st) return st;
+  fs::rename(staging, final_dir, ec);
+  if (ec) return io_error("'" + final_dir.string() + "': cannot rename snapshot into place: " + ec.message());
+  const fs::path link_tmp = model_dir / "current.tmp";
+  fs::remove(link_tmp, ec);
+  fs::create_directory_symlink(name, link_tmp, ec);
+  if (ec) return io_error("'" + link_tmp.string() + "': cannot create link: " + ec.message());
+  fs::rename(link_tmp, model_dir / "current", ec);  // atomic replacement of the link
+  if (ec) return io_error("'" + (model_dir / "current").string() + "': cannot replace link: " + ec.message());
+  if (auto st = fsync_path(model_dir, true); !st) return st;
+  // Older snapshots are no longer referenced.
+  for (const auto& entry : fs::directory_iterator(model_dir, ec)) {
+    const std::string n = entry.path().filename().string();
+    if (n.rfind("snap-", 0) == 0 && n != name) fs::remove_all(entry.path(), ec);
+  }
+  return {};
+}
+
+}  // namespace scenewatch::pipeline

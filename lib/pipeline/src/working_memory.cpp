@@ -1,0 +1,464 @@
+// The working memory: one frame at a time through validate -> segment -> track -> update the
+// background, with events out and an immutable snapshot for readers.
+#include "scenewatch/pipeline/working_memory.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <fstream>
+#include <sstream>
+
+#include "model_store.h"
+
+namespace scenewatch::pipeline {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+Status validate_frame(const Frame& f) {
+  const std::string where = f.source.empty() ? std::string("frame") : "frame from '" + f.source + "'";
+  if (!f.cloud || f.cloud->empty()) return invalid_argument(where + ": cloud is empty");
+  if (f.cloud->width * f.cloud->height != f.cloud->size()) {
+    return invalid_argument(where + ": cloud width x height (" + std::to_string(f.cloud->width) + "x" +
+                            std::to_string(f.cloud->height) + ") does not match its " + std::to_string(f.cloud->size()) + " points");
+  }
+  if (count_valid(*f.cloud) == 0) return invalid_argument(where + ": no valid points (all NaN or non-finite)");
+  if (!std::isfinite(f.stamp_s)) return invalid_argument(where + ": stamp is not finite");
+  if (f.T_world_camera) {
+    if (auto st = validate_rigid(f.T_world_camera->matrix()); !st) return invalid_argument(where + ": " + st.error().message);
+  }
+  if (f.intrinsics) {
+    const Intrinsics& K = *f.intrinsics;
+    if (!K.valid()) return invalid_argument(where + ": intrinsics are invalid");
+    if (f.cloud->height > 1 && (static_cast<int>(f.cloud->width) != K.width || static_cast<int>(f.cloud->height) != K.height)) {
+      return invalid_argument(where + ": intrinsics are for " + std::to_string(K.width) + "x" + std::to_string(K.height) +
+                              ", the organized cloud is " + std::to_string(f.cloud->width) + "x" + std::to_string(f.cloud->height));
+    }
+  }
+  return {};
+}
+
+Plane to_world(Plane p, const Pose& T) {
+  p.normal = T.linear() * p.normal;
+  p.centroid = T * p.centroid;
+  for (auto& h : p.hull) h = T * h;
+  p.d = -p.normal.dot(p.centroid);
+  return p;
+}
+
+ObjectCluster to_world(ObjectCluster c, const Pose& T) {
+  c.centroid = T * c.centroid;
+  c.box.center = T * c.box.center;
+  c.box.rotation = Eigen::Quaterniond(T.linear()) * c.box.rotation;
+  return c;
+}
+
+bool inside(const OrientedBox& box, const Eigen::Vector3d& p, double margin) {
+  const Eigen::Vector3d q = box.rotation.conjugate() * (p - box.center);
+  return (q.cwiseAbs().array() <= (0.5 * box.extents.array() + margin)).all();
+}
+
+constexpr std::size_t kSamplesPerObject = 200;
+
+}  // namespace
+
+struct WorkingMemory::Impl {
+  explicit Impl(const Config& c) : map(c.background), snapshot(std::make_shared<SceneSnapshot>()) {}
+
+  // process() and the other writers hold this for their whole duration.
+  mutable std::mutex writer;
+  // Guards `map` between writers and concurrent occupancy readers.
+  mutable std::shared_mutex map_mutex;
+  background::OccupancyMap map;
+
+  // Owned by the writer.
+  std::vector<TrackedObject> objects;
+  std::map<std::uint64_t, std::vector<Eigen::Vector3d>> object_samples;  // world points per object
+  std::vector<Plane> planes;
+  std::uint64_t next_object_id = 1;
+  std::uint64_t frames = 0, points = 0;
+  double total_ms = 0, last_ms = 0;
+
+  std::shared_ptr<const SceneSnapshot> snapshot;  // read and written with std::atomic_load/store
+
+  mutable std::mutex events_mutex;
+  std::deque<Event> events;
+  std::uint64_t next_event_id = 1;
+  std::uint64_t events_emitted = 0;
+  std::map<int, EventCallback> subscribers;
+  int next_token = 1;
+
+  void publish() {
+    auto s = std::make_shared<SceneSnapshot>();
+    s->frames_processed = frames;
+    s->planes = planes;
+    s->objects = objects;
+    s->last_stamp_s = objects.empty() ? 0.0 : objects.back().last_seen_s;
+    std::atomic_store(&snapshot, std::shared_ptr<const SceneSnapshot>(std::move(s)));
+  }
+
+  void emit(std::vector<Event>& batch, std::size_t max_log) {
+    std::vector<EventCallback> callbacks;
+    {
+      std::lock_guard<std::mutex> lock(events_mutex);
+      for (auto& e : batch) {
+        e.id = next_event_id++;
+        events.push_back(e);
+        ++events_emitted;
+      }
+      while (events.size() > max_log) events.pop_front();
+      for (const auto& [token, cb] : subscribers) callbacks.push_back(cb);
+    }
+    for (const auto& e : batch)
+      for (const auto& cb : callbacks) cb(e);
+  }
+};
+
+Status validate(const Config& c) {
+  if (auto st = background::validate(c.background); !st) return st;
+  if (auto st = segmentation::validate(c.segmentation); !st) return st;
+  if (!(c.tracking.match_distance_m > 0 && c.tracking.match_distance_m < 5)) return invalid_argument("tracking.match_distance_m: must be in (0, 5) m");
+  if (!(c.tracking.gone_free_fraction > 0 && c.tracking.gone_free_fraction <= 1)) return invalid_argument("tracking.gone_free_fraction: must be in (0, 1]");
+  if (c.max_event_log < 1) return invalid_argument("events.max_log: must be >= 1");
+  return {};
+}
+
+WorkingMemory::WorkingMemory(Config config) : config_(std::move(config)), impl_(std::make_unique<Impl>(config_)) {}
+WorkingMemory::~WorkingMemory() = default;
+
+Result<FrameResult> WorkingMemory::process(const Frame& frame) {
+  if (auto st = validate_frame(frame); !st) return st.error();
+  const auto t0 = Clock::now();
+  std::lock_guard<std::mutex> lock(impl_->writer);
+  Impl& m = *impl_;
+  const Pose T = frame.pose_or_identity();
+  FrameResult result;
+  result.frame_index = m.frames;
+
+  // Segment in the camera frame (indices stay those of the input cloud), then move to the world.
+  segmentation::Config seg = config_.segmentation;
+  if (seg.up) seg.up = T.linear().transpose() * *seg.up;
+  const auto t_seg = Clock::now();
+  segmentation::Segmentation s = segmentation::segment(*frame.cloud, seg, Eigen::Vector3d::Zero());
+  result.segment_ms = ms_since(t_seg);
+  for (auto& p : s.planes) result.planes.push_back(to_world(std::move(p), T));
+  for (auto& o : s.objects) result.objects.push_back(to_world(std::move(o), T));
+
+  // World sample points of each cluster, for the free-space evidence before and after insertion.
+  std::vector<std::vector<Eigen::Vector3d>> samples(result.objects.size());
+  for (std::size_t i = 0; i < result.objects.size(); ++i) {
+    const auto& idx = result.objects[i].indices;
+    const std::size_t step = std::max<std::size_t>(1, idx.size() / kSamplesPerObject);
+    for (std::size_t k = 0; k < idx.size(); k += step) samples[i].push_back(T * frame.cloud->points[idx[k]].getVector3fMap().cast<double>());
+  }
+  auto free_fraction = [&](const std::vector<Eigen::Vector3d>& pts) {
+    std::size_t n = 0;
+    for (const auto& p : pts) n += m.map.query(p) == background::Occupancy::kFree ? 1 : 0;
+    return pts.empty() ? 0.0 : static_cast<double>(n) / pts.size();
+  };
+
+  // Track: greedy nearest matching of clusters to remembered objects.
+  std::vector<Event> events;
+  std::vector<char> object_matched(m.objects.size(), 0);
+  std::vector<int> cluster_match(result.objects.size(), -1);
+  {
+    std::vector<std::tuple<double, int, int>> pairs;
+    for (std::size_t c = 0; c < result.objects.size(); ++c)
+      for (std::size_t o = 0; o < m.objects.size(); ++o) {
+        const double d = (result.objects[c].centroid - m.objects[o].cluster.centroid).norm();
+        if (d <= config_.tracking.match_distance_m ||
+            inside(result.objects[c].box, m.objects[o].cluster.centroid, 0.0)) {
+          pairs.emplace_back(d, static_cast<int>(c), static_cast<int>(o));
+        }
+      }
+    std::sort(pairs.begin(), pairs.end());
+    for (const auto& [d, c, o] : pairs) {
+      if (cluster_match[c] >= 0 || object_matched[o]) continue;
+      cluster_match[c] = o;
+      object_matched[o] = 1;
+    }
+  }
+
+  std::vector<double> prior_free(result.objects.size(), 0.0);
+  {
+    std::shared_lock<std::shared_mutex> read(m.map_mutex);
+    for (std::size_t c = 0; c < result.objects.size(); ++c) {
+      if (cluster_match[c] < 0) prior_free[c] = free_fraction(samples[c]);
+    }
+  }
+
+  // Update the background.
+  const auto t_ins = Clock::now();
+  {
+    std::unique_lock<std::shared_mutex> write(m.map_mutex);
+    result.insert_stats = m.map.insert(*frame.cloud, T);
+  }
+  result.insert_ms = ms_since(t_ins);
+
+  for (std::size_t c = 0; c < result.objects.size(); ++c) {
+    ObjectCluster cluster = result.objects[c];
+    cluster.indices.clear();  // indices belong to this frame only
+    if (cluster_match[c] >= 0) {
+      TrackedObject& obj = m.objects[cluster_match[c]];
+      obj.cluster = std::move(cluster);
+      obj.last_seen_s = frame.stamp_s;
+      ++obj.observations;
+      m.object_samples[obj.id] = samples[c];
+      continue;
+    }
+    TrackedObject obj;
+    obj.id = m.next_object_id++;
+    obj.cluster = std::move(cluster);
+    obj.first_seen_s = obj.last_seen_s = frame.stamp_s;
+    obj.observations = 1;
+    m.object_samples[obj.id] = samples[c];
+    Event e;
+    e.stamp_s = frame.stamp_s;
+    e.level = EventLevel::kMismatch;
+    e.kind = EventKind::kObjectAppeared;
+    // Score: the share of the object's points in space the map had seen free. 0 means merely
+    // first seen (the space was unknown); 1 means it appeared where there was nothing.
+    e.score = prior_free[c];
+    e.box_world = obj.cluster.box.aabb();
+    e.centroid_world = obj.cluster.centroid;
+    e.object_id = obj.id;
+    std::ostringstream os;
+    os << obj.cluster.point_count << " points on plane " << obj.cluster.plane_id << ", "
+       << static_cast<int>(std::round(100 * prior_free[c])) << "% in previously free space";
+    e.detail = os.str();
+    events.push_back(std::move(e));
+    m.objects.push_back(std::move(obj));
+  }
+
+  // Objects not seen in this frame are gone only when the space they filled is now seen free;
+  // an occluded or out-of-view object keeps its place.
+  {
+    std::shared_lock<std::shared_mutex> read(m.map_mutex);
+    std::vector<TrackedObject> kept;
+    for (std::size_t o = 0; o < m.objects.size(); ++o) {
+      TrackedObject& obj = m.objects[o];
+      if (o >= object_matched.size() || object_matched[o]) {
+        kept.push_back(std::move(obj));
+        continue;
+      }
+      const auto& pts = m.object_samples[obj.id];
+      std::size_t seen_through = 0;
+      for (const auto& p : pts) seen_through += m.map.freed_by_last_insert(p) ? 1 : 0;
+      const double f = std::max(free_fraction(pts), pts.empty() ? 0.0 : static_cast<double>(seen_through) / pts.size());
+      if (f < config_.tracking.gone_free_fraction) {
+        kept.push_back(std::move(obj));
+        continue;
+      }
+      Event e;
+      e.stamp_s = frame.stamp_s;
+      e.level = EventLevel::kMismatch;
+      e.kind = EventKind::kObjectGone;
+      e.score = f;
+      e.box_world = obj.cluster.box.aabb();
+      e.centroid_world = obj.cluster.centroid;
+      e.object_id = obj.id;
+      e.detail = std::to_string(static_cast<int>(std::round(100 * f))) + "% of its space is now seen free";
+      events.push_back(std::move(e));
+      m.object_samples.erase(obj.id);
+    }
+    m.objects.swap(kept);
+  }
+
+  m.planes = result.planes;
+  for (auto& p : m.planes) p.indices.clear();
+  ++m.frames;
+  m.points += result.insert_stats.points;
+  result.total_ms = ms_since(t0);
+  m.last_ms = result.total_ms;
+  m.total_ms += result.total_ms;
+  m.emit(events, config_.max_event_log);
+  result.events = std::move(events);
+  m.publish();
+  return result;
+}
+
+std::shared_ptr<const SceneSnapshot> WorkingMemory::snapshot() const { return std::atomic_load(&impl_->snapshot); }
+
+Stats WorkingMemory::stats() const {
+  Stats s;
+  {
+    std::lock_guard<std::mutex> lock(impl_->writer);
+    s.frames_processed = impl_->frames;
+    s.points_processed = impl_->points;
+    s.last_frame_ms = impl_->last_ms;
+    s.mean_frame_ms = impl_->frames ? impl_->total_ms / impl_->frames : 0.0;
+    s.tracked_objects = impl_->objects.size();
+    std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
+    s.map_leaf_nodes = impl_->map.num_leaf_nodes();
+    s.map_occupied_leaves = impl_->map.num_occupied_leaves();
+    s.map_memory_bytes = impl_->map.memory_bytes();
+    s.map_resolution_m = impl_->map.resolution();
+  }
+  std::lock_guard<std::mutex> lock(impl_->events_mutex);
+  s.events_emitted = impl_->events_emitted;
+  return s;
+}
+
+background::Occupancy WorkingMemory::query(const Eigen::Vector3d& p) const {
+  std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
+  return impl_->map.query(p);
+}
+
+background::BoxOccupancy WorkingMemory::query_box(const Aabb& box) const {
+  std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
+  return impl_->map.query_box(box);
+}
+
+std::size_t WorkingMemory::clear_box(const Aabb& box) {
+  std::lock_guard<std::mutex> lock(impl_->writer);
+  std::unique_lock<std::shared_mutex> write(impl_->map_mutex);
+  return impl_->map.clear_box(box);
+}
+
+void WorkingMemory::reset() {
+  std::lock_guard<std::mutex> lock(impl_->writer);
+  {
+    std::unique_lock<std::shared_mutex> write(impl_->map_mutex);
+    impl_->map.reset();
+  }
+  impl_->objects.clear();
+  impl_->object_samples.clear();
+  impl_->planes.clear();
+  impl_->frames = impl_->points = 0;
+  impl_->total_ms = impl_->last_ms = 0;
+  impl_->publish();
+}
+
+Status WorkingMemory::save(const fs::path& model_dir) const {
+  std::lock_guard<std::mutex> lock(impl_->writer);
+  const Impl& m = *impl_;
+  return commit_snapshot(model_dir, [&](const fs::path& dir) -> Status {
+    {
+      std::shared_lock<std::shared_mutex> read(m.map_mutex);
+      if (auto st = m.map.save(dir / "background.ot"); !st) return st;
+    }
+    nlohmann::json scene = {{"format", "scenewatch-model"}, {"version", 1}, {"frames_processed", m.frames},
+                            {"points_processed", m.points}, {"next_object_id", m.next_object_id}};
+    scene["objects"] = nlohmann::json::array();
+    for (const auto& o : m.objects) {
+      nlohmann::json j = to_json(o);
+      nlohmann::json pts = nlohmann::json::array();
+      auto it = m.object_samples.find(o.id);
+      if (it != m.object_samples.end())
+        for (const auto& p : it->second) pts.push_back({p.x(), p.y(), p.z()});
+      j["samples"] = pts;
+      scene["objects"].push_back(j);
+    }
+    scene["planes"] = nlohmann::json::array();
+    for (const auto& p : m.planes) scene["planes"].push_back(to_json(p));
+    std::string log;
+    {
+      std::lock_guard<std::mutex> events_lock(m.events_mutex);
+      scene["next_event_id"] = m.next_event_id;
+      for (const auto& e : m.events) log += to_json(e).dump() + "\n";
+    }
+    if (auto st = write_file_synced(dir / "scene.json", scene.dump(2)); !st) return st;
+    return write_file_synced(dir / "events.jsonl", log);
+  });
+}
+
+Status WorkingMemory::load(const fs::path& model_dir) {
+  auto dir = current_snapshot(model_dir);
+  if (!dir) return dir.error();
+  // Build everything aside first: a bad file leaves the model as it was.
+  background::OccupancyMap map(config_.background);
+  if (auto st = map.load(*dir / "background.ot"); !st) return st;
+  std::ifstream in(*dir / "scene.json");
+  if (!in) return io_error("'" + (*dir / "scene.json").string() + "': cannot open");
+  nlohmann::json scene;
+  try {
+    scene = nlohmann::json::parse(in);
+  } catch (const std::exception& e) {
+    return invalid_argument("'" + (*dir / "scene.json").string() + "': " + e.what());
+  }
+  std::vector<TrackedObject> objects;
+  std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples;
+  std::vector<Plane> planes;
+  std::deque<Event> events;
+  std::uint64_t frames = 0, points = 0, next_object_id = 1, next_event_id = 1;
+  try {
+    frames = scene.at("frames_processed").get<std::uint64_t>();
+    points = scene.value("points_processed", std::uint64_t{0});
+    next_object_id = scene.at("next_object_id").get<std::uint64_t>();
+    next_event_id = scene.value("next_event_id", std::uint64_t{1});
+    for (const auto& j : scene.at("objects")) {
+      auto o = object_from_json(j);
+      if (!o) return o.error();
+      for (const auto& p : j.value("samples", nlohmann::json::array()))
+        samples[o->id].emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+      objects.push_back(*o);
+    }
+    for (const auto& j : scene.at("planes")) {
+      auto p = plane_from_json(j);
+      if (!p) return p.error();
+      planes.push_back(*p);
+    }
+  } catch (const std::exception& e) {
+    return invalid_argument("'" + (*dir / "scene.json").string() + "': malformed: " + e.what());
+  }
+  std::ifstream log(*dir / "events.jsonl");
+  std::string line;
+  while (std::getline(log, line)) {
+    if (line.empty()) continue;
+    try {
+      auto e = event_from_json(nlohmann::json::parse(line));
+      if (!e) return e.error();
+      events.push_back(*e);
+    } catch (const std::exception& ex) {
+      return invalid_argument("'" + (*dir / "events.jsonl").string() + "': " + ex.what());
+    }
+  }
+
+  std::lock_guard<std::mutex> lock(impl_->writer);
+  Impl& m = *impl_;
+  {
+    std::unique_lock<std::shared_mutex> write(m.map_mutex);
+    m.map = std::move(map);
+  }
+  config_.background.resolution_m = m.map.resolution();
+  m.objects = std::move(objects);
+  m.object_samples = std::move(samples);
+  m.planes = std::move(planes);
+  m.frames = frames;
+  m.points = points;
+  m.next_object_id = next_object_id;
+  {
+    std::lock_guard<std::mutex> events_lock(m.events_mutex);
+    m.events = std::move(events);
+    m.next_event_id = std::max(next_event_id, m.events.empty() ? 1 : m.events.back().id + 1);
+  }
+  m.publish();
+  return {};
+}
+
+int WorkingMemory::subscribe(EventCallback callback) {
+  std::lock_guard<std::mutex> lock(impl_->events_mutex);
+  const int token = impl_->next_token++;
+  impl_->subscribers.emplace(token, std::move(callback));
+  return token;
+}
+
+void WorkingMemory::unsubscribe(int token) {
+  std::lock_guard<std::mutex> lock(impl_->events_mutex);
+  impl_->subscribers.erase(token);
+}
+
+std::vector<Event> WorkingMemory::events_since(std::uint64_t since, std::size_t max_count) const {
+  std::lock_guard<std::mutex> lock(impl_->events_mutex);
+  std::vector<Event> out;
+  for (const auto& e : impl_->events) {
+    if (e.id > since && out.size() < max_count) out.push_back(e);
+  }
+  return out;
+}
+
+}  // namespace scenewatch::pipeline

@@ -1,0 +1,280 @@
+// The working memory end to end on synthetic and real frames: events, tracking, validation,
+// snapshots, save and load.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <fstream>
+#include <random>
+#include <thread>
+
+#include "scenewatch/io/cloud_io.h"
+#include "scenewatch/pipeline/working_memory.h"
+#include "test_data.h"
+
+namespace scenewatch::pipeline {
+namespace {
+namespace fs = std::filesystem;
+
+// A camera 1 m above a 1.2 x 1.2 m table top (world z = 0), looking down, rendered as an
+// organized cloud by casting one ray per pixel against the table and axis-aligned boxes on it.
+struct Box {
+  Eigen::Vector3d lo, hi;
+};
+
+Cloud render(const std::vector<Box>& boxes, const Pose& T_world_camera, int w = 160, int h = 120) {
+  Cloud c(w, h);
+  const double f = 0.5 * w;  // 90 degree horizontal field of view
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const Eigen::Vector3d dir_c = Eigen::Vector3d((u - 0.5 * w) / f, (v - 0.5 * h) / f, 1.0).normalized();
+      const Eigen::Vector3d o = T_world_camera.translation();
+      const Eigen::Vector3d d = T_world_camera.linear() * dir_c;
+      double best = std::numeric_limits<double>::infinity();
+      if (d.z() < 0) {
+        const double t = -o.z() / d.z();
+        const Eigen::Vector3d p = o + t * d;
+        if (std::abs(p.x()) <= 0.6 && std::abs(p.y()) <= 0.6) best = t;
+      }
+      for (const Box& b : boxes) {  // slab test
+        double t0 = 0, t1 = best;
+        for (int i = 0; i < 3; ++i) {
+          const double inv = 1.0 / d(i);
+          double a = (b.lo(i) - o(i)) * inv, c2 = (b.hi(i) - o(i)) * inv;
+          if (a > c2) std::swap(a, c2);
+          t0 = std::max(t0, a);
+          t1 = std::min(t1, c2);
+        }
+        if (t0 <= t1 && t0 < best) best = t0;
+      }
+      PointT& p = c.at(u, v);
+      if (!std::isfinite(best)) {
+        p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+        continue;
+      }
+      const Eigen::Vector3f pc = (best * dir_c).cast<float>();
+      p.getVector3fMap() = pc;
+      p.r = p.g = p.b = 150;
+    }
+  return c;
+}
+
+Pose looking_down(double height = 1.0) {
+  Pose T = Pose::Identity();
+  T.linear() = Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()).toRotationMatrix();  // z down, y flipped
+  T.translation() = Eigen::Vector3d(0, 0, height);
+  return T;
+}
+
+Frame make_frame(const std::vector<Box>& boxes, double stamp) {
+  Frame f;
+  f.cloud = std::make_shared<Cloud>(render(boxes, looking_down()));
+  f.T_world_camera = looking_down();
+  f.stamp_s = stamp;
+  f.source = "synthetic";
+  return f;
+}
+
+Config test_config() {
+  Config c;
+  c.segmentation.up = Eigen::Vector3d::UnitZ();
+  c.segmentation.min_cluster_points = 20;
+  c.background.resolution_m = 0.02;
+  return c;
+}
+
+const Box kCube{{0.10, 0.10, 0.0}, {0.20, 0.20, 0.10}};
+const Box kTall{{-0.25, -0.20, 0.0}, {-0.15, -0.10, 0.20}};
+
+std::size_t count_kind(const std::vector<Event>& events, EventKind kind) {
+  return static_cast<std::size_t>(std::count_if(events.begin(), events.end(), [kind](const Event& e) { return e.kind == kind; }));
+}
+
+TEST(WorkingMemory, ObjectsAppearStayAndGo) {
+  WorkingMemory wm(test_config());
+  std::vector<Event> pushed;
+  const int token = wm.subscribe([&](const Event& e) { pushed.push_back(e); });
+
+  auto r1 = wm.process(make_frame({kCube, kTall}, 1.0));
+  ASSERT_TRUE(r1.ok()) << r1.error().message;
+  ASSERT_EQ(r1->planes.size(), 1u);
+  EXPECT_NEAR(r1->planes[0].normal.z(), 1.0, 1e-3) << "plane in world coordinates";
+  EXPECT_NEAR(r1->planes[0].d, 0.0, 0.01);
+  ASSERT_EQ(r1->objects.size(), 2u);
+  EXPECT_EQ(count_kind(r1->events, EventKind::kObjectAppeared), 2u);
+  for (const auto& e : r1->events) EXPECT_DOUBLE_EQ(e.score, 0.0) << "first sight: the space was unknown";
+  EXPECT_EQ(pushed.size(), 2u);
+
+  // The same view again: the objects are matched, nothing new.
+  auto r2 = wm.process(make_frame({kCube, kTall}, 2.0));
+  ASSERT_TRUE(r2.ok());
+  EXPECT_TRUE(r2->events.empty());
+  auto snap = wm.snapshot();
+  ASSERT_EQ(snap->objects.size(), 2u);
+  for (const auto& o : snap->objects) EXPECT_EQ(o.observations, 2);
+
+  // The cube is taken away: its space is now seen free -> gone. The tall box stays.
+  auto r3 = wm.process(make_frame({kTall}, 3.0));
+  ASSERT_TRUE(r3.ok());
+  ASSERT_EQ(count_kind(r3->events, EventKind::kObjectGone), 1u);
+  const Event& gone = r3->events.front();
+  EXPECT_NEAR(gone.centroid_world.x(), 0.15, 0.03);
+  EXPECT_NEAR(gone.centroid_world.y(), 0.15, 0.03);
+  EXPECT_EQ(wm.snapshot()->objects.size(), 1u);
+
+  // A cube is put where the table had been seen three times: it appears in space the map holds
+  // free, so the score is high (the first objects scored 0: their space was unknown).
+  const Box moved{{-0.25, 0.15, 0.0}, {-0.15, 0.25, 0.10}};
+  auto r4 = wm.process(make_frame({kTall, moved}, 4.0));
+  ASSERT_TRUE(r4.ok());
+  ASSERT_EQ(count_kind(r4->events, EventKind::kObjectAppeared), 1u);
+  EXPECT_GT(r4->events.front().score, 0.5);
+
+  wm.unsubscribe(token);
+  ASSERT_TRUE(wm.process(make_frame({kTall}, 5.0)).ok());
+  EXPECT_EQ(pushed.size(), 4u) << "no events after unsubscribing";
+  const auto log = wm.events_since(0);
+  ASSERT_EQ(log.size(), 5u);
+  for (std::size_t i = 1; i < log.size(); ++i) EXPECT_GT(log[i].id, log[i - 1].id);
+  EXPECT_EQ(wm.events_since(log[2].id).size(), 2u);
+}
+
+TEST(WorkingMemory, OccludedObjectIsNotGone) {
+  WorkingMemory wm(test_config());
+  ASSERT_TRUE(wm.process(make_frame({kCube}, 1.0)).ok());
+  // A large box now hides the cube from the camera: no evidence that it left.
+  const Box cover{{0.05, 0.05, 0.0}, {0.25, 0.25, 0.6}};
+  auto r = wm.process(make_frame({kCube, cover}, 2.0));
+  ASSERT_TRUE(r.ok());
+  EXPECT_EQ(count_kind(r->events, EventKind::kObjectGone), 0u);
+}
+
+TEST(WorkingMemory, BadFramesChangeNothing) {
+  WorkingMemory wm(test_config());
+  ASSERT_TRUE(wm.process(make_frame({kCube}, 1.0)).ok());
+  const auto before = wm.snapshot();
+  const Stats stats_before = wm.stats();
+
+  Frame nan_pose = make_frame({kCube}, 2.0);
+  nan_pose.T_world_camera->translation().x() = std::numeric_limits<double>::quiet_NaN();
+  auto r = wm.process(nan_pose);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("non-finite"), std::string::npos);
+
+  Frame skew = make_frame({kCube}, 2.0);
+  skew.T_world_camera->linear()(0, 1) = 0.5;
+  EXPECT_FALSE(wm.process(skew).ok());
+
+  Frame empty;
+  empty.cloud = std::make_shared<Cloud>();
+  EXPECT_NE(wm.process(empty).error().message.find("empty"), std::string::npos);
+
+  Frame all_nan;
+  auto c = std::make_shared<Cloud>(4, 4);
+  for (auto& p : c->points) p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
+  all_nan.cloud = c;
+  EXPECT_NE(wm.process(all_nan).error().message.find("no valid points"), std::string::npos);
+
+  Frame wrong_k = make_frame({kCube}, 2.0);
+  wrong_k.intrinsics = Intrinsics{500, 500, 320, 240, 640, 480};
+  EXPECT_FALSE(wm.process(wrong_k).ok()) << "intrinsics for 640x480, cloud is 160x120";
+
+  EXPECT_EQ(wm.snapshot(), before) << "the snapshot was not replaced";
+  const Stats after = wm.stats();
+  EXPECT_EQ(after.frames_processed, stats_before.frames_processed);
+  EXPECT_EQ(after.map_leaf_nodes, stats_before.map_leaf_nodes);
+}
+
+TEST(WorkingMemory, OccupancyQueriesClearAndReset) {
+  WorkingMemory wm(test_config());
+  ASSERT_TRUE(wm.process(make_frame({kCube}, 1.0)).ok());
+  EXPECT_EQ(wm.query({0.15, 0.15, 0.10}), background::Occupancy::kOccupied) << "the cube's top";
+  EXPECT_EQ(wm.query({0.15, 0.15, 0.5}), background::Occupancy::kFree);
+  EXPECT_EQ(wm.query({0.15, 0.15, 0.05}), background::Occupancy::kUnknown) << "inside the cube";
+  EXPECT_EQ(wm.query_box({{0.1, 0.1, 0.09}, {0.2, 0.2, 0.11}}).state, background::Occupancy::kOccupied);
+  EXPECT_GT(wm.clear_box({{0.1, 0.1, 0.08}, {0.2, 0.2, 0.12}}), 0u);
+  EXPECT_EQ(wm.query({0.15, 0.15, 0.10}), background::Occupancy::kFree);
+  wm.reset();
+  EXPECT_EQ(wm.query({0.15, 0.15, 0.5}), background::Occupancy::kUnknown);
+  EXPECT_TRUE(wm.snapshot()->objects.empty());
+  EXPECT_EQ(wm.stats().frames_processed, 0u);
+}
+
+TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
+  const fs::path dir = test::make_temp_dir("model");
+  {
+    WorkingMemory wm(test_config());
+    EXPECT_EQ(wm.load(dir).error().code, ErrorCode::kNotFound) << "nothing saved yet";
+    ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, 1.0)).ok());
+    ASSERT_TRUE(wm.save(dir).ok());
+    ASSERT_TRUE(wm.process(make_frame({kTall}, 2.0)).ok());
+    ASSERT_TRUE(wm.save(dir).ok()) << "a second save replaces the first";
+  }
+  EXPECT_TRUE(fs::is_symlink(dir / "current"));
+  std::size_t snapshots = 0;
+  for (const auto& e : fs::directory_iterator(dir)) snapshots += e.path().filename().string().rfind("snap-", 0) == 0;
+  EXPECT_EQ(snapshots, 1u) << "older snapshots are removed";
+
+  WorkingMemory wm(test_config());
+  ASSERT_TRUE(wm.load(dir).ok());
+  auto snap = wm.snapshot();
+  ASSERT_EQ(snap->objects.size(), 1u) << "the cube was gone at the second save";
+  EXPECT_EQ(snap->planes.size(), 1u);
+  EXPECT_EQ(wm.stats().frames_processed, 2u);
+  EXPECT_EQ(wm.events_since(0).size(), 3u) << "2 appeared + 1 gone";
+  EXPECT_EQ(wm.query_box({{-0.22, -0.18, 0.18}, {-0.18, -0.12, 0.22}}).state, background::Occupancy::kOccupied)
+      << "the map came back: the tall box's top";
+  // New events continue the numbering.
+  auto r = wm.process(make_frame({kTall, kCube}, 3.0));
+  ASSERT_TRUE(r.ok());
+  ASSERT_FALSE(r->events.empty());
+  EXPECT_GT(r->events.front().id, 3u);
+  EXPECT_GT(r->events.front().object_id.value(), 2u) << "object ids are not reused";
+
+  // A damaged model is refused and the loaded one stays.
+  const fs::path current = fs::read_symlink(dir / "current");
+  std::ofstream(dir / current / "scene.json") << "{ not json";
+  auto st = wm.load(dir);
+  ASSERT_FALSE(st.ok());
+  EXPECT_NE(st.error().message.find("scene.json"), std::string::npos);
+  EXPECT_EQ(wm.snapshot()->objects.size(), 2u);
+  fs::remove_all(dir);
+}
+
+TEST(WorkingMemory, ReadersRunWhileFramesAreProcessed) {
+  WorkingMemory wm(test_config());
+  std::atomic<bool> done{false};
+  std::atomic<std::size_t> reads{0};
+  std::thread reader([&] {
+    while (!done) {
+      auto s = wm.snapshot();
+      ASSERT_NE(s, nullptr);
+      wm.query({0, 0, 0.5});
+      ++reads;
+    }
+  });
+  for (int i = 0; i < 10; ++i) ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, i)).ok());
+  done = true;
+  reader.join();
+  EXPECT_GT(reads.load(), 0u);
+  EXPECT_EQ(wm.snapshot()->frames_processed, 10u);
+}
+
+TEST(WorkingMemory, RealKinectFrame) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn13.pcd");
+  auto file = io::read_cloud(test::data_dir() / "mosd/learn/learn13.pcd");
+  ASSERT_TRUE(file.ok());
+  WorkingMemory wm(Config{});
+  Frame f;
+  f.cloud = file->cloud;
+  f.stamp_s = 1;
+  auto r = wm.process(f);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  std::printf("learn13: %zu planes, %zu objects, segment %.1f ms, insert %.1f ms, total %.1f ms\n", r->planes.size(),
+              r->objects.size(), r->segment_ms, r->insert_ms, r->total_ms);
+  EXPECT_EQ(r->planes.size(), 1u);
+  EXPECT_EQ(r->objects.size(), 3u) << "learn13 has three boxes on the table";
+  EXPECT_EQ(count_kind(r->events, EventKind::kObjectAppeared), 3u);
+}
+
+}  // namespace
+}  // namespace scenewatch::pipeline
