@@ -2,19 +2,20 @@
 //
 // Fast insertion follows OctoMap's own discretized update (OccupancyOcTreeBase::computeDiscreteUpdate):
 // endpoints are first reduced to one per voxel, rays are cast from the sensor to the voxel centres,
-// and cells both hit and passed through count as hit. We keep the key sets in robin-hood hash sets,
-// update the leaves with lazy evaluation in Morton order (neighbouring keys share tree paths), and
-// refresh the inner nodes once per frame.
+// and cells both hit and passed through count as hit. The key sets live in robin-hood hash sets;
+// the updates are radix-sorted by Morton code and applied in one ordered descent of the tree
+// (bulk_update.h), which also refreshes inner nodes along the touched paths only.
 #include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
 #include <tsl/robin_map.h>
-#include <tsl/robin_set.h>
 
 #include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <system_error>
 
+#include "bulk_update.h"
+#include "ray_set.h"
 #include "scenewatch/background/occupancy_map.h"
 
 namespace scenewatch::background {
@@ -42,19 +43,6 @@ struct KeyHash {
   }
 };
 
-// Interleaves the 16-bit key components so that sorting visits the tree depth-first.
-std::uint64_t morton(std::uint64_t packed) {
-  auto spread = [](std::uint64_t v) {
-    v &= 0xffff;
-    v = (v | (v << 16)) & 0x0000ff0000ffULL;
-    v = (v | (v << 8)) & 0x00f00f00f00fULL;
-    v = (v | (v << 4)) & 0x0c30c30c30c3ULL;
-    v = (v | (v << 2)) & 0x249249249249ULL;
-    return v;
-  };
-  return spread(packed >> 32) | (spread(packed >> 16) << 1) | (spread(packed) << 2);
-}
-
 struct ColorSum {
   std::uint32_t r = 0, g = 0, b = 0, n = 0;
 };
@@ -77,13 +65,12 @@ struct OccupancyMap::Impl {
     tree.setClampingThresMin(c.clamp_min);
     tree.setClampingThresMax(c.clamp_max);
   }
-  octomap::ColorOcTree tree;
-  // Scratch buffers kept between frames to avoid reallocation.
+  BulkColorOcTree tree;
+  // The last insert's endpoints (with their colour) and ray voxels, kept for
+  // freed_by_last_insert(); scratch buffers reused between frames.
   tsl::robin_map<std::uint64_t, ColorSum, KeyHash> endpoints;
-  tsl::robin_set<std::uint64_t, KeyHash> clipped_ends;
-  tsl::robin_set<std::uint64_t, KeyHash> free_cells;   // of the last insert, without its endpoints
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> order;  // (morton, packed)
-  octomap::KeyRay ray;
+  RaySet rays;
+  std::vector<std::uint64_t> clipped_ends, updates, scratch;
 };
 
 Status validate(const Config& c) {
@@ -111,16 +98,66 @@ OccupancyMap::~OccupancyMap() = default;
 OccupancyMap::OccupancyMap(OccupancyMap&&) noexcept = default;
 OccupancyMap& OccupancyMap::operator=(OccupancyMap&&) noexcept = default;
 
+namespace {
+// The voxels from the origin's voxel up to, not including, the end's voxel: OctoMap's
+// OcTreeBaseImpl::computeRayKeys (Amanatides & Woo), step for step, with its float/double
+// arithmetic, so that the rays match OctoMap's; they go into a RaySet instead of a KeyRay.
+void cast_ray(const octomap::ColorOcTree& tree, const octomap::point3d& origin, const OcTreeKey& key_origin,
+              const octomap::point3d& end, const OcTreeKey& key_end, RaySet& rays) {
+  if (key_origin == key_end) return;
+  rays.insert_free(key_origin);
+  octomap::point3d direction = end - origin;
+  const float length = static_cast<float>(direction.norm());
+  direction /= length;
+  int step[3];
+  double t_max[3], t_delta[3];
+  OcTreeKey current = key_origin;
+  const double res = tree.getResolution();
+  for (unsigned i = 0; i < 3; ++i) {
+    step[i] = direction(i) > 0.0 ? 1 : (direction(i) < 0.0 ? -1 : 0);
+    if (step[i] != 0) {
+      double border = tree.keyToCoord(current[i]);
+      border += static_cast<float>(step[i] * res * 0.5);
+      t_max[i] = (border - origin(i)) / direction(i);
+      t_delta[i] = res / std::fabs(direction(i));
+    } else {
+      t_max[i] = t_delta[i] = std::numeric_limits<double>::max();
+    }
+  }
+  while (true) {
+    const unsigned dim = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
+    current[dim] = static_cast<octomap::key_type>(current[dim] + step[dim]);
+    t_max[dim] += t_delta[dim];
+    if (current == key_end) return;
+    if (std::min(std::min(t_max[0], t_max[1]), t_max[2]) > length) return;
+    rays.insert_free(current);
+  }
+}
+}  // namespace
+
 InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world_camera) {
   auto& tree = impl_->tree;
+  auto& endpoints = impl_->endpoints;
+  auto& rays = impl_->rays;
+  endpoints.clear();
   InsertStats stats;
   const Eigen::Isometry3f T = T_world_camera.cast<float>();
   const Eigen::Vector3f origin_f = T.translation();
   const octomap::point3d origin(origin_f.x(), origin_f.y(), origin_f.z());
   const double max_range = config_.max_range_m;
+  OcTreeKey origin_key;
+  if (!tree.coordToKeyChecked(origin, origin_key)) {
+    rays.reset(OcTreeKey(0, 0, 0), OcTreeKey(0, 0, 0));
+    return stats;  // the sensor is outside the map's extent
+  }
+  OcTreeKey lo = origin_key, hi = origin_key;
+  auto grow = [&](const OcTreeKey& k) {
+    for (int i = 0; i < 3; ++i) {
+      lo[i] = std::min(lo[i], k[i]);
+      hi[i] = std::max(hi[i], k[i]);
+    }
+  };
 
-  auto& free_cells = impl_->free_cells;
-  free_cells.clear();
   if (!config_.fast_insertion) {
     // Reference: OctoMap's plain insertion, one ray per point.
     octomap::Pointcloud scan;
@@ -131,11 +168,18 @@ InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world
       scan.push_back(w.x(), w.y(), w.z());
     }
     stats.points = scan.size();
+    const double range = max_range > 0 ? max_range : -1.0;
     // The same key sets OctoMap computes inside insertPointCloud, kept for freed_by_last_insert().
     octomap::KeySet free_keys, occupied_keys;
-    tree.computeUpdate(scan, origin, free_keys, occupied_keys, max_range > 0 ? max_range : -1.0);
-    for (const auto& k : free_keys) free_cells.insert(pack(k));
-    tree.insertPointCloud(scan, origin, max_range > 0 ? max_range : -1.0, /*lazy_eval=*/false, /*discretize=*/false);
+    tree.computeUpdate(scan, origin, free_keys, occupied_keys, range);
+    for (const auto& k : free_keys) grow(k);
+    for (const auto& k : occupied_keys) grow(k);
+    rays.reset(lo, hi);
+    for (const auto& k : free_keys) rays.insert_free(k);
+    for (const auto& k : occupied_keys) rays.insert_end(k);
+    stats.free_updates = free_keys.size();
+    stats.occupied_updates = occupied_keys.size();
+    tree.insertPointCloud(scan, origin, range, /*lazy_eval=*/false, /*discretize=*/false);
     for (const auto& p : points_camera.points) {
       if (!is_valid(p)) continue;
       const Eigen::Vector3f w = T * p.getVector3fMap();
@@ -144,12 +188,10 @@ InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world
     return stats;
   }
 
-  auto& endpoints = impl_->endpoints;
+  // 1. One endpoint per voxel, with the frame's mean colour in it; rays beyond max range are cut
+  //    and end in a voxel that is freed, not hit.
   auto& clipped = impl_->clipped_ends;
-  endpoints.clear();
   clipped.clear();
-
-  // 1. One endpoint per voxel, with the frame's mean colour in it.
   OcTreeKey key;
   for (const auto& p : points_camera.points) {
     if (!is_valid(p)) continue;
@@ -159,7 +201,7 @@ InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world
     const float range = d.norm();
     if (max_range > 0 && range > max_range) {
       w = origin_f + d * static_cast<float>(max_range / range);
-      if (tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) clipped.insert(pack(key));
+      if (tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) clipped.push_back(pack(key));
       continue;
     }
     if (!tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) continue;
@@ -169,48 +211,38 @@ InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world
     c.b += p.b;
     ++c.n;
   }
+  std::sort(clipped.begin(), clipped.end());
+  clipped.erase(std::unique(clipped.begin(), clipped.end()), clipped.end());
+  for (const auto& [k, c] : endpoints) grow(unpack(k));
+  for (std::uint64_t k : clipped) grow(unpack(k));
 
-  // 2. Rays from the sensor to each endpoint voxel centre; the end voxel itself is not on the ray.
-  auto cast = [&](std::uint64_t end_key) {
-    const octomap::point3d end = tree.keyToCoord(unpack(end_key));
-    if (tree.computeRayKeys(origin, end, impl_->ray)) {
-      for (const auto& k : impl_->ray) free_cells.insert(pack(k));
-    }
-  };
-  for (const auto& [k, c] : endpoints) cast(k);
+  // 2. Rays from the sensor to each endpoint voxel's centre (OctoMap's discretized update).
+  rays.reset(lo, hi);
+  for (const auto& [k, c] : endpoints) {
+    const OcTreeKey end = unpack(k);
+    rays.insert_end(end);
+    cast_ray(tree, origin, origin_key, tree.keyToCoord(end), end, rays);
+  }
   for (std::uint64_t k : clipped) {
-    cast(k);
-    free_cells.insert(k);  // a clipped ray frees its last voxel too: nothing was seen there
+    const OcTreeKey end = unpack(k);
+    cast_ray(tree, origin, origin_key, tree.keyToCoord(end), end, rays);
+    rays.insert_free(end);  // a cut ray frees its last voxel too: nothing was seen there
   }
 
-  // 3. Hits win over misses (OctoMap's computeUpdate does the same).
-  auto& order = impl_->order;
-  order.clear();
-  order.reserve(free_cells.size());
-  for (auto it = free_cells.begin(); it != free_cells.end();) {
-    if (endpoints.find(*it) != endpoints.end()) {
-      it = free_cells.erase(it);
-    } else {
-      order.emplace_back(morton(*it), *it);
-      ++it;
-    }
-  }
-  std::sort(order.begin(), order.end());
-  for (const auto& [m, k] : order) tree.updateNode(unpack(k), false, /*lazy_eval=*/true);
-  stats.free_updates = order.size();
-
-  order.clear();
-  for (const auto& [k, c] : endpoints) order.emplace_back(morton(k), k);
-  std::sort(order.begin(), order.end());
-  for (const auto& [m, k] : order) {
-    const OcTreeKey ok = unpack(k);
-    tree.updateNode(ok, true, /*lazy_eval=*/true);
-    const ColorSum& c = endpoints.find(k)->second;
-    tree.averageNodeColor(ok, static_cast<std::uint8_t>(c.r / c.n), static_cast<std::uint8_t>(c.g / c.n),
-                          static_cast<std::uint8_t>(c.b / c.n));
-  }
-  stats.occupied_updates = order.size();
-  refresh_inner(tree);
+  // 3. One sorted list of updates, (morton << 1) | hit, then one ordered descent of the tree.
+  auto& updates = impl_->updates;
+  updates.clear();
+  rays.for_each([&](const OcTreeKey& k, bool is_end) {
+    updates.push_back((morton_encode(k) << 1) | (is_end ? 1 : 0));
+    ++(is_end ? stats.occupied_updates : stats.free_updates);
+  });
+  radix_sort(updates, impl_->scratch, 49);
+  bulk_update(tree, updates, [&](const OcTreeKey& k, std::uint8_t rgb[3]) {
+    const ColorSum& c = endpoints.find(pack(k))->second;
+    rgb[0] = static_cast<std::uint8_t>(c.r / c.n);
+    rgb[1] = static_cast<std::uint8_t>(c.g / c.n);
+    rgb[2] = static_cast<std::uint8_t>(c.b / c.n);
+  });
   return stats;
 }
 
@@ -227,7 +259,7 @@ Occupancy OccupancyMap::query(const Eigen::Vector3d& p) const {
 bool OccupancyMap::freed_by_last_insert(const Eigen::Vector3d& p) const {
   OcTreeKey key;
   if (!p.allFinite() || !impl_->tree.coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) return false;
-  return impl_->free_cells.count(pack(key)) > 0;
+  return impl_->rays.freed(key);
 }
 
 namespace {
@@ -308,7 +340,8 @@ std::size_t OccupancyMap::clear_box(const Aabb& box) {
 
 void OccupancyMap::reset() {
   impl_->tree.clear();
-  impl_->free_cells.clear();
+  impl_->rays.clear();
+  impl_->endpoints.clear();
 }
 
 Status OccupancyMap::save(const fs::path& path) const {
