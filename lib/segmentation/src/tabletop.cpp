@@ -51,21 +51,32 @@ struct RansacResult {
 };
 
 // RANSAC over the candidate voxels. Hypotheses are scored on a fixed random subset for speed;
-// the caller recomputes the inliers on all candidates.
+// the caller recomputes the inliers on all candidates. Adaptive termination (Fischler & Bolles;
+// Hartley & Zisserman, Multiple View Geometry, sec. 4.7.1): stop once N = log(1 - p) / log(1 - w^3)
+// hypotheses have been drawn for the best inlier ratio w so far, with p = 0.999;
+// config.ransac_iterations is the upper bound.
 RansacResult ransac_plane(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& candidates,
                           const Config& cfg, const std::optional<Eigen::Vector3d>& up, std::mt19937& rng) {
   RansacResult best;
   if (candidates.size() < 3) return best;
   constexpr std::size_t kScoreSamples = 3000;
-  std::vector<int> scoring = candidates;
-  if (scoring.size() > kScoreSamples) {
-    std::shuffle(scoring.begin(), scoring.end(), rng);
-    scoring.resize(kScoreSamples);
+  constexpr double kConfidence = 0.999;
+  constexpr int kMinIterations = 20;
+  std::vector<Eigen::Vector3f> scoring;
+  scoring.reserve(std::min(kScoreSamples, candidates.size()));
+  if (candidates.size() > kScoreSamples) {
+    std::vector<int> pick = candidates;
+    std::shuffle(pick.begin(), pick.end(), rng);
+    for (std::size_t i = 0; i < kScoreSamples; ++i) scoring.push_back(centroids[pick[i]]);
+  } else {
+    for (int v : candidates) scoring.push_back(centroids[v]);
   }
   const double cos_max = std::cos(cfg.max_normal_angle_deg * M_PI / 180.0);
+  const float threshold = static_cast<float>(cfg.plane_distance_m);
   std::uniform_int_distribution<std::size_t> pick(0, candidates.size() - 1);
   std::size_t best_score = 0;
-  for (int it = 0; it < cfg.ransac_iterations; ++it) {
+  double needed = cfg.ransac_iterations;
+  for (int it = 0; it < cfg.ransac_iterations && it < needed; ++it) {
     const Eigen::Vector3d a = centroids[candidates[pick(rng)]].cast<double>();
     const Eigen::Vector3d b = centroids[candidates[pick(rng)]].cast<double>();
     const Eigen::Vector3d c = centroids[candidates[pick(rng)]].cast<double>();
@@ -74,13 +85,17 @@ RansacResult ransac_plane(const std::vector<Eigen::Vector3f>& centroids, const s
     if (len < 1e-9) continue;  // collinear or repeated sample
     n /= len;
     if (up && std::abs(n.dot(*up)) < cos_max) continue;
-    const double d = -n.dot(a);
+    const Eigen::Vector3f nf = n.cast<float>();
+    const float d = static_cast<float>(-n.dot(a));
     std::size_t score = 0;
-    for (int v : scoring) score += std::abs(n.dot(centroids[v].cast<double>()) + d) < cfg.plane_distance_m ? 1 : 0;
+    for (const auto& q : scoring) score += std::abs(nf.dot(q) + d) < threshold ? 1 : 0;
     if (score > best_score) {
       best_score = score;
       best.found = true;
-      best.model = {n, d};
+      best.model = {n, static_cast<double>(d)};
+      const double w = static_cast<double>(score) / scoring.size();
+      const double miss = 1.0 - w * w * w;
+      needed = miss <= 0.0 ? 0.0 : std::max<double>(kMinIterations, std::log(1.0 - kConfidence) / std::log(miss));
     }
   }
   return best;
