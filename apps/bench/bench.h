@@ -1,0 +1,45 @@
+#pragma once
+// Shared pieces of the benchmark app: timing and table printing.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace scenewatch::bench {
+
+struct Options {
+  std::filesystem::path data_dir;
+  int repetitions = 7;
+};
+
+/// Median of a sample (copies).
+inline double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/// The q-quantile (0..1) of a sample, nearest rank.
+inline double quantile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(q * v.size()));
+  return v[i];
+}
+
+/// Runs `f` once and returns its wall time in milliseconds.
+inline double time_ms(const std::function<void()>& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int run_octomap(const Options& o);
+int run_segmentation(const Options& o);
+int run_latency(const Options& o);
+
+}  // namespace scenewatch::bench

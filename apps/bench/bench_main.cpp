@@ -1,0 +1,26 @@
+// scenewatch-bench: prints the figures the README quotes, each next to its baseline in the same run.
+#include <CLI/CLI.hpp>
+
+#include "bench.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"scenewatch-bench: time scenewatch against its baselines on real frames (prints tables; not a test)"};
+  scenewatch::bench::Options o;
+  o.data_dir = SCENEWATCH_DEFAULT_DATA_DIR;
+  std::vector<std::string> only;
+  app.add_option("--data", o.data_dir, "Folder of the real recordings (../shared/data)")->capture_default_str();
+  app.add_option("--repetitions,-n", o.repetitions, "Timed runs per case; medians are reported")->capture_default_str()->check(CLI::Range(1, 1000));
+  app.add_option("--only", only, "Run only these sections: octomap, segmentation, latency")
+      ->check(CLI::IsMember({"octomap", "segmentation", "latency"}));
+  CLI11_PARSE(app, argc, argv);
+  if (!std::filesystem::exists(o.data_dir)) {
+    std::fprintf(stderr, "scenewatch-bench: data folder '%s' not found (pass --data DIR)\n", o.data_dir.c_str());
+    return 1;
+  }
+  auto want = [&](const std::string& s) { return only.empty() || std::find(only.begin(), only.end(), s) != only.end(); };
+  int rc = 0;
+  if (want("octomap")) rc |= scenewatch::bench::run_octomap(o);
+  if (want("segmentation")) rc |= scenewatch::bench::run_segmentation(o);
+  if (want("latency")) rc |= scenewatch::bench::run_latency(o);
+  return rc;
+}
