@@ -1,0 +1,165 @@
+#include "format.h"
+
+#include <cstdio>
+#include <sstream>
+
+namespace scenewatch::cli {
+namespace {
+
+std::string fixed(double value, int decimals = 3) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+}  // namespace
+
+nlohmann::json to_json(const proto::Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+
+nlohmann::json to_json(const proto::Box& box) { return {{"min", to_json(box.min())}, {"max", to_json(box.max())}}; }
+
+nlohmann::json to_json(const proto::OrientedBox& box) {
+  const auto& q = box.rotation();
+  return {{"center", to_json(box.center())},
+          {"rotation", {{"w", q.w()}, {"x", q.x()}, {"y", q.y()}, {"z", q.z()}}},
+          {"extents", to_json(box.extents())}};
+}
+
+nlohmann::json to_json(const proto::Plane& plane) {
+  nlohmann::json hull = nlohmann::json::array();
+  for (const auto& p : plane.hull()) hull.push_back(to_json(p));
+  return {{"id", plane.id()},
+          {"normal", to_json(plane.normal())},
+          {"d", plane.d()},
+          {"area_m2", plane.area_m2()},
+          {"inlier_count", plane.inlier_count()},
+          {"centroid", to_json(plane.centroid())},
+          {"hull", std::move(hull)}};
+}
+
+nlohmann::json to_json(const proto::Cluster& cluster) {
+  return {{"plane_id", cluster.plane_id()},
+          {"centroid", to_json(cluster.centroid())},
+          {"box", to_json(cluster.box())},
+          {"point_count", cluster.point_count()},
+          {"mean_rgb", to_json(cluster.mean_rgb())}};
+}
+
+nlohmann::json to_json(const proto::Object& object) {
+  return {{"id", object.id()},
+          {"plane_id", object.plane_id()},
+          {"centroid", to_json(object.centroid())},
+          {"box", to_json(object.box())},
+          {"point_count", object.point_count()},
+          {"mean_rgb", to_json(object.mean_rgb())},
+          {"first_seen_s", object.first_seen_s()},
+          {"last_seen_s", object.last_seen_s()},
+          {"observations", object.observations()}};
+}
+
+nlohmann::json to_json(const proto::Event& event) {
+  nlohmann::json j = {{"id", event.id()},
+                      {"stamp_s", event.stamp_s()},
+                      {"level", proto::Event::Level_Name(event.level())},
+                      {"kind", proto::Event::Kind_Name(event.kind())},
+                      {"score", event.score()},
+                      {"box_world", to_json(event.box_world())},
+                      {"centroid_world", to_json(event.centroid_world())},
+                      {"detail", event.detail()}};
+  j["object_id"] = event.has_object_id() ? nlohmann::json(event.object_id()) : nlohmann::json(nullptr);
+  return j;
+}
+
+nlohmann::json to_json(const proto::HealthReply& health) {
+  return {{"status", "OK"},
+          {"version", health.version()},
+          {"uptime_s", health.uptime_s()},
+          {"frames_processed", health.frames_processed()}};
+}
+
+nlohmann::json to_json(const proto::StatsReply& s) {
+  return {{"frames_processed", s.frames_processed()},
+          {"points_processed", s.points_processed()},
+          {"events_emitted", s.events_emitted()},
+          {"map_leaf_nodes", s.map_leaf_nodes()},
+          {"map_occupied_leaves", s.map_occupied_leaves()},
+          {"map_memory_bytes", s.map_memory_bytes()},
+          {"map_resolution_m", s.map_resolution_m()},
+          {"last_frame_ms", s.last_frame_ms()},
+          {"mean_frame_ms", s.mean_frame_ms()},
+          {"tracked_objects", s.tracked_objects()},
+          {"connections", s.connections()},
+          {"uptime_s", s.uptime_s()}};
+}
+
+nlohmann::json to_json(const proto::IngestReply& ingest) {
+  nlohmann::json planes = nlohmann::json::array(), clusters = nlohmann::json::array(),
+                 events = nlohmann::json::array();
+  for (const auto& p : ingest.planes()) planes.push_back(to_json(p));
+  for (const auto& c : ingest.clusters()) clusters.push_back(to_json(c));
+  for (const auto& e : ingest.events()) events.push_back(to_json(e));
+  return {{"frame_index", ingest.frame_index()},
+          {"points", ingest.points()},
+          {"planes", std::move(planes)},
+          {"clusters", std::move(clusters)},
+          {"events", std::move(events)},
+          {"segment_ms", ingest.segment_ms()},
+          {"insert_ms", ingest.insert_ms()},
+          {"total_ms", ingest.total_ms()}};
+}
+
+std::string occupancy_name(proto::OccupancyState state) {
+  switch (state) {
+    case proto::OCCUPANCY_FREE: return "free";
+    case proto::OCCUPANCY_OCCUPIED: return "occupied";
+    default: return "unknown";
+  }
+}
+
+nlohmann::json to_json(const proto::BoxOccupancy& box) {
+  return {{"state", occupancy_name(box.state())},
+          {"occupied_voxels", box.occupied_voxels()},
+          {"free_voxels", box.free_voxels()},
+          {"unknown_voxels", box.unknown_voxels()}};
+}
+
+std::string text(const proto::Vec3& v) { return "(" + fixed(v.x()) + ", " + fixed(v.y()) + ", " + fixed(v.z()) + ")"; }
+
+std::string text(const proto::Plane& plane) {
+  std::ostringstream os;
+  os << "  plane " << plane.id() << ": normal " << text(plane.normal()) << ", d " << fixed(plane.d()) << ", area "
+     << fixed(plane.area_m2(), 2) << " m2, " << plane.inlier_count() << " inliers, centroid " << text(plane.centroid());
+  return os.str();
+}
+
+std::string text(const proto::Object& object) {
+  std::ostringstream os;
+  const auto& e = object.box().extents();
+  os << "  object " << object.id() << ": at " << text(object.centroid()) << ", size " << fixed(e.x()) << " x "
+     << fixed(e.y()) << " x " << fixed(e.z()) << " m, " << object.point_count() << " points, rgb ("
+     << fixed(object.mean_rgb().x(), 0) << ", " << fixed(object.mean_rgb().y(), 0) << ", "
+     << fixed(object.mean_rgb().z(), 0) << "), seen " << object.observations() << "x (first "
+     << fixed(object.first_seen_s(), 2) << " s, last " << fixed(object.last_seen_s(), 2) << " s)";
+  return os.str();
+}
+
+std::string text(const proto::Cluster& cluster) {
+  std::ostringstream os;
+  const auto& e = cluster.box().extents();
+  os << "  cluster on plane " << cluster.plane_id() << ": at " << text(cluster.centroid()) << ", size "
+     << fixed(e.x()) << " x " << fixed(e.y()) << " x " << fixed(e.z()) << " m, " << cluster.point_count()
+     << " points";
+  return os.str();
+}
+
+std::string text(const proto::Event& event) {
+  std::ostringstream os;
+  os << "  event " << event.id() << " " << proto::Event::Kind_Name(event.kind()) << " ("
+     << proto::Event::Level_Name(event.level()) << ", score " << fixed(event.score(), 2) << ")";
+  if (event.has_object_id()) os << " object " << event.object_id();
+  os << " at " << text(event.centroid_world()) << ", t " << fixed(event.stamp_s(), 2) << " s";
+  if (!event.detail().empty()) os << ": " << event.detail();
+  return os.str();
+}
+
+}  // namespace scenewatch::cli

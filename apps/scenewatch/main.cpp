@@ -1,0 +1,125 @@
+// scenewatch: the command-line client of scenewatchd, plus offline tools that work on files.
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <iostream>
+
+#include "commands.h"
+
+namespace {
+
+using namespace scenewatch::cli;
+
+void add_remote_options(CLI::App* command, RemoteOptions& options) {
+  command->add_option("--host", options.host, "daemon host")->capture_default_str();
+  command->add_option("--port", options.port, "daemon TCP port")->check(CLI::Range(1, 65535))->capture_default_str();
+  command->add_option("--timeout", options.timeout_s, "seconds to wait for each answer, 0 = forever")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command->add_flag("--json", options.json, "print machine-readable JSON");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"scenewatch - talk to the scenewatchd perception service, or work on cloud files offline.\n"
+               "Exit codes: 0 ok, 1 error (message on stderr), 2 usage."};
+  app.require_subcommand(1);
+  RemoteOptions remote;
+  // Accepted before the command too: `scenewatch --port 7879 health` as well as `scenewatch health --port 7879`.
+  add_remote_options(&app, remote);
+  std::function<int()> action;
+
+  auto* health = app.add_subcommand("health", "check that the daemon answers");
+  add_remote_options(health, remote);
+  health->callback([&] { action = [&] { return run_health(remote); }; });
+
+  auto* stats = app.add_subcommand("stats", "counters of the daemon and its map");
+  add_remote_options(stats, remote);
+  stats->callback([&] { action = [&] { return run_stats(remote); }; });
+
+  std::vector<std::string> ingest_paths;
+  bool server_side = false;
+  auto* ingest = app.add_subcommand(
+      "ingest", "send cloud files or RGB-D sequence folders, frame by frame (--json: one object per line)");
+  ingest->add_option("paths", ingest_paths, "cloud files and/or sequence folders")->required();
+  ingest->add_flag("--server-side", server_side,
+                   "let the daemon read the files itself (absolute paths under its data roots)");
+  add_remote_options(ingest, remote);
+  ingest->callback([&] { action = [&] { return run_ingest(remote, ingest_paths, server_side); }; });
+
+  auto* planes = app.add_subcommand("planes", "supporting planes of the last frame");
+  add_remote_options(planes, remote);
+  planes->callback([&] { action = [&] { return run_planes(remote); }; });
+
+  auto* objects = app.add_subcommand("objects", "the tracked objects");
+  add_remote_options(objects, remote);
+  objects->callback([&] { action = [&] { return run_objects(remote); }; });
+
+  std::vector<double> points, box;
+  auto* occupancy = app.add_subcommand("occupancy", "occupancy of world points (X Y Z ...) and/or a box");
+  occupancy->add_option("point", points, "X Y Z, possibly several points");
+  occupancy->add_option("--box", box, "MINX MINY MINZ MAXX MAXY MAXZ")->expected(6);
+  add_remote_options(occupancy, remote);
+  occupancy->callback([&] {
+    action = [&] {
+      if (points.size() % 3 != 0) {
+        std::cerr << "scenewatch occupancy: points need 3 coordinates each, got " << points.size() << " numbers\n";
+        return kExitUsage;
+      }
+      if (points.empty() && box.empty()) {
+        std::cerr << "scenewatch occupancy: give a point X Y Z and/or --box\n";
+        return kExitUsage;
+      }
+      return run_occupancy(remote, points, box);
+    };
+  });
+
+  std::vector<double> clear_box;
+  auto* clear = app.add_subcommand("clear-box", "mark the known voxels in a world box free");
+  clear->add_option("box", clear_box, "MINX MINY MINZ MAXX MAXY MAXZ")->expected(6)->required();
+  add_remote_options(clear, remote);
+  clear->callback([&] { action = [&] { return run_clear_box(remote, clear_box); }; });
+
+  auto* reset = app.add_subcommand("reset", "forget everything: map, objects, events");
+  add_remote_options(reset, remote);
+  reset->callback([&] { action = [&] { return run_reset(remote); }; });
+
+  auto* save = app.add_subcommand("save", "save the model to the daemon's model directory");
+  add_remote_options(save, remote);
+  save->callback([&] { action = [&] { return run_save(remote); }; });
+
+  auto* load = app.add_subcommand("load", "reload the model from the daemon's model directory");
+  add_remote_options(load, remote);
+  load->callback([&] { action = [&] { return run_load(remote); }; });
+
+  std::uint64_t since = 0;
+  std::uint32_t max_count = 0;
+  auto* events = app.add_subcommand("events", "events from the daemon's log");
+  events->add_option("--since", since, "only events with a larger id")->capture_default_str();
+  events->add_option("--max", max_count, "at most this many (0: the daemon's default, 1000)");
+  add_remote_options(events, remote);
+  events->callback([&] { action = [&] { return run_events(remote, since, max_count); }; });
+
+  auto* watch = app.add_subcommand("watch", "print events as they happen until Ctrl-C (--json: one per line)");
+  add_remote_options(watch, remote);
+  watch->callback([&] { action = [&] { return run_watch(remote); }; });
+
+  SegmentOptions segment_options;
+  auto* segment = app.add_subcommand(
+      "segment", "offline: find supporting planes and the objects on them in a cloud file (no daemon)");
+  segment->add_option("file", segment_options.file, "cloud file (.pcd or .ply)")->required();
+  segment->add_flag("--json", segment_options.json, "print JSON (objects with the indices of their points)");
+  segment->add_option("--out", segment_options.out_dir,
+                      "write object_000.pcd, ... and plane_000.pcd, ... into this folder");
+  segment->add_option("--config", segment_options.config, "YAML config (its segmentation section is used)");
+  segment->add_flag("--plane-indices", segment_options.plane_indices, "with --json: also list plane inlier indices");
+  segment->callback([&] { action = [&] { return run_segment(segment_options); }; });
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? kExitOk : kExitUsage;
+  }
+  return action ? action() : kExitUsage;
+}

@@ -1,0 +1,387 @@
+// Commands that talk to the daemon through scenewatch::service::Client.
+#include <signal.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <functional>
+#include <iostream>
+#include <optional>
+
+#include "commands.h"
+#include "format.h"
+#include "scenewatch/io/sequence.h"
+#include "scenewatch/service/client.h"
+
+namespace scenewatch::cli {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+constexpr double kConnectTimeoutS = 5.0;
+
+Result<service::Client> connect(const RemoteOptions& options) {
+  return service::Client::connect(options.host, static_cast<std::uint16_t>(options.port), kConnectTimeoutS);
+}
+
+/// Sends one request; prints the problem and returns nothing on a transport error or an error
+/// status.
+std::optional<proto::Response> call(service::Client& client, proto::Request request, const RemoteOptions& options) {
+  auto response = client.call(std::move(request), options.timeout_s);
+  if (!response) {
+    fail(response.error().message);
+    return std::nullopt;
+  }
+  if (response->status().code() != proto::Status::OK) {
+    fail(service::to_string(response->status().code()) + ": " + response->status().message());
+    return std::nullopt;
+  }
+  return std::move(*response);
+}
+
+/// Connects, makes one call and prints its result with `print`.
+int simple_call(const RemoteOptions& options, proto::Request request,
+                const std::function<void(const proto::Response&)>& print) {
+  auto client = connect(options);
+  if (!client) return fail(client.error().message);
+  auto response = call(*client, std::move(request), options);
+  if (!response) return kExitError;
+  print(*response);
+  return kExitOk;
+}
+
+void print_json(const json& j) { std::cout << j.dump(2) << std::endl; }
+
+std::string plural(std::size_t n, const std::string& word) {
+  return std::to_string(n) + " " + word + (n == 1 ? "" : "s");
+}
+
+/// The message, prefixed with the path unless it names it already.
+std::string naming(const std::string& path, const std::string& message) {
+  return message.find(path) != std::string::npos ? message : path + ": " + message;
+}
+
+/// Progress of a sequence on stderr, for terminals.
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled) {}
+  ~ProgressBar() { clear(); }
+  void draw(std::size_t done, std::size_t total, const std::string& label) {
+    if (!enabled_) return;
+    constexpr std::size_t kWidth = 30;
+    const std::size_t filled = total == 0 ? kWidth : done * kWidth / total;
+    std::cerr << "\r\033[K[" << std::string(filled, '#') << std::string(kWidth - filled, '.') << "] " << done << "/"
+              << total << " " << label << std::flush;
+    shown_ = true;
+  }
+  void clear() {
+    if (enabled_ && shown_) std::cerr << "\r\033[K" << std::flush;
+    shown_ = false;
+  }
+
+ private:
+  bool enabled_;
+  bool shown_ = false;
+};
+
+void print_ingest(const RemoteOptions& options, const std::string& source, const proto::IngestReply& reply) {
+  if (options.json) {
+    json j = to_json(reply);
+    j["source"] = source;
+    std::cout << j.dump() << std::endl;
+    return;
+  }
+  std::cout << "frame " << reply.frame_index() << " " << source << ": " << plural(reply.planes_size(), "plane") << ", "
+            << plural(reply.clusters_size(), "object") << ", " << plural(reply.events_size(), "event") << " ("
+            << reply.points() << " points, " << static_cast<long>(reply.total_ms()) << " ms)\n";
+  for (const auto& event : reply.events()) std::cout << text(event) << "\n";
+  std::cout << std::flush;
+}
+
+volatile sig_atomic_t g_interrupted = 0;
+
+void on_interrupt(int) { g_interrupted = 1; }
+
+}  // namespace
+
+int fail(const std::string& message) {
+  std::cerr << "scenewatch: " << message << std::endl;
+  return kExitError;
+}
+
+int run_health(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_health();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    if (options.json) return print_json(to_json(r.health()));
+    std::cout << "ok: scenewatchd " << r.health().version() << " at " << options.host << ":" << options.port
+              << ", up " << static_cast<long>(r.health().uptime_s()) << " s, "
+              << plural(r.health().frames_processed(), "frame") << " processed" << std::endl;
+  });
+}
+
+int run_stats(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_stats();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    if (options.json) return print_json(to_json(r.stats()));
+    const auto& s = r.stats();
+    std::cout << "frames processed   " << s.frames_processed() << "\n"
+              << "points processed   " << s.points_processed() << "\n"
+              << "events emitted     " << s.events_emitted() << "\n"
+              << "tracked objects    " << s.tracked_objects() << "\n"
+              << "map                " << s.map_occupied_leaves() << " occupied of " << s.map_leaf_nodes()
+              << " leaves at " << s.map_resolution_m() << " m, " << s.map_memory_bytes() / 1024 << " KiB\n"
+              << "frame time         last " << s.last_frame_ms() << " ms, mean " << s.mean_frame_ms() << " ms\n"
+              << "connections        " << s.connections() << "\n"
+              << "uptime             " << static_cast<long>(s.uptime_s()) << " s" << std::endl;
+  });
+}
+
+int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side) {
+  auto client = connect(options);
+  if (!client) return fail(client.error().message);
+  const bool show_progress = !options.json && ::isatty(STDOUT_FILENO) == 1;
+  int failures = 0;
+
+  // Sends one request; false when the connection is gone (no point going on).
+  auto send = [&](proto::Request request, const std::string& source, ProgressBar* bar) {
+    auto response = client->call(std::move(request), options.timeout_s);
+    if (bar != nullptr) bar->clear();
+    if (!response) {
+      fail(response.error().message);
+      ++failures;
+      return false;
+    }
+    if (response->status().code() != proto::Status::OK) {
+      fail(naming(source, service::to_string(response->status().code()) + ": " + response->status().message()));
+      ++failures;
+      return true;
+    }
+    print_ingest(options, source, response->ingest());
+    return true;
+  };
+
+  for (const std::string& path : paths) {
+    std::error_code ec;
+    if (server_side) {
+      if (fs::is_directory(path, ec)) {
+        fail(path + ": --server-side takes cloud files (.pcd/.ply), not folders");
+        ++failures;
+        continue;
+      }
+      proto::Request request;
+      request.mutable_ingest_file()->set_path(fs::absolute(path).lexically_normal().string());
+      if (!send(std::move(request), path, nullptr)) return kExitError;
+      continue;
+    }
+    if (io::is_sequence_dir(path)) {
+      auto sequence = io::open_sequence(path);
+      if (!sequence) {
+        fail(naming(path, sequence.error().message));
+        ++failures;
+        continue;
+      }
+      ProgressBar bar(show_progress);
+      const std::size_t total = sequence->frames.size();
+      for (std::size_t i = 0; i < total; ++i) {
+        const std::string source = (fs::path(path) / sequence->frames[i].name).string();
+        bar.draw(i, total, sequence->frames[i].name);
+        auto frame = io::load_sequence_frame(*sequence, i);
+        if (!frame) {
+          bar.clear();
+          fail(naming(source, frame.error().message));
+          ++failures;
+          continue;
+        }
+        frame->source = source;
+        proto::Request request;
+        *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+        if (!send(std::move(request), source, &bar)) return kExitError;
+      }
+      continue;
+    }
+    auto frame = io::load_cloud_frame(path);
+    if (!frame) {
+      fail(naming(path, frame.error().message));
+      ++failures;
+      continue;
+    }
+    frame->source = path;
+    proto::Request request;
+    *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+    if (!send(std::move(request), path, nullptr)) return kExitError;
+  }
+  return failures == 0 ? kExitOk : kExitError;
+}
+
+int run_planes(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_get_planes();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    const auto& planes = r.planes();
+    if (options.json) {
+      json list = json::array();
+      for (const auto& p : planes.planes()) list.push_back(to_json(p));
+      return print_json({{"frames_processed", planes.frames_processed()},
+                         {"last_stamp_s", planes.last_stamp_s()},
+                         {"planes", std::move(list)}});
+    }
+    std::cout << plural(planes.planes_size(), "plane") << " in the last frame (" << planes.frames_processed()
+              << " processed)\n";
+    for (const auto& p : planes.planes()) std::cout << text(p) << "\n";
+    std::cout << std::flush;
+  });
+}
+
+int run_objects(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_get_objects();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    const auto& objects = r.objects();
+    if (options.json) {
+      json list = json::array();
+      for (const auto& o : objects.objects()) list.push_back(to_json(o));
+      return print_json({{"frames_processed", objects.frames_processed()}, {"objects", std::move(list)}});
+    }
+    std::cout << plural(objects.objects_size(), "tracked object") << "\n";
+    for (const auto& o : objects.objects()) std::cout << text(o) << "\n";
+    std::cout << std::flush;
+  });
+}
+
+int run_occupancy(const RemoteOptions& options, const std::vector<double>& points, const std::vector<double>& box) {
+  proto::Request request;
+  auto* query = request.mutable_query_occupancy();
+  for (std::size_t i = 0; i + 2 < points.size(); i += 3) {
+    auto* p = query->add_points();
+    p->set_x(points[i]);
+    p->set_y(points[i + 1]);
+    p->set_z(points[i + 2]);
+  }
+  if (box.size() == 6) {
+    auto* b = query->mutable_box();
+    b->mutable_min()->set_x(box[0]);
+    b->mutable_min()->set_y(box[1]);
+    b->mutable_min()->set_z(box[2]);
+    b->mutable_max()->set_x(box[3]);
+    b->mutable_max()->set_y(box[4]);
+    b->mutable_max()->set_z(box[5]);
+  }
+  return simple_call(options, request, [&](const proto::Response& r) {
+    const auto& occupancy = r.occupancy();
+    if (options.json) {
+      json list = json::array();
+      for (int i = 0; i < occupancy.states_size() && i < query->points_size(); ++i) {
+        list.push_back({{"point", to_json(query->points(i))}, {"state", occupancy_name(occupancy.states(i))}});
+      }
+      json j = {{"points", std::move(list)}};
+      j["box"] = occupancy.has_box() ? to_json(occupancy.box()) : json(nullptr);
+      return print_json(j);
+    }
+    for (int i = 0; i < occupancy.states_size() && i < query->points_size(); ++i) {
+      std::cout << text(query->points(i)) << ": " << occupancy_name(occupancy.states(i)) << "\n";
+    }
+    if (occupancy.has_box()) {
+      const auto& b = occupancy.box();
+      std::cout << "box: " << occupancy_name(b.state()) << " (" << b.occupied_voxels() << " occupied, "
+                << b.free_voxels() << " free, " << b.unknown_voxels() << " unknown voxels)\n";
+    }
+    std::cout << std::flush;
+  });
+}
+
+int run_clear_box(const RemoteOptions& options, const std::vector<double>& box) {
+  proto::Request request;
+  auto* b = request.mutable_clear_box()->mutable_box();
+  b->mutable_min()->set_x(box[0]);
+  b->mutable_min()->set_y(box[1]);
+  b->mutable_min()->set_z(box[2]);
+  b->mutable_max()->set_x(box[3]);
+  b->mutable_max()->set_y(box[4]);
+  b->mutable_max()->set_z(box[5]);
+  return simple_call(options, request, [&](const proto::Response& r) {
+    if (options.json) return print_json({{"voxels_changed", r.clear_box().voxels_changed()}});
+    std::cout << "cleared: " << plural(r.clear_box().voxels_changed(), "voxel") << " changed" << std::endl;
+  });
+}
+
+int run_reset(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_reset();
+  return simple_call(options, request, [&](const proto::Response&) {
+    if (options.json) return print_json({{"status", "OK"}});
+    std::cout << "reset: the model is empty" << std::endl;
+  });
+}
+
+int run_save(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_save_model();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    if (options.json) return print_json({{"model_dir", r.save_model().model_dir()}});
+    std::cout << "saved the model to " << r.save_model().model_dir() << std::endl;
+  });
+}
+
+int run_load(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_load_model();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    if (options.json) return print_json({{"model_dir", r.load_model().model_dir()}, {"objects", r.load_model().objects()}});
+    std::cout << "loaded the model from " << r.load_model().model_dir() << " ("
+              << plural(r.load_model().objects(), "object") << ")" << std::endl;
+  });
+}
+
+int run_events(const RemoteOptions& options, std::uint64_t since, std::uint32_t max_count) {
+  proto::Request request;
+  request.mutable_get_events()->set_since(since);
+  request.mutable_get_events()->set_max_count(max_count);
+  return simple_call(options, request, [&](const proto::Response& r) {
+    if (options.json) {
+      json list = json::array();
+      for (const auto& e : r.events().events()) list.push_back(to_json(e));
+      return print_json({{"events", std::move(list)}});
+    }
+    std::cout << plural(r.events().events_size(), "event") << (since > 0 ? " after " + std::to_string(since) : "")
+              << "\n";
+    for (const auto& e : r.events().events()) std::cout << text(e) << "\n";
+    std::cout << std::flush;
+  });
+}
+
+int run_watch(const RemoteOptions& options) {
+  auto client = connect(options);
+  if (!client) return fail(client.error().message);
+  proto::Request request;
+  request.mutable_subscribe();
+  auto response = call(*client, std::move(request), options);
+  if (!response) return kExitError;
+
+  // Ctrl-C ends the wait (no SA_RESTART: the blocking poll returns EINTR).
+  struct sigaction action {};
+  action.sa_handler = on_interrupt;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+  if (!options.json) {
+    std::cerr << "watching events of " << client->endpoint() << " (after event "
+              << response->subscribe().last_event_id() << "); Ctrl-C to stop" << std::endl;
+  }
+  while (!g_interrupted) {
+    auto event = client->next_event();
+    if (!event) {
+      if (g_interrupted) break;
+      return fail(event.error().message);
+    }
+    if (options.json) {
+      std::cout << to_json(*event).dump() << std::endl;
+    } else {
+      std::cout << text(*event).substr(2) << std::endl;
+    }
+  }
+  return kExitOk;
+}
+
+}  // namespace scenewatch::cli

@@ -1,0 +1,142 @@
+// scenewatchd: the scenewatch perception service. Serves the wire protocol (proto/scenewatch.proto)
+// over TCP, keeps the working memory of the scene, and persists it in the model directory.
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <csignal>
+#include <ctime>
+#include <iostream>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/service/daemon_config.h"
+#include "scenewatch/service/log.h"
+#include "scenewatch/service/server.h"
+
+namespace {
+
+using scenewatch::service::LogLevel;
+
+/// Thread-safe stderr logger: "2024-05-01T12:00:00.123Z INFO  message".
+class StderrLog {
+ public:
+  explicit StderrLog(LogLevel min_level) : min_level_(min_level) {}
+
+  void operator()(LogLevel level, const std::string& message) {
+    if (static_cast<int>(level) < static_cast<int>(min_level_)) return;
+    const auto now = std::chrono::system_clock::now();
+    const std::time_t t = std::chrono::system_clock::to_time_t(now);
+    const auto ms = std::chrono::duration_cast<std::chrono::milliseconds>(now.time_since_epoch()).count() % 1000;
+    std::tm tm{};
+    ::gmtime_r(&t, &tm);
+    char stamp[32];
+    std::strftime(stamp, sizeof stamp, "%Y-%m-%dT%H:%M:%S", &tm);
+    char line_prefix[64];
+    std::snprintf(line_prefix, sizeof line_prefix, "%s.%03dZ %-5s ", stamp, static_cast<int>(ms),
+                  scenewatch::service::to_string(level));
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::cerr << line_prefix << message << '\n' << std::flush;
+  }
+
+ private:
+  LogLevel min_level_;
+  std::mutex mutex_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"scenewatchd - the scenewatch perception service.\n"
+               "Serves the scenewatch protocol (4-byte big-endian length + protobuf) over TCP, keeps the\n"
+               "working memory of the scene and saves it to the model directory on SaveModel and on\n"
+               "SIGINT/SIGTERM. Prints 'listening on ADDRESS:PORT' on stdout once ready."};
+  std::string config_path;
+  std::optional<int> port;
+  std::optional<std::string> address;
+  std::optional<std::string> model_dir;
+  std::string log_level = "info";
+  app.add_option("--config", config_path, "YAML config file (see config/scenewatchd.yaml); default: built-in defaults");
+  app.add_option("--port", port, "TCP port, 0 = pick a free one (overrides server.port)")->check(CLI::Range(0, 65535));
+  app.add_option("--address", address, "listen address (overrides server.address)");
+  app.add_option("--model-dir", model_dir, "model directory, '' = none (overrides server.model_dir)");
+  app.add_option("--log-level", log_level, "debug, info, warn or error")
+      ->check(CLI::IsMember({"debug", "info", "warn", "error"}));
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  const LogLevel min_level = log_level == "debug"  ? LogLevel::kDebug
+                             : log_level == "warn" ? LogLevel::kWarning
+                             : log_level == "error" ? LogLevel::kError
+                                                    : LogLevel::kInfo;
+  StderrLog log(min_level);
+  std::signal(SIGPIPE, SIG_IGN);
+
+  scenewatch::service::DaemonConfig config;
+  if (!config_path.empty()) {
+    auto loaded = scenewatch::service::load_daemon_config(config_path);
+    if (!loaded) {
+      log(LogLevel::kError, "config: " + loaded.error().message);
+      return 1;
+    }
+    config = std::move(*loaded);
+  }
+  if (port) config.server.port = static_cast<std::uint16_t>(*port);
+  if (address) config.server.address = *address;
+  if (model_dir) config.server.model_dir = *model_dir;
+  if (auto s = scenewatch::service::validate(config.server); !s) {
+    log(LogLevel::kError, "config: " + s.error().message);
+    return 1;
+  }
+  if (auto s = scenewatch::pipeline::validate(config.pipeline); !s) {
+    log(LogLevel::kError, "config: " + s.error().message);
+    return 1;
+  }
+
+  scenewatch::pipeline::WorkingMemory memory(config.pipeline);
+  const std::filesystem::path& model = config.server.model_dir;
+  if (!model.empty()) {
+    if (auto s = memory.load(model); s) {
+      log(LogLevel::kInfo, "loaded the model from " + model.string() + " (" +
+                               std::to_string(memory.snapshot()->objects.size()) + " objects)");
+    } else if (s.error().code == scenewatch::ErrorCode::kNotFound) {
+      log(LogLevel::kInfo, "no model in " + model.string() + " yet; starting empty");
+    } else {
+      // Starting empty would overwrite the damaged model at exit: refuse instead.
+      log(LogLevel::kError, "cannot load the model from " + model.string() + ": " + s.error().message +
+                                " (repair or move the directory, or pass another --model-dir)");
+      return 1;
+    }
+  } else {
+    log(LogLevel::kInfo, "no model directory configured: the model is not persisted");
+  }
+
+  scenewatch::service::Server server(config.server, memory,
+                                     [&log](LogLevel level, const std::string& message) { log(level, message); });
+  if (auto s = server.listen(); !s) {
+    log(LogLevel::kError, s.error().message);
+    return 1;
+  }
+  log(LogLevel::kInfo, "scenewatchd listening on " + server.endpoint() + " (max message " +
+                           std::to_string(config.server.max_message_bytes) + " bytes, " +
+                           std::to_string(config.server.data_roots.size()) + " data roots)");
+  std::cout << "listening on " << server.endpoint() << std::endl;
+
+  server.run();
+
+  int rc = 0;
+  if (!model.empty()) {
+    if (auto s = memory.save(model); s) {
+      log(LogLevel::kInfo, "saved the model to " + model.string());
+    } else {
+      log(LogLevel::kError, "cannot save the model to " + model.string() + ": " + s.error().message);
+      rc = 1;
+    }
+  }
+  log(LogLevel::kInfo, "stopped");
+  return rc;
+}

@@ -1,0 +1,74 @@
+#pragma once
+/// A blocking client of scenewatchd for the CLI and tests. This is the one service header that
+/// exposes the protocol's generated types: users link scenewatch::proto as well.
+#include <cstdint>
+#include <deque>
+#include <string>
+#include <string_view>
+
+#include "scenewatch.pb.h"
+#include "scenewatch/core/frame.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/service/frame_parser.h"
+#include "scenewatch/service/server_config.h"
+
+namespace scenewatch::service {
+
+/// One connection to the daemon. Transport failures are Errors (code kUnavailable or kIoError,
+/// message naming host:port); a request the server refused is an OK Result holding a Response
+/// whose status says why (see status_of()). NOT thread safe; movable.
+class Client {
+ public:
+  /// Connects within timeout_s. The error names host:port and suggests starting scenewatchd.
+  static Result<Client> connect(const std::string& host, std::uint16_t port, double timeout_s = 5.0,
+                                std::size_t max_message_bytes = ServerConfig{}.max_message_bytes);
+
+  Client(Client&& other) noexcept;
+  Client& operator=(Client&& other) noexcept;
+  Client(const Client&) = delete;
+  Client& operator=(const Client&) = delete;
+  ~Client();
+
+  /// Sends a request (its id is set to the next free one) and waits for the response with that
+  /// id; events pushed meanwhile are kept for next_event(). timeout_s <= 0: wait forever.
+  Result<proto::Response> call(proto::Request request, double timeout_s = 0);
+
+  /// The next pushed event (after a Subscribe call). timeout_s <= 0: wait forever.
+  Result<proto::Event> next_event(double timeout_s = 0);
+
+  /// Sends a request as is (its id untouched), without waiting.
+  Status send(const proto::Request& request);
+  /// Receives the next message of any kind. timeout_s <= 0: wait forever.
+  Result<proto::Response> receive(double timeout_s = 0);
+  /// Writes raw bytes to the socket (tests of broken framing).
+  Status send_raw(std::string_view bytes);
+
+  /// Closes the connection (also done by the destructor).
+  void close();
+  /// False after close() or once the server closed the connection.
+  bool is_open() const { return fd_ >= 0; }
+  /// "host:port" as given to connect().
+  const std::string& endpoint() const { return endpoint_; }
+
+ private:
+  Client(int fd, std::string endpoint, std::size_t max_message_bytes);
+  Result<std::string> read_payload(double timeout_s);
+
+  int fd_ = -1;
+  std::string endpoint_;
+  FrameParser parser_;
+  std::uint64_t next_id_ = 1;
+  std::deque<proto::Event> events_;
+};
+
+/// OK when the response's status is OK, else an Error with its code and message.
+Status status_of(const proto::Response& response);
+
+/// Printable name of a status code ("INVALID_ARGUMENT").
+std::string to_string(proto::Status::Code code);
+
+/// Builds the IngestFrame message of a frame: cloud (xyz, and rgb when it has colour), pose,
+/// intrinsics, stamp and source.
+proto::IngestFrame make_ingest_frame(const Frame& frame);
+
+}  // namespace scenewatch::service

@@ -1,0 +1,39 @@
+#pragma once
+/// The `server` section of scenewatchd's YAML configuration (see daemon_config.h for the file).
+#include <yaml-cpp/yaml.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "scenewatch/core/result.h"
+
+namespace scenewatch::service {
+
+/// The TCP port of scenewatchd unless configured otherwise (also the CLI's default).
+inline constexpr std::uint16_t kDefaultPort = 7878;
+
+/// The `server:` section. Defaults are those of config/scenewatchd.yaml.
+struct ServerConfig {
+  std::string address = "127.0.0.1";            ///< listen address; loopback unless opened on purpose
+  std::uint16_t port = kDefaultPort;            ///< 0: pick a free port (the daemon prints it)
+  std::size_t max_message_bytes = 64u << 20;    ///< largest accepted frame payload (64 MiB)
+  double read_timeout_s = 10.0;                 ///< a frame stalled this long mid-way closes the connection
+  std::size_t max_queued_bytes = 16u << 20;     ///< outgoing bytes queued per client before a subscriber is dropped
+  std::size_t max_connections = 64;             ///< further clients get UNAVAILABLE and are closed
+  int io_threads = 2;                           ///< threads running the sockets
+  std::vector<std::filesystem::path> data_roots;  ///< IngestFile only reads below these (none: disabled)
+  std::filesystem::path model_dir;              ///< loaded at start, saved by SaveModel and at exit (empty: none)
+};
+
+/// Checks ranges; the message names the key ("server.read_timeout_s: must be > 0, got 0").
+Status validate(const ServerConfig& config);
+
+/// Reads the `server` section of a parsed YAML root (absent: defaults). Unknown keys are errors.
+/// Relative data_roots and model_dir are taken relative to `base_dir` (the config file's folder).
+Status read_server_config(const YAML::Node& root, const std::filesystem::path& base_dir,
+                          ServerConfig& config);
+
+}  // namespace scenewatch::service

@@ -1,0 +1,36 @@
+#include "connection_registry.h"
+
+#include <vector>
+
+#include "session.h"
+
+namespace scenewatch::service {
+
+std::size_t ConnectionRegistry::add(const std::shared_ptr<Session>& session) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (stopped_) return 0;
+  sessions_.insert(session);
+  return sessions_.size();
+}
+
+void ConnectionRegistry::remove(const std::shared_ptr<Session>& session) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  sessions_.erase(session);
+}
+
+void ConnectionRegistry::stop_all() {
+  std::vector<std::shared_ptr<Session>> sessions;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stopped_ = true;
+    sessions.assign(sessions_.begin(), sessions_.end());
+  }
+  for (const auto& session : sessions) session->stop();
+}
+
+std::size_t ConnectionRegistry::size() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return sessions_.size();
+}
+
+}  // namespace scenewatch::service

@@ -1,0 +1,49 @@
+#pragma once
+// Conversions between core types and the wire protocol's messages. Private to the service module
+// (the client header re-exports only what the CLI needs).
+#include <string>
+
+#include "scenewatch.pb.h"
+#include "scenewatch/core/cloud.h"
+#include "scenewatch/core/event.h"
+#include "scenewatch/core/geometry.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/core/scene.h"
+
+namespace scenewatch::service::convert {
+
+proto::Status::Code to_proto(ErrorCode code);
+ErrorCode from_proto(proto::Status::Code code);
+
+void to_proto(const Eigen::Vector3d& v, proto::Vec3* out);
+Eigen::Vector3d from_proto(const proto::Vec3& v);
+void to_proto(const Aabb& box, proto::Box* out);
+void to_proto(const OrientedBox& box, proto::OrientedBox* out);
+void to_proto(const Plane& plane, proto::Plane* out);
+void to_proto(const ObjectCluster& cluster, proto::Cluster* out);
+void to_proto(const TrackedObject& object, proto::Object* out);
+void to_proto(const Event& event, proto::Event* out);
+void to_proto(const Pose& pose, proto::Pose* out);
+void to_proto(const Intrinsics& intrinsics, proto::Intrinsics* out);
+
+/// Cloud -> xyz (little-endian float32) and, when has_color, rgb bytes.
+void encode_cloud(const Cloud& cloud, bool has_color, proto::Cloud* out);
+
+/// A decoded cloud; grey (128) when the message had no rgb.
+struct DecodedCloud {
+  CloudPtr cloud;
+  bool has_color = false;
+};
+/// Checks sizes (xyz 12 bytes and rgb 3 bytes per point) and decodes. Errors name the field.
+Result<DecodedCloud> decode_cloud(const proto::Cloud& msg);
+
+/// 16 finite values forming a rigid transform. `field` names the field in messages.
+Result<Pose> decode_pose(const proto::Pose& msg, const std::string& field);
+/// Finite, min <= max.
+Result<Aabb> decode_box(const proto::Box& msg, const std::string& field);
+/// Finite point.
+Result<Eigen::Vector3d> decode_point(const proto::Vec3& msg, const std::string& field);
+/// Positive focal lengths and image size.
+Result<Intrinsics> decode_intrinsics(const proto::Intrinsics& msg, const std::string& field);
+
+}  // namespace scenewatch::service::convert

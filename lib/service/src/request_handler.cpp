@@ -1,0 +1,438 @@
+#include "scenewatch/service/request_handler.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <exception>
+
+#include "proto_convert.h"
+#include "scenewatch.pb.h"
+#include "scenewatch/io/sequence.h"
+#include "scenewatch/pipeline/working_memory.h"
+
+#ifndef SCENEWATCH_VERSION
+#define SCENEWATCH_VERSION "unknown"
+#endif
+
+namespace scenewatch::service {
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::uint32_t kDefaultEventCount = 1000;
+constexpr std::uint32_t kMaxEventCount = 10000;
+constexpr std::size_t kMaxSourceLabel = 256;
+
+/// Where a call runs: see the class comment of RequestHandler.
+enum class Route { kInline, kQuery, kMutate };
+
+Route route_of(proto::Request::CallCase call) {
+  switch (call) {
+    case proto::Request::kQueryOccupancy:
+    case proto::Request::kStats:
+      return Route::kQuery;
+    case proto::Request::kIngestFrame:
+    case proto::Request::kIngestFile:
+    case proto::Request::kClearBox:
+    case proto::Request::kReset:
+    case proto::Request::kSaveModel:
+    case proto::Request::kLoadModel:
+      return Route::kMutate;
+    default:
+      return Route::kInline;
+  }
+}
+
+/// Name of the request's call as in the .proto ("ingest_frame"), for messages and logs.
+std::string call_name(const proto::Request& request) {
+  if (request.call_case() == proto::Request::CALL_NOT_SET) return "none";
+  const auto* field = proto::Request::descriptor()->FindFieldByNumber(request.call_case());
+  return field != nullptr ? field->name() : "unknown";
+}
+
+Error permission_denied(std::string message) { return {ErrorCode::kPermissionDenied, std::move(message)}; }
+Error unavailable(std::string message) { return {ErrorCode::kUnavailable, std::move(message)}; }
+
+/// True when `path` equals `root` or lies below it (component-wise, both canonical).
+bool is_within(const fs::path& path, const fs::path& root) {
+  auto [root_it, path_it] = std::mismatch(root.begin(), root.end(), path.begin(), path.end());
+  return root_it == root.end();
+}
+
+/// Absolute, symlink-resolved, without a trailing separator.
+fs::path canonical_root(const fs::path& root) {
+  std::error_code ec;
+  fs::path out = fs::weakly_canonical(fs::absolute(root, ec), ec);
+  if (ec) out = fs::absolute(root).lexically_normal();
+  if (!out.has_filename() && out.has_relative_path()) out = out.parent_path();
+  return out;
+}
+
+Reply finish(proto::Response& response, std::string call) {
+  Reply reply;
+  reply.call = std::move(call);
+  reply.ok = response.status().code() == proto::Status::OK;
+  if (!reply.ok) reply.error = response.status().message();
+  response.SerializeToString(&reply.payload);
+  return reply;
+}
+
+Reply error_reply(std::uint64_t id, proto::Status::Code code, const std::string& message, std::string call) {
+  proto::Response response;
+  response.set_id(id);
+  response.mutable_status()->set_code(code);
+  response.mutable_status()->set_message(message);
+  return finish(response, std::move(call));
+}
+
+}  // namespace
+
+struct RequestHandler::Impl {
+  pipeline::WorkingMemory& memory;
+  HandlerConfig config;
+  Executor mutate, query;
+  std::function<std::size_t()> connections;
+  std::atomic<bool> stopping{false};
+  std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+
+  Impl(pipeline::WorkingMemory& m, HandlerConfig c, Executor mu, Executor q)
+      : memory(m), config(std::move(c)), mutate(std::move(mu)), query(std::move(q)) {
+    for (auto& root : config.data_roots) root = canonical_root(root);
+  }
+
+  double uptime_s() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  }
+
+  /// Decodes a request and runs it inline or on its executor; see RequestHandler::handle().
+  void handle(std::string payload, SessionContext& context, std::function<void(Reply)> done,
+              bool use_executors) {
+    auto request = std::make_shared<proto::Request>();
+    if (!request->ParseFromString(payload)) {
+      done(error_reply(0, proto::Status::INVALID_ARGUMENT,
+                       "request of " + std::to_string(payload.size()) +
+                           " bytes is not a valid scenewatch.proto.Request message",
+                       "unparseable"));
+      return;
+    }
+    if (request->call_case() == proto::Request::CALL_NOT_SET) {
+      done(error_reply(request->id(), proto::Status::UNKNOWN_REQUEST,
+                       "request " + std::to_string(request->id()) +
+                           " has no call set (empty, or a call this server does not know)",
+                       "none"));
+      return;
+    }
+    payload = std::string();  // an ingest payload can be large: free it before the work is queued
+    const Route route = route_of(request->call_case());
+    const Executor& executor = route == Route::kMutate ? mutate : query;
+    if (!use_executors || route == Route::kInline || !executor) {
+      done(execute(*request, &context));
+      return;
+    }
+    executor([this, request, done = std::move(done)] { done(execute(*request, nullptr)); });
+  }
+
+  /// Runs one call and encodes its response. `context` is null off the connection's thread.
+  Reply execute(const proto::Request& request, SessionContext* context) {
+    proto::Response response;
+    response.set_id(request.id());
+    std::string call = call_name(request);
+    Status status;
+    try {
+      status = dispatch(request, context, response);
+    } catch (const std::exception& e) {
+      // A bug or out of memory: answer the client, keep serving the others.
+      status = Error{ErrorCode::kInternal, std::string("unexpected exception: ") + e.what()};
+    }
+    if (!status) {
+      response.clear_result();
+      const Error& e = status.error();
+      response.mutable_status()->set_code(convert::to_proto(e.code));
+      response.mutable_status()->set_message(call + ": " + e.message);
+    }
+    return finish(response, std::move(call));
+  }
+
+  Status dispatch(const proto::Request& request, SessionContext* context, proto::Response& response) {
+    if (route_of(request.call_case()) == Route::kMutate && stopping) {
+      return unavailable("the server is shutting down");
+    }
+    switch (request.call_case()) {
+      case proto::Request::kHealth: return health(response);
+      case proto::Request::kStats: return stats(response);
+      case proto::Request::kIngestFrame: return ingest_frame(request.ingest_frame(), response);
+      case proto::Request::kIngestFile: return ingest_file(request.ingest_file(), response);
+      case proto::Request::kGetPlanes: return get_planes(response);
+      case proto::Request::kGetObjects: return get_objects(response);
+      case proto::Request::kQueryOccupancy: return query_occupancy(request.query_occupancy(), response);
+      case proto::Request::kClearBox: return clear_box(request.clear_box(), response);
+      case proto::Request::kReset:
+        memory.reset();
+        response.mutable_reset();
+        return {};
+      case proto::Request::kSaveModel: return save_model(response);
+      case proto::Request::kLoadModel: return load_model(response);
+      case proto::Request::kSubscribe: return subscribe(context, response);
+      case proto::Request::kGetEvents: return get_events(request.get_events(), response);
+      case proto::Request::CALL_NOT_SET: break;
+    }
+    // Not reached for a known call: the empty oneof is answered by the caller.
+    return Error{ErrorCode::kInternal, "unhandled call"};
+  }
+
+  Status health(proto::Response& response) {
+    auto* out = response.mutable_health();
+    out->set_version(SCENEWATCH_VERSION);
+    out->set_uptime_s(uptime_s());
+    out->set_frames_processed(memory.snapshot()->frames_processed);
+    return {};
+  }
+
+  Status stats(proto::Response& response) {
+    const pipeline::Stats s = memory.stats();
+    auto* out = response.mutable_stats();
+    out->set_frames_processed(s.frames_processed);
+    out->set_points_processed(s.points_processed);
+    out->set_events_emitted(s.events_emitted);
+    out->set_map_leaf_nodes(s.map_leaf_nodes);
+    out->set_map_occupied_leaves(s.map_occupied_leaves);
+    out->set_map_memory_bytes(s.map_memory_bytes);
+    out->set_map_resolution_m(s.map_resolution_m);
+    out->set_last_frame_ms(s.last_frame_ms);
+    out->set_mean_frame_ms(s.mean_frame_ms);
+    out->set_tracked_objects(s.tracked_objects);
+    out->set_connections(connections ? static_cast<std::uint32_t>(connections()) : 0);
+    out->set_uptime_s(uptime_s());
+    return {};
+  }
+
+  Status ingest_frame(const proto::IngestFrame& msg, proto::Response& response) {
+    if (!msg.has_cloud()) return invalid_argument("cloud is missing");
+    auto cloud = convert::decode_cloud(msg.cloud());
+    if (!cloud) return cloud.error();
+    Frame frame;
+    frame.cloud = cloud->cloud;
+    frame.has_color = cloud->has_color;
+    if (msg.has_pose()) {
+      auto pose = convert::decode_pose(msg.pose(), "pose");
+      if (!pose) return pose.error();
+      frame.T_world_camera = *pose;
+    }
+    if (msg.has_intrinsics()) {
+      auto k = convert::decode_intrinsics(msg.intrinsics(), "intrinsics");
+      if (!k) return k.error();
+      if (frame.cloud->height > 1 && (static_cast<std::uint32_t>(k->width) != frame.cloud->width ||
+                                      static_cast<std::uint32_t>(k->height) != frame.cloud->height)) {
+        return invalid_argument("intrinsics are for a " + std::to_string(k->width) + " x " +
+                                std::to_string(k->height) + " image but the organized cloud is " +
+                                std::to_string(frame.cloud->width) + " x " + std::to_string(frame.cloud->height));
+      }
+      frame.intrinsics = *k;
+    }
+    if (!std::isfinite(msg.stamp_s())) return invalid_argument("stamp_s is not finite");
+    frame.stamp_s = msg.stamp_s();
+    frame.source = msg.source().empty() ? std::string("api") : msg.source().substr(0, kMaxSourceLabel);
+    return process(frame, response);
+  }
+
+  Result<fs::path> resolve_under_roots(const fs::path& requested) const {
+    if (config.data_roots.empty()) {
+      return permission_denied("reading files on the server is disabled: no data roots are configured "
+                               "(server.data_roots)");
+    }
+    std::error_code ec;
+    fs::path resolved = fs::weakly_canonical(requested, ec);
+    if (ec) return io_error("cannot resolve '" + requested.string() + "': " + ec.message());
+    for (const auto& root : config.data_roots) {
+      if (is_within(resolved, root)) return resolved;
+    }
+    std::string roots;
+    for (const auto& root : config.data_roots) roots += (roots.empty() ? "" : ", ") + root.string();
+    return permission_denied("'" + requested.string() + "' is outside the data roots (" + roots + ")");
+  }
+
+  Status ingest_file(const proto::IngestFile& msg, proto::Response& response) {
+    if (msg.path().empty()) return invalid_argument("path is empty");
+    const fs::path requested(msg.path());
+    if (!requested.is_absolute()) return invalid_argument("path must be absolute, got '" + msg.path() + "'");
+    auto resolved = resolve_under_roots(requested);
+    if (!resolved) return resolved.error();
+    auto frame = io::load_cloud_frame(*resolved);
+    if (!frame) return frame.error();
+    if (msg.has_pose()) {
+      auto pose = convert::decode_pose(msg.pose(), "pose");
+      if (!pose) return pose.error();
+      frame->T_world_camera = *pose;
+    }
+    if (!std::isfinite(msg.stamp_s())) return invalid_argument("stamp_s is not finite");
+    frame->stamp_s = msg.stamp_s();
+    return process(*frame, response);
+  }
+
+  Status process(const Frame& frame, proto::Response& response) {
+    auto result = memory.process(frame);
+    if (!result) return result.error();
+    auto* out = response.mutable_ingest();
+    out->set_frame_index(result->frame_index);
+    out->set_points(result->insert_stats.points);
+    for (const auto& plane : result->planes) convert::to_proto(plane, out->add_planes());
+    for (const auto& cluster : result->objects) convert::to_proto(cluster, out->add_clusters());
+    for (const auto& event : result->events) convert::to_proto(event, out->add_events());
+    out->set_segment_ms(result->segment_ms);
+    out->set_insert_ms(result->insert_ms);
+    out->set_total_ms(result->total_ms);
+    return {};
+  }
+
+  Status get_planes(proto::Response& response) {
+    const auto snapshot = memory.snapshot();
+    auto* out = response.mutable_planes();
+    out->set_frames_processed(snapshot->frames_processed);
+    out->set_last_stamp_s(snapshot->last_stamp_s);
+    for (const auto& plane : snapshot->planes) convert::to_proto(plane, out->add_planes());
+    return {};
+  }
+
+  Status get_objects(proto::Response& response) {
+    const auto snapshot = memory.snapshot();
+    auto* out = response.mutable_objects();
+    out->set_frames_processed(snapshot->frames_processed);
+    for (const auto& object : snapshot->objects) convert::to_proto(object, out->add_objects());
+    return {};
+  }
+
+  Status query_occupancy(const proto::QueryOccupancy& msg, proto::Response& response) {
+    if (msg.points_size() == 0 && !msg.has_box()) return invalid_argument("give points, a box, or both");
+    std::vector<Eigen::Vector3d> points;
+    points.reserve(static_cast<std::size_t>(msg.points_size()));
+    for (int i = 0; i < msg.points_size(); ++i) {
+      auto p = convert::decode_point(msg.points(i), "points[" + std::to_string(i) + "]");
+      if (!p) return p.error();
+      points.push_back(*p);
+    }
+    std::optional<Aabb> box;
+    if (msg.has_box()) {
+      auto b = convert::decode_box(msg.box(), "box");
+      if (!b) return b.error();
+      box = *b;
+    }
+    auto* out = response.mutable_occupancy();
+    for (const auto& p : points) out->add_states(to_proto(memory.query(p)));
+    if (box) {
+      const background::BoxOccupancy summary = memory.query_box(*box);
+      auto* b = out->mutable_box();
+      b->set_state(to_proto(summary.state));
+      b->set_occupied_voxels(summary.occupied_voxels);
+      b->set_free_voxels(summary.free_voxels);
+      b->set_unknown_voxels(summary.unknown_voxels);
+    }
+    return {};
+  }
+
+  static proto::OccupancyState to_proto(background::Occupancy state) {
+    switch (state) {
+      case background::Occupancy::kFree: return proto::OCCUPANCY_FREE;
+      case background::Occupancy::kOccupied: return proto::OCCUPANCY_OCCUPIED;
+      case background::Occupancy::kUnknown: break;
+    }
+    return proto::OCCUPANCY_UNKNOWN;
+  }
+
+  Status clear_box(const proto::ClearBox& msg, proto::Response& response) {
+    if (!msg.has_box()) return invalid_argument("box is missing");
+    auto box = convert::decode_box(msg.box(), "box");
+    if (!box) return box.error();
+    response.mutable_clear_box()->set_voxels_changed(memory.clear_box(*box));
+    return {};
+  }
+
+  Status require_model_dir() const {
+    if (config.model_dir.empty()) {
+      return unavailable("no model directory is configured (server.model_dir or --model-dir)");
+    }
+    return {};
+  }
+
+  Status save_model(proto::Response& response) {
+    if (Status s = require_model_dir(); !s) return s;
+    if (Status s = memory.save(config.model_dir); !s) return s;
+    response.mutable_save_model()->set_model_dir(config.model_dir.string());
+    return {};
+  }
+
+  Status load_model(proto::Response& response) {
+    if (Status s = require_model_dir(); !s) return s;
+    if (Status s = memory.load(config.model_dir); !s) return s;
+    auto* out = response.mutable_load_model();
+    out->set_model_dir(config.model_dir.string());
+    out->set_objects(memory.snapshot()->objects.size());
+    return {};
+  }
+
+  Status subscribe(SessionContext* context, proto::Response& response) {
+    if (context == nullptr || !context->event_sink) {
+      return unavailable("this connection cannot receive pushed events");
+    }
+    // Subscribe first, then read the log: every later event is pushed, none is lost in between
+    // (an event may be both in the log up to last_event_id and pushed; ids tell them apart).
+    if (context->subscription < 0) {
+      context->subscription = memory.subscribe([sink = context->event_sink](const Event& event) {
+        proto::Response pushed;
+        pushed.set_id(0);
+        convert::to_proto(event, pushed.mutable_event());
+        std::string bytes;
+        pushed.SerializeToString(&bytes);
+        sink(std::move(bytes));
+      });
+    }
+    const auto log = memory.events_since(0, std::max<std::size_t>(1, memory.config().max_event_log));
+    response.mutable_subscribe()->set_last_event_id(log.empty() ? 0 : log.back().id);
+    return {};
+  }
+
+  Status get_events(const proto::GetEvents& msg, proto::Response& response) {
+    const std::uint32_t count =
+        msg.max_count() == 0 ? kDefaultEventCount : std::min(msg.max_count(), kMaxEventCount);
+    auto* out = response.mutable_events();
+    for (const auto& event : memory.events_since(msg.since(), count)) convert::to_proto(event, out->add_events());
+    return {};
+  }
+};
+
+RequestHandler::RequestHandler(pipeline::WorkingMemory& memory, HandlerConfig config, Executor mutate,
+                               Executor query)
+    : impl_(std::make_unique<Impl>(memory, std::move(config), std::move(mutate), std::move(query))) {}
+
+RequestHandler::~RequestHandler() = default;
+
+void RequestHandler::handle(std::string payload, SessionContext& context, std::function<void(Reply)> done) {
+  impl_->handle(std::move(payload), context, std::move(done), /*use_executors=*/true);
+}
+
+Reply RequestHandler::handle_now(const std::string& payload, SessionContext& context) {
+  Reply out;
+  impl_->handle(payload, context, [&out](Reply reply) { out = std::move(reply); }, /*use_executors=*/false);
+  return out;
+}
+
+void RequestHandler::unsubscribe(SessionContext& context) {
+  if (context.subscription >= 0) {
+    impl_->memory.unsubscribe(context.subscription);
+    context.subscription = -1;
+  }
+}
+
+std::string RequestHandler::error_payload(ErrorCode code, const std::string& message) const {
+  return error_reply(0, convert::to_proto(code), message, "connection").payload;
+}
+
+void RequestHandler::set_connection_counter(std::function<std::size_t()> counter) {
+  impl_->connections = std::move(counter);
+}
+
+void RequestHandler::shutdown() { impl_->stopping = true; }
+
+const HandlerConfig& RequestHandler::config() const { return impl_->config; }
+
+}  // namespace scenewatch::service

@@ -1,0 +1,197 @@
+#include "scenewatch/service/server.h"
+
+#include <boost/asio/io_context.hpp>
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/post.hpp>
+#include <boost/asio/signal_set.hpp>
+#include <boost/asio/steady_timer.hpp>
+#include <boost/asio/strand.hpp>
+#include <boost/asio/thread_pool.hpp>
+
+#include <atomic>
+#include <csignal>
+#include <exception>
+#include <thread>
+#include <vector>
+
+#include "connection_registry.h"
+#include "scenewatch/service/request_handler.h"
+#include "session.h"
+
+namespace scenewatch::service {
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+
+namespace {
+/// Worker threads for calls that touch the model: one runs model changes (a strand keeps them
+/// in order), the other lets queries that wait for the map proceed meanwhile.
+constexpr int kWorkerThreads = 2;
+}  // namespace
+
+struct Server::Impl {
+  ServerConfig config;
+  pipeline::WorkingMemory& memory;
+  LogSink log;
+
+  // Declaration order is destruction order in reverse: sessions (owned by the io_context's
+  // handlers and the registry) go before the handler they unsubscribe from.
+  asio::thread_pool workers{kWorkerThreads};
+  asio::strand<asio::thread_pool::executor_type> model_strand{workers.get_executor()};
+  RequestHandler handler;
+  asio::io_context io;
+  ConnectionRegistry registry;
+  tcp::acceptor acceptor{io};
+  asio::signal_set signals{io};
+  asio::steady_timer accept_retry{io};
+  std::atomic<std::uint64_t> next_number{1};
+  std::atomic<bool> stop_requested{false};
+  bool handle_signals = true;
+  bool joined = false;
+
+  Impl(ServerConfig c, pipeline::WorkingMemory& m, LogSink l, bool signals_wanted)
+      : config(std::move(c)),
+        memory(m),
+        log(std::move(l)),
+        handler(m, HandlerConfig{config.data_roots, config.model_dir},
+                [this](std::function<void()> task) { asio::post(model_strand, std::move(task)); },
+                [this](std::function<void()> task) { asio::post(workers, std::move(task)); }) {
+    handler.set_connection_counter([this] { return registry.size(); });
+    handle_signals = signals_wanted;
+  }
+
+  ~Impl() {
+    handler.shutdown();
+    if (!joined) workers.join();
+  }
+
+  void write_log(LogLevel level, const std::string& message) const {
+    if (log) log(level, message);
+  }
+
+  void do_accept() {
+    acceptor.async_accept(asio::make_strand(io), [this](const boost::system::error_code& ec, tcp::socket socket) {
+      if (ec) {
+        if (ec == asio::error::operation_aborted || !acceptor.is_open()) return;
+        // Typically out of file descriptors: wait a little instead of spinning.
+        write_log(LogLevel::kError, "accept failed: " + ec.message());
+        accept_retry.expires_after(std::chrono::milliseconds(100));
+        accept_retry.async_wait([this](const boost::system::error_code& wait_ec) {
+          if (!wait_ec && acceptor.is_open()) do_accept();
+        });
+        return;
+      }
+      on_accept(std::move(socket));
+      do_accept();
+    });
+  }
+
+  void on_accept(tcp::socket socket) {
+    boost::system::error_code ignored;
+    socket.set_option(tcp::no_delay(true), ignored);
+    const SessionOptions options{config.max_message_bytes, config.read_timeout_s, config.max_queued_bytes};
+    auto session = std::make_shared<Session>(std::move(socket), options, handler, registry, log, next_number++);
+    const std::size_t count = registry.add(session);
+    if (count == 0) return;  // stopping: the socket closes with the session
+    if (count > config.max_connections) {
+      asio::post(session->executor(), [session, limit = config.max_connections] {
+        session->start_rejected(ErrorCode::kUnavailable,
+                                "too many connections (limit " + std::to_string(limit) + ", server.max_connections)");
+      });
+    } else {
+      asio::post(session->executor(), [session] { session->start(); });
+    }
+  }
+
+  void run_io() {
+    // A handler that throws (out of memory, a bug) must not take the daemon down.
+    for (;;) {
+      try {
+        io.run();
+        return;
+      } catch (const std::exception& e) {
+        write_log(LogLevel::kError, std::string("unexpected exception in the network loop: ") + e.what());
+      }
+    }
+  }
+};
+
+Server::Server(ServerConfig config, pipeline::WorkingMemory& memory, LogSink log, bool handle_signals)
+    : impl_(std::make_unique<Impl>(std::move(config), memory, std::move(log), handle_signals)) {}
+
+Server::~Server() = default;
+
+Status Server::listen() {
+  Impl& s = *impl_;
+  boost::system::error_code ec;
+  const auto address = asio::ip::make_address(s.config.address, ec);
+  if (ec) return invalid_argument("server.address: '" + s.config.address + "' is not an IP address");
+  const tcp::endpoint endpoint(address, s.config.port);
+  const std::string where = format_endpoint(endpoint);
+  s.acceptor.open(endpoint.protocol(), ec);
+  if (!ec) s.acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
+  if (!ec) s.acceptor.bind(endpoint, ec);
+  if (!ec) s.acceptor.listen(asio::socket_base::max_listen_connections, ec);
+  if (ec) {
+    boost::system::error_code ignored;
+    s.acceptor.close(ignored);
+    return io_error("cannot listen on " + where + ": " + ec.message());
+  }
+  if (s.handle_signals) {
+    // Caught from here on (delivered once run() runs), so a signal right after the daemon says
+    // it is listening still shuts it down cleanly.
+    s.signals.add(SIGINT, ec);
+    if (!ec) s.signals.add(SIGTERM, ec);
+    if (ec) return io_error("cannot install the SIGINT/SIGTERM handler: " + ec.message());
+    s.signals.async_wait([this](const boost::system::error_code& wait_ec, int signal) {
+      if (wait_ec) return;
+      impl_->write_log(LogLevel::kInfo, std::string("received ") + (signal == SIGINT ? "SIGINT" : "SIGTERM") +
+                                            ", shutting down");
+      stop();
+    });
+  }
+  return {};
+}
+
+std::uint16_t Server::port() const {
+  boost::system::error_code ec;
+  const auto endpoint = impl_->acceptor.local_endpoint(ec);
+  return ec ? 0 : endpoint.port();
+}
+
+std::string Server::endpoint() const {
+  boost::system::error_code ec;
+  const auto endpoint = impl_->acceptor.local_endpoint(ec);
+  return ec ? std::string() : format_endpoint(endpoint);
+}
+
+void Server::run() {
+  Impl& s = *impl_;
+  if (s.stop_requested || !s.acceptor.is_open()) return;
+  s.do_accept();
+  std::vector<std::thread> threads;
+  for (int i = 1; i < s.config.io_threads; ++i) threads.emplace_back([&s] { s.run_io(); });
+  s.run_io();
+  for (auto& thread : threads) thread.join();
+  // Every connection is closed. Let the calls in progress finish (queued model changes are
+  // answered UNAVAILABLE), then deliver their replies to the closed sessions, which drop them.
+  s.handler.shutdown();
+  s.workers.join();
+  s.joined = true;
+  s.io.restart();
+  s.run_io();
+}
+
+void Server::stop() {
+  Impl& s = *impl_;
+  s.stop_requested = true;
+  asio::post(s.io, [&s] {
+    boost::system::error_code ignored;
+    s.handler.shutdown();
+    s.acceptor.close(ignored);
+    s.accept_retry.cancel();
+    s.signals.cancel(ignored);
+    s.registry.stop_all();
+  });
+}
+
+}  // namespace scenewatch::service

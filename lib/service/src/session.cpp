@@ -1,0 +1,289 @@
+#include "session.h"
+
+#include <boost/asio/post.hpp>
+#include <boost/asio/write.hpp>
+
+#include <chrono>
+#include <sstream>
+
+namespace scenewatch::service {
+namespace asio = boost::asio;
+using tcp = asio::ip::tcp;
+
+namespace {
+/// Requests read ahead of the one being handled; beyond this the session stops reading.
+constexpr std::size_t kMaxPendingRequests = 8;
+/// After an error reply, how long the client's remaining bytes are drained before closing.
+constexpr double kLingerS = 2.0;
+
+std::string seconds(double s) {
+  std::ostringstream os;
+  os << s << " s";
+  return os.str();
+}
+}  // namespace
+
+std::string format_endpoint(const tcp::endpoint& endpoint) {
+  const std::string address = endpoint.address().to_string();
+  return (endpoint.address().is_v6() ? "[" + address + "]" : address) + ":" + std::to_string(endpoint.port());
+}
+
+Session::Session(tcp::socket socket, const SessionOptions& options, RequestHandler& handler,
+                 ConnectionRegistry& registry, const LogSink& log, std::uint64_t number)
+    : executor_(socket.get_executor()),
+      socket_(std::move(socket)),
+      timer_(executor_),
+      options_(options),
+      handler_(handler),
+      registry_(registry),
+      log_(log),
+      number_(number),
+      parser_(options.max_message_bytes) {
+  boost::system::error_code ec;
+  const tcp::endpoint peer = socket_.remote_endpoint(ec);
+  peer_ = ec ? std::string("unknown peer") : format_endpoint(peer);
+}
+
+Session::~Session() { handler_.unsubscribe(context_); }
+
+void Session::log(LogLevel level, const std::string& message) const {
+  if (log_) log_(level, "client #" + std::to_string(number_) + " " + peer_ + ": " + message);
+}
+
+void Session::start() {
+  context_.event_sink = [weak = weak_from_this(), executor = executor_](std::string payload) {
+    if (auto self = weak.lock()) {
+      asio::post(executor, [self, payload = std::move(payload)]() mutable { self->push_event(std::move(payload)); });
+    }
+  };
+  log(LogLevel::kInfo, "connected");
+  maybe_resume_reading();
+}
+
+void Session::start_rejected(ErrorCode code, const std::string& message) {
+  log(LogLevel::kWarning, "rejected: " + message);
+  fail_and_close(code, message);
+}
+
+void Session::stop() {
+  asio::post(executor_, [self = shared_from_this()] { self->close("server stopping"); });
+}
+
+void Session::do_read() {
+  if (reading_ || closed_) return;
+  reading_ = true;
+  socket_.async_read_some(asio::buffer(read_buffer_),
+                          [self = shared_from_this()](const boost::system::error_code& ec, std::size_t n) {
+                            self->on_read(ec, n);
+                          });
+}
+
+void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
+  reading_ = false;
+  if (closed_) return;
+  if (lingering_) {
+    // Our side is shut down; drain what the client still sends until it closes too.
+    if (ec) {
+      close(close_reason_);
+    } else {
+      do_read();
+    }
+    return;
+  }
+  if (ec) {
+    if (ec == asio::error::operation_aborted) return;
+    if (ec == asio::error::eof && !parser_.has_partial() && !idle()) {
+      // The client half-closed after its last request (as `nc -N` does): answer what it sent,
+      // then close.
+      peer_done_ = true;
+      cancel_timer();
+    } else if (ec == asio::error::eof || ec == asio::error::connection_reset) {
+      close(parser_.has_partial() ? "client disconnected mid-frame (" + std::to_string(parser_.buffered_bytes()) +
+                                        " bytes of an unfinished frame dropped)"
+                                  : "client disconnected");
+    } else {
+      close("read failed: " + ec.message());
+    }
+    return;
+  }
+  if (closing_) {
+    do_read();  // an error reply is being flushed; the client's bytes are ignored
+    return;
+  }
+  cancel_timer();  // progress: the stall clock restarts
+  const Status fed = parser_.feed(std::string_view(read_buffer_.data(), n));
+  while (auto frame = parser_.next()) {
+    pending_bytes_ += frame->size();
+    pending_.push_back(std::move(*frame));
+  }
+  if (!fed) {
+    fail_and_close(ErrorCode::kInvalidArgument, "broken framing: " + fed.error().message);
+    return;
+  }
+  dispatch_next();
+  maybe_resume_reading();
+}
+
+bool Session::idle() const { return !in_flight_ && pending_.empty() && outgoing_.empty(); }
+
+void Session::maybe_resume_reading() {
+  if (closing_ || closed_ || lingering_) return;
+  if (peer_done_) {
+    if (idle()) close("client disconnected");
+    return;
+  }
+  if (!reading_) {
+    // Back-pressure: a client that pipelines requests faster than they are answered, or does not
+    // read its replies, is simply not read from until it catches up. Requests waiting hold at
+    // most about one maximum-size message.
+    if (pending_.size() >= kMaxPendingRequests || pending_bytes_ >= options_.max_message_bytes ||
+        queued_bytes_ >= options_.max_queued_bytes) {
+      cancel_timer();
+      return;
+    }
+    do_read();
+    if (parser_.has_partial()) {
+      arm_timer(options_.read_timeout_s, &Session::on_stall_timeout);
+    } else {
+      cancel_timer();
+    }
+  }
+}
+
+void Session::dispatch_next() {
+  if (in_flight_ || pending_.empty() || closing_ || closed_) return;
+  in_flight_ = true;
+  std::string payload = std::move(pending_.front());
+  pending_.pop_front();
+  pending_bytes_ -= payload.size();
+  auto self = shared_from_this();
+  handler_.handle(std::move(payload), context_, [self](Reply reply) {
+    // Possibly on a worker thread: continue on the strand.
+    asio::post(self->executor_, [self, reply = std::move(reply)]() mutable { self->on_reply(std::move(reply)); });
+  });
+}
+
+void Session::on_reply(Reply reply) {
+  in_flight_ = false;
+  if (closed_ || closing_) return;
+  if (reply.ok) {
+    log(LogLevel::kDebug, reply.call + " ok");
+  } else {
+    log(LogLevel::kWarning, reply.call + " failed: " + reply.error);
+  }
+  enqueue(std::move(reply.payload));
+  dispatch_next();
+  maybe_resume_reading();
+}
+
+void Session::push_event(std::string payload) {
+  if (closed_ || closing_) return;
+  if (queued_bytes_ + kFrameHeaderBytes + payload.size() > options_.max_queued_bytes) {
+    const std::string why = "subscriber too slow: " + std::to_string(queued_bytes_) +
+                            " bytes already queued, limit " + std::to_string(options_.max_queued_bytes) +
+                            " (server.max_queued_bytes)";
+    log(LogLevel::kWarning, why + "; disconnecting");
+    close(why);
+    return;
+  }
+  enqueue(std::move(payload));
+}
+
+void Session::enqueue(std::string payload) {
+  Outgoing out;
+  const auto n = static_cast<std::uint32_t>(payload.size());
+  out.header = {static_cast<unsigned char>(n >> 24), static_cast<unsigned char>(n >> 16),
+                static_cast<unsigned char>(n >> 8), static_cast<unsigned char>(n)};
+  out.payload = std::move(payload);
+  queued_bytes_ += kFrameHeaderBytes + out.payload.size();
+  outgoing_.push_back(std::move(out));
+  if (!writing_) do_write();
+}
+
+void Session::do_write() {
+  writing_ = true;
+  const Outgoing& front = outgoing_.front();  // deque: stays put while others are appended
+  const std::array<asio::const_buffer, 2> buffers{asio::buffer(front.header), asio::buffer(front.payload)};
+  asio::async_write(socket_, buffers,
+                    [self = shared_from_this()](const boost::system::error_code& ec, std::size_t) {
+                      self->on_write(ec);
+                    });
+}
+
+void Session::on_write(const boost::system::error_code& ec) {
+  writing_ = false;
+  if (closed_) return;
+  if (ec) {
+    close("write failed: " + ec.message());
+    return;
+  }
+  queued_bytes_ -= kFrameHeaderBytes + outgoing_.front().payload.size();
+  outgoing_.pop_front();
+  if (!outgoing_.empty()) {
+    do_write();
+  } else if (closing_ && !lingering_) {
+    begin_linger();
+    return;
+  }
+  maybe_resume_reading();
+}
+
+void Session::arm_timer(double seconds, void (Session::*on_expiry)()) {
+  const std::uint64_t generation = ++timer_generation_;
+  timer_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+      std::chrono::duration<double>(seconds)));
+  timer_.async_wait([self = shared_from_this(), generation, on_expiry](const boost::system::error_code& ec) {
+    if (ec || generation != self->timer_generation_ || self->closed_) return;
+    ((*self).*on_expiry)();
+  });
+}
+
+void Session::cancel_timer() {
+  ++timer_generation_;
+  timer_.cancel();
+}
+
+void Session::on_stall_timeout() {
+  fail_and_close(ErrorCode::kUnavailable,
+                 "read timeout: " + std::to_string(parser_.buffered_bytes()) + " bytes of a frame arrived, then nothing for " +
+                     seconds(options_.read_timeout_s) + " (server.read_timeout_s)");
+}
+
+void Session::on_linger_timeout() { close(close_reason_); }
+
+void Session::fail_and_close(ErrorCode code, const std::string& message) {
+  if (closing_ || closed_) return;
+  log(LogLevel::kWarning, message + "; closing");
+  closing_ = true;
+  close_reason_ = message;
+  pending_.clear();
+  pending_bytes_ = 0;
+  enqueue(handler_.error_payload(code, message));
+  // The client may not read the error either: give the write as long as a stalled read.
+  arm_timer(options_.read_timeout_s, &Session::on_linger_timeout);
+}
+
+void Session::begin_linger() {
+  // Half-close and drain: closing with unread client bytes would send a reset that can destroy
+  // the error reply before the client reads it.
+  lingering_ = true;
+  boost::system::error_code ignored;
+  socket_.shutdown(tcp::socket::shutdown_send, ignored);
+  arm_timer(kLingerS, &Session::on_linger_timeout);
+  do_read();
+}
+
+void Session::close(const std::string& reason) {
+  if (closed_) return;
+  closed_ = true;
+  cancel_timer();
+  handler_.unsubscribe(context_);
+  boost::system::error_code ignored;
+  socket_.shutdown(tcp::socket::shutdown_both, ignored);
+  socket_.close(ignored);
+  pending_.clear();
+  log(LogLevel::kInfo, "disconnected (" + reason + ")");
+  registry_.remove(shared_from_this());
+}
+
+}  // namespace scenewatch::service

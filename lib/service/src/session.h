@@ -1,0 +1,104 @@
+#pragma once
+// One client connection: reads frames, runs their requests one at a time in order, writes the
+// replies and pushed events. Everything runs on the socket's strand.
+#include <boost/asio/ip/tcp.hpp>
+#include <boost/asio/steady_timer.hpp>
+
+#include <array>
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <string>
+
+#include "connection_registry.h"
+#include "scenewatch/service/frame_parser.h"
+#include "scenewatch/service/log.h"
+#include "scenewatch/service/request_handler.h"
+
+namespace scenewatch::service {
+
+/// "1.2.3.4:5678", or "[::1]:5678" for IPv6.
+std::string format_endpoint(const boost::asio::ip::tcp::endpoint& endpoint);
+
+struct SessionOptions {
+  std::size_t max_message_bytes = 0;
+  double read_timeout_s = 10.0;
+  std::size_t max_queued_bytes = 0;
+};
+
+/// Owned by shared_ptrs (the registry, pending operations, queued replies). The socket's
+/// executor must be a strand; every member function except stop() runs on it.
+class Session : public std::enable_shared_from_this<Session> {
+ public:
+  using Executor = boost::asio::ip::tcp::socket::executor_type;
+
+  Session(boost::asio::ip::tcp::socket socket, const SessionOptions& options, RequestHandler& handler,
+          ConnectionRegistry& registry, const LogSink& log, std::uint64_t number);
+  ~Session();
+
+  /// Starts reading. Call once, after adding the session to the registry.
+  void start();
+  /// Sends a connection-level error, then closes (e.g. too many connections).
+  void start_rejected(ErrorCode code, const std::string& message);
+  /// Closes the connection. Thread safe.
+  void stop();
+  /// The strand the session runs on.
+  const Executor& executor() const { return executor_; }
+
+ private:
+  /// A frame ready to send: its 4-byte length prefix and the payload.
+  struct Outgoing {
+    std::array<unsigned char, kFrameHeaderBytes> header;
+    std::string payload;
+  };
+
+  void do_read();
+  void on_read(const boost::system::error_code& ec, std::size_t n);
+  void maybe_resume_reading();
+  /// No request waiting or running and nothing left to send.
+  bool idle() const;
+  void dispatch_next();
+  void on_reply(Reply reply);
+  void push_event(std::string payload);
+  void enqueue(std::string payload);
+  void do_write();
+  void on_write(const boost::system::error_code& ec);
+  void arm_timer(double seconds, void (Session::*on_expiry)());
+  void cancel_timer();
+  void on_stall_timeout();
+  void on_linger_timeout();
+  void fail_and_close(ErrorCode code, const std::string& message);
+  void begin_linger();
+  void close(const std::string& reason);
+  void log(LogLevel level, const std::string& message) const;
+
+  Executor executor_;  ///< the strand; copied once so other threads may post to it
+  boost::asio::ip::tcp::socket socket_;
+  boost::asio::steady_timer timer_;
+  SessionOptions options_;
+  RequestHandler& handler_;
+  ConnectionRegistry& registry_;
+  const LogSink& log_;
+  std::uint64_t number_;
+  std::string peer_;
+
+  FrameParser parser_;
+  std::array<char, 64 * 1024> read_buffer_{};
+  bool reading_ = false;        ///< a read is outstanding
+  std::deque<std::string> pending_;  ///< requests received, not yet started
+  std::size_t pending_bytes_ = 0;    ///< payload bytes in pending_
+  bool in_flight_ = false;      ///< a request is being handled
+  std::deque<Outgoing> outgoing_;
+  std::size_t queued_bytes_ = 0;
+  bool writing_ = false;
+  SessionContext context_;
+  std::uint64_t timer_generation_ = 0;
+
+  bool peer_done_ = false;      ///< the client half-closed: finish its requests, then close
+  bool closing_ = false;        ///< no more requests: flush the error reply, then close
+  bool lingering_ = false;      ///< our side is shut down; draining the client's bytes
+  bool closed_ = false;
+  std::string close_reason_;
+};
+
+}  // namespace scenewatch::service

@@ -1,0 +1,219 @@
+// The scenewatch CLI, run as a user would: offline segmentation, usage errors, and the daemon
+// commands against a real scenewatchd.
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "daemon_harness.h"
+#include "scenewatch/io/cloud_io.h"
+
+namespace scenewatch::test {
+namespace {
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+const char* const kMug = "pcl/table_scene_mug_stereo_textured.pcd";
+
+class CliTest : public ::testing::Test {
+ protected:
+  void TearDown() override {
+    if (HasFailure()) std::cerr << "---- scenewatchd log ----\n" << daemon_.log() << "-------------------------\n";
+    daemon_ = Daemon();
+    std::error_code ec;
+    fs::remove_all(tmp_, ec);
+  }
+
+  CommandResult cli(std::vector<std::string> args) {
+    args.insert(args.begin(), cli_binary().string());
+    return run_command(args, tmp_);
+  }
+
+  /// The CLI against the test's daemon.
+  CommandResult remote(std::vector<std::string> args) {
+    args.push_back("--port");
+    args.push_back(std::to_string(daemon_.port()));
+    return cli(std::move(args));
+  }
+
+  static json parse(const std::string& text) {
+    try {
+      return json::parse(text);
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "not JSON (" << e.what() << "):\n" << text;
+      return json();
+    }
+  }
+
+  fs::path tmp_ = make_temp_dir("cli");
+  Daemon daemon_;
+};
+
+TEST_F(CliTest, SegmentPrintsPlanesAndObjectsWithIndices) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  const auto result = cli({"segment", (data_dir() / kMug).string(), "--json", "--out", (tmp_ / "out").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json j = parse(result.out);
+  ASSERT_TRUE(j.is_object());
+  ASSERT_GE(j.at("planes").size(), 1u);
+  ASSERT_GE(j.at("objects").size(), 1u);
+  const std::size_t points = j.at("points").get<std::size_t>();
+  EXPECT_EQ(points, 640u * 480u);
+  for (const auto& object : j.at("objects")) {
+    const auto& indices = object.at("indices");
+    ASSERT_FALSE(indices.empty());
+    EXPECT_EQ(indices.size(), object.at("point_count").get<std::size_t>());
+    for (const auto& i : indices) {
+      ASSERT_GE(i.get<long>(), 0);
+      ASSERT_LT(i.get<std::size_t>(), points);
+    }
+  }
+  // --out: one PCD per object and per plane, holding exactly their points.
+  auto first = io::read_cloud(tmp_ / "out" / "object_000.pcd");
+  ASSERT_TRUE(first.ok()) << first.error().message;
+  EXPECT_EQ(first->cloud->size(), j.at("objects")[0].at("point_count").get<std::size_t>());
+  EXPECT_TRUE(fs::exists(tmp_ / "out" / "plane_000.pcd"));
+  EXPECT_EQ(j.at("written").size(), j.at("objects").size() + j.at("planes").size());
+
+  const auto text = cli({"segment", (data_dir() / kMug).string()});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("object 0"), std::string::npos) << text.out;
+}
+
+TEST_F(CliTest, HelpAndUsageErrors) {
+  EXPECT_EQ(cli({"--help"}).exit_code, 0);
+  for (const char* command : {"health", "stats", "ingest", "planes", "objects", "occupancy", "clear-box", "reset",
+                              "save", "load", "events", "watch", "segment"}) {
+    const auto result = cli({command, "--help"});
+    EXPECT_EQ(result.exit_code, 0) << command;
+    EXPECT_NE(result.out.find("--json"), std::string::npos) << command << ":\n" << result.out;
+  }
+  EXPECT_EQ(cli({}).exit_code, 2);
+  EXPECT_EQ(cli({"bogus"}).exit_code, 2);
+  EXPECT_EQ(cli({"segment"}).exit_code, 2);
+  EXPECT_EQ(cli({"occupancy", "1", "2"}).exit_code, 2);
+  EXPECT_EQ(cli({"clear-box", "1", "2", "3"}).exit_code, 2);
+}
+
+TEST_F(CliTest, MissingFileIsAnErrorNamingIt) {
+  const auto result = cli({"segment", (tmp_ / "no-such-cloud.pcd").string(), "--json"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("no-such-cloud.pcd"), std::string::npos) << result.err;
+  EXPECT_TRUE(result.out.empty()) << result.out;
+}
+
+TEST_F(CliTest, NoDaemonIsAnErrorNamingTheEndpoint) {
+  // A port that was free a moment ago.
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  socklen_t len = sizeof addr;
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  const int port = ntohs(addr.sin_port);
+  ::close(fd);
+
+  const auto result = cli({"health", "--port", std::to_string(port)});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("127.0.0.1:" + std::to_string(port)), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("scenewatchd"), std::string::npos) << result.err;
+}
+
+TEST_F(CliTest, DaemonCommands) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  fs::create_directories(tmp_ / "data");
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "  data_roots: [" + (data_dir() / "pcl").string() + "]\n  model_dir: " +
+                                                  (tmp_ / "model").string() + "\n"));
+  const std::string mug = (data_dir() / kMug).string();
+
+  auto result = remote({"health", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(parse(result.out).at("status"), "OK");
+
+  result = remote({"ingest", mug, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  json frame = parse(result.out);
+  EXPECT_GE(frame.at("planes").size(), 1u);
+  EXPECT_GE(frame.at("clusters").size(), 1u);
+  EXPECT_EQ(frame.at("source"), mug);
+
+  result = remote({"ingest", "--server-side", mug});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("frame 1"), std::string::npos) << result.out;
+
+  result = remote({"ingest", "--server-side", (tmp_ / "cli.yaml").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("PERMISSION_DENIED"), std::string::npos) << result.err;
+
+  result = remote({"objects", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const std::size_t objects = parse(result.out).at("objects").size();
+  EXPECT_GE(objects, 1u);
+
+  result = remote({"planes", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_GE(parse(result.out).at("planes").size(), 1u);
+
+  result = remote({"events", "--since", "0", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json events = parse(result.out).at("events");
+  ASSERT_GE(events.size(), 1u);
+  EXPECT_EQ(events[0].at("kind"), "OBJECT_APPEARED");
+
+  result = remote({"occupancy", "0", "0", "0.5", "--box", "-1", "-1", "0", "1", "1", "3", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  json occupancy = parse(result.out);
+  EXPECT_EQ(occupancy.at("points").size(), 1u);
+  EXPECT_EQ(occupancy.at("box").at("state"), "occupied");
+
+  result = remote({"stats", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(parse(result.out).at("frames_processed"), 2);
+
+  result = remote({"save", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(parse(result.out).at("model_dir"), (tmp_ / "model").string());
+  ASSERT_EQ(remote({"reset"}).exit_code, 0);
+  result = remote({"objects", "--json"});
+  EXPECT_EQ(parse(result.out).at("objects").size(), 0u);
+  result = remote({"load", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(parse(result.out).at("objects").get<std::size_t>(), objects);
+
+  result = remote({"clear-box", "-10", "-10", "-10", "10", "10", "10", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_GT(parse(result.out).at("voxels_changed").get<std::size_t>(), 0u);
+
+  result = remote({"clear-box", "1", "1", "1", "0", "0", "0"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("INVALID_ARGUMENT"), std::string::npos) << result.err;
+}
+
+TEST_F(CliTest, WatchPrintsEventsUntilInterrupted) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, ""));
+  auto watch = ChildProcess::start(
+      {cli_binary().string(), "watch", "--json", "--port", std::to_string(daemon_.port())}, tmp_ / "watch.stderr");
+  ASSERT_TRUE(watch.has_value());
+  // The watcher may subscribe after a frame; repeat the scene from scratch until it reports.
+  std::optional<std::string> line;
+  for (int attempt = 0; attempt < 20 && !line; ++attempt) {
+    ASSERT_EQ(remote({"reset"}).exit_code, 0);
+    ASSERT_EQ(remote({"ingest", (data_dir() / kMug).string()}).exit_code, 0);
+    line = watch->read_line(2.0);
+  }
+  ASSERT_TRUE(line.has_value()) << watch->stderr_text();
+  const json event = parse(*line);
+  EXPECT_EQ(event.at("kind"), "OBJECT_APPEARED");
+  EXPECT_FALSE(event.at("object_id").is_null());
+  watch->signal(SIGINT);
+  EXPECT_EQ(watch->wait(kStartTimeoutS), std::optional<int>(0)) << watch->stderr_text();
+}
+
+}  // namespace
+}  // namespace scenewatch::test

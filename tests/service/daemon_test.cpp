@@ -1,0 +1,344 @@
+// Integration: the real scenewatchd binary on a loopback port, driven through the protocol.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "daemon_harness.h"
+#include "scenewatch.pb.h"
+#include "scenewatch/io/sequence.h"
+#include "scenewatch/service/frame_parser.h"
+
+namespace scenewatch::test {
+namespace {
+namespace fs = std::filesystem;
+using service::Client;
+
+const char* const kMug = "pcl/table_scene_mug_stereo_textured.pcd";
+
+proto::Request health() {
+  return request([](proto::Request& r) { r.mutable_health(); });
+}
+proto::Request get_objects() {
+  return request([](proto::Request& r) { r.mutable_get_objects(); });
+}
+proto::Request get_planes() {
+  return request([](proto::Request& r) { r.mutable_get_planes(); });
+}
+proto::Request ingest_file(const fs::path& path) {
+  return request([&](proto::Request& r) { r.mutable_ingest_file()->set_path(path.string()); });
+}
+
+class DaemonTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    tmp_ = make_temp_dir("daemon");
+    data_root_ = tmp_ / "data";
+    model_dir_ = tmp_ / "model";
+    fs::create_directories(data_root_);
+  }
+
+  void TearDown() override {
+    if (HasFailure()) std::cerr << "---- scenewatchd log ----\n" << daemon_.log() << "-------------------------\n";
+    daemon_ = Daemon();  // kills the process if it still runs
+    std::error_code ec;
+    fs::remove_all(tmp_, ec);
+  }
+
+  /// Server section with the test's data roots and model directory.
+  std::string server_yaml(const std::string& extra = "") const {
+    std::string roots = "[" + data_root_.string();
+    if (fs::exists(data_dir() / "pcl")) roots += ", " + (data_dir() / "pcl").string();
+    roots += "]";
+    return "  data_roots: " + roots + "\n  model_dir: " + model_dir_.string() + "\n" + extra;
+  }
+
+  proto::Request ingest_mug() const {
+    auto frame = io::load_cloud_frame(data_dir() / kMug);
+    EXPECT_TRUE(frame.ok()) << frame.error().message;
+    proto::Request r;
+    if (frame.ok()) *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+    return r;
+  }
+
+  fs::path tmp_, data_root_, model_dir_;
+  Daemon daemon_;
+};
+
+TEST_F(DaemonTest, IngestQuerySubscribeAndPersistAcrossRestarts) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+
+  Client subscriber = daemon_.connect();
+  const auto subscribed = call(subscriber, request([](proto::Request& r) { r.mutable_subscribe(); }));
+  ASSERT_EQ(subscribed.status().code(), proto::Status::OK) << subscribed.status().message();
+
+  Client client = daemon_.connect();
+  const auto alive = call(client, health());
+  ASSERT_EQ(alive.status().code(), proto::Status::OK);
+  EXPECT_EQ(alive.health().frames_processed(), 0u);
+
+  const auto ingested = call(client, ingest_mug());
+  ASSERT_EQ(ingested.status().code(), proto::Status::OK) << ingested.status().message();
+  EXPECT_GE(ingested.ingest().planes_size(), 1);
+  EXPECT_GE(ingested.ingest().clusters_size(), 1);
+
+  // The subscriber hears about the new object.
+  auto event = subscriber.next_event(kCallTimeoutS);
+  ASSERT_TRUE(event.ok()) << event.error().message;
+  EXPECT_EQ(event->kind(), proto::Event::OBJECT_APPEARED);
+  EXPECT_EQ(event->level(), proto::Event::MISMATCH);
+  EXPECT_TRUE(event->has_object_id());
+  EXPECT_GT(event->id(), subscribed.subscribe().last_event_id());
+
+  // The same scene read by the daemon itself, from an allowed root.
+  const auto by_file = call(client, ingest_file(fs::absolute(data_dir() / kMug)));
+  ASSERT_EQ(by_file.status().code(), proto::Status::OK) << by_file.status().message();
+  EXPECT_GE(by_file.ingest().planes_size(), 1);
+
+  // Outside the roots, even through "..": refused without reading.
+  for (const fs::path& outside : {fs::path("/etc/passwd"), data_root_ / ".." / ".." / "etc" / "passwd"}) {
+    const auto denied = call(client, ingest_file(outside));
+    EXPECT_EQ(denied.status().code(), proto::Status::PERMISSION_DENIED) << outside;
+    EXPECT_NE(denied.status().message().find("outside the data roots"), std::string::npos)
+        << denied.status().message();
+  }
+
+  const auto planes = call(client, get_planes());
+  ASSERT_EQ(planes.status().code(), proto::Status::OK);
+  EXPECT_GE(planes.planes().planes_size(), 1);
+  const auto objects = call(client, get_objects());
+  ASSERT_EQ(objects.status().code(), proto::Status::OK);
+  ASSERT_GE(objects.objects().objects_size(), 1);
+  EXPECT_EQ(objects.objects().frames_processed(), 2u);
+
+  const auto stats = call(client, request([](proto::Request& r) { r.mutable_stats(); }));
+  EXPECT_EQ(stats.stats().frames_processed(), 2u);
+  EXPECT_GE(stats.stats().connections(), 2u);
+
+  // SIGTERM saves the model; a new daemon on the same model directory finds it again.
+  ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
+  EXPECT_NE(daemon_.log().find("saved the model"), std::string::npos) << daemon_.log();
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+  Client again = daemon_.connect();
+  const auto restored = call(again, get_objects());
+  ASSERT_EQ(restored.status().code(), proto::Status::OK);
+  ASSERT_EQ(restored.objects().objects_size(), objects.objects().objects_size());
+  for (int i = 0; i < objects.objects().objects_size(); ++i) {
+    EXPECT_EQ(restored.objects().objects(i).id(), objects.objects().objects(i).id());
+    EXPECT_EQ(restored.objects().objects(i).point_count(), objects.objects().objects(i).point_count());
+    EXPECT_NEAR(restored.objects().objects(i).centroid().x(), objects.objects().objects(i).centroid().x(), 1e-9);
+  }
+  const auto restored_planes = call(again, get_planes());
+  EXPECT_EQ(restored_planes.planes().planes_size(), planes.planes().planes_size());
+  EXPECT_EQ(restored_planes.planes().frames_processed(), 2u);
+}
+
+TEST_F(DaemonTest, BadClientsNeitherChangeTheModelNorStopTheDaemon) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml("  read_timeout_s: 0.3\n")));
+  Client setup = daemon_.connect();
+  ASSERT_EQ(call(setup, ingest_mug()).status().code(), proto::Status::OK);
+  const auto baseline = call(setup, get_objects());
+  ASSERT_GE(baseline.objects().objects_size(), 1);
+  const std::string baseline_bytes = baseline.objects().SerializeAsString();
+
+  // After each bad client: a fresh client is served and sees the very same objects.
+  auto expect_unchanged = [&](const std::string& what) {
+    SCOPED_TRACE(what);
+    ASSERT_TRUE(daemon_.running()) << daemon_.log();
+    Client probe = daemon_.connect();
+    EXPECT_EQ(call(probe, health()).status().code(), proto::Status::OK);
+    const auto objects = call(probe, get_objects());
+    EXPECT_EQ(objects.objects().SerializeAsString(), baseline_bytes);
+  };
+  // The server closed the connection after its error reply.
+  auto expect_closed = [](Client& client) {
+    auto next = client.receive(kCallTimeoutS);
+    ASSERT_FALSE(next.ok());
+    EXPECT_NE(next.error().message.find("closed"), std::string::npos) << next.error().message;
+  };
+
+  {  // A truncated PCD read by the server: the error names the file and the problem.
+    std::ifstream in(data_dir() / kMug, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::ofstream(data_root_ / "truncated.pcd", std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+    Client client = daemon_.connect();
+    const auto response = call(client, ingest_file(data_root_ / "truncated.pcd"));
+    EXPECT_EQ(response.status().code(), proto::Status::INVALID_ARGUMENT);
+    EXPECT_NE(response.status().message().find("truncated.pcd"), std::string::npos) << response.status().message();
+    EXPECT_NE(response.status().message().find("truncated"), std::string::npos) << response.status().message();
+    expect_unchanged("truncated PCD");
+  }
+  {  // Garbage inside a well-formed frame: an error reply, and the connection stays usable.
+    Client client = daemon_.connect();
+    ASSERT_TRUE(client.send_raw(service::encode_frame(std::string("\xff\xfe garbage \x01\x02", 13))).ok());
+    auto reply = client.receive(kCallTimeoutS);
+    ASSERT_TRUE(reply.ok()) << reply.error().message;
+    EXPECT_EQ(reply->id(), 0u);
+    EXPECT_EQ(reply->status().code(), proto::Status::INVALID_ARGUMENT);
+    EXPECT_EQ(call(client, health()).status().code(), proto::Status::OK);
+    expect_unchanged("garbage payload");
+  }
+  {  // Bad clouds and poses over the wire.
+    Client client = daemon_.connect();
+    proto::Request bad_size = ingest_mug();
+    bad_size.mutable_ingest_frame()->mutable_cloud()->mutable_xyz()->resize(1000);
+    auto response = call(client, bad_size);
+    EXPECT_EQ(response.status().code(), proto::Status::INVALID_ARGUMENT);
+    EXPECT_NE(response.status().message().find("cloud.xyz"), std::string::npos) << response.status().message();
+    proto::Request nan_pose = ingest_mug();
+    auto* pose = nan_pose.mutable_ingest_frame()->mutable_pose();
+    for (int i = 0; i < 16; ++i) pose->add_matrix(i % 5 == 0 ? 1.0 : 0.0);
+    pose->set_matrix(3, std::nan(""));
+    response = call(client, nan_pose);
+    EXPECT_EQ(response.status().code(), proto::Status::INVALID_ARGUMENT);
+    EXPECT_NE(response.status().message().find("pose"), std::string::npos) << response.status().message();
+    expect_unchanged("bad cloud and pose");
+  }
+  {  // An empty call: UNKNOWN_REQUEST with the request's id; the connection stays open.
+    Client client = daemon_.connect();
+    proto::Request empty;
+    empty.set_id(77);
+    ASSERT_TRUE(client.send(empty).ok());
+    auto reply = client.receive(kCallTimeoutS);
+    ASSERT_TRUE(reply.ok()) << reply.error().message;
+    EXPECT_EQ(reply->id(), 77u);
+    EXPECT_EQ(reply->status().code(), proto::Status::UNKNOWN_REQUEST);
+    EXPECT_EQ(call(client, health()).status().code(), proto::Status::OK);
+    expect_unchanged("unknown request");
+  }
+  {  // A length prefix above the maximum: an error naming both numbers, then the server closes.
+    Client client = daemon_.connect();
+    ASSERT_TRUE(client.send_raw(std::string("\x7f\xff\xff\xff", 4)).ok());
+    auto reply = client.receive(kCallTimeoutS);
+    ASSERT_TRUE(reply.ok()) << reply.error().message;
+    EXPECT_EQ(reply->status().code(), proto::Status::INVALID_ARGUMENT);
+    EXPECT_NE(reply->status().message().find("2147483647"), std::string::npos) << reply->status().message();
+    EXPECT_NE(reply->status().message().find("67108864"), std::string::npos) << reply->status().message();
+    expect_closed(client);
+    expect_unchanged("oversized length");
+  }
+  {  // Bytes that are not our protocol at all (their first 4 bytes read as a huge length).
+    Client client = daemon_.connect();
+    ASSERT_TRUE(client.send_raw("GET / HTTP/1.1\r\nHost: localhost\r\n\r\n").ok());
+    auto reply = client.receive(kCallTimeoutS);
+    ASSERT_TRUE(reply.ok()) << reply.error().message;
+    EXPECT_EQ(reply->status().code(), proto::Status::INVALID_ARGUMENT);
+    expect_closed(client);
+    expect_unchanged("raw garbage");
+  }
+  {  // A zero length.
+    Client client = daemon_.connect();
+    ASSERT_TRUE(client.send_raw(std::string(4, '\0')).ok());
+    auto reply = client.receive(kCallTimeoutS);
+    ASSERT_TRUE(reply.ok()) << reply.error().message;
+    EXPECT_EQ(reply->status().code(), proto::Status::INVALID_ARGUMENT);
+    expect_closed(client);
+    expect_unchanged("zero length");
+  }
+  {  // A client that disconnects in the middle of a frame.
+    Client client = daemon_.connect();
+    ASSERT_TRUE(client.send_raw(std::string("\x00\x00\x03\xe8", 4) + std::string(10, 'x')).ok());
+    client.close();
+    expect_unchanged("disconnect mid-frame");
+  }
+  {  // A client that stalls in the middle of a frame: the read timeout closes it.
+    Client client = daemon_.connect();
+    ASSERT_TRUE(client.send_raw(std::string("\x00\x00\x03\xe8", 4) + std::string(10, 'x')).ok());
+    auto reply = client.receive(kCallTimeoutS);
+    ASSERT_TRUE(reply.ok()) << reply.error().message;
+    EXPECT_EQ(reply->status().code(), proto::Status::UNAVAILABLE);
+    EXPECT_NE(reply->status().message().find("read timeout"), std::string::npos) << reply->status().message();
+    expect_closed(client);
+    expect_unchanged("stalled mid-frame");
+  }
+  EXPECT_TRUE(daemon_.running());
+  EXPECT_EQ(daemon_.terminate(), std::optional<int>(0));
+  const std::string log = daemon_.log();
+  EXPECT_NE(log.find("connected"), std::string::npos);
+  EXPECT_NE(log.find("read timeout"), std::string::npos);
+}
+
+TEST_F(DaemonTest, ManyClientsAreServedWhileFramesAreProcessed) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+  const proto::Request mug = ingest_mug();
+  std::atomic<int> failures{0};
+  std::thread ingester([&] {
+    auto client = Client::connect("127.0.0.1", daemon_.port(), 10.0);
+    if (!client.ok()) {
+      ++failures;
+      return;
+    }
+    for (int i = 0; i < 3; ++i) {
+      auto r = client->call(mug, kCallTimeoutS);
+      if (!r.ok() || r->status().code() != proto::Status::OK) ++failures;
+    }
+  });
+  std::vector<std::thread> readers;
+  for (int t = 0; t < 8; ++t) {
+    readers.emplace_back([&] {
+      auto client = Client::connect("127.0.0.1", daemon_.port(), 10.0);
+      if (!client.ok()) {
+        ++failures;
+        return;
+      }
+      for (int i = 0; i < 20; ++i) {
+        for (const auto& req : {health(), get_objects(), get_planes()}) {
+          auto r = client->call(req, kCallTimeoutS);
+          if (!r.ok() || r->status().code() != proto::Status::OK) ++failures;
+        }
+      }
+    });
+  }
+  ingester.join();
+  for (auto& t : readers) t.join();
+  EXPECT_EQ(failures.load(), 0);
+  Client client = daemon_.connect();
+  EXPECT_EQ(call(client, health()).health().frames_processed(), 3u);
+}
+
+TEST_F(DaemonTest, ConnectionsBeyondTheLimitAreTurnedAway) {
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml("  max_connections: 2\n")));
+  Client first = daemon_.connect();
+  Client second = daemon_.connect();
+  ASSERT_EQ(call(first, health()).status().code(), proto::Status::OK);
+  ASSERT_EQ(call(second, health()).status().code(), proto::Status::OK);
+  Client third = daemon_.connect();
+  auto reply = third.receive(kCallTimeoutS);
+  ASSERT_TRUE(reply.ok()) << reply.error().message;
+  EXPECT_EQ(reply->status().code(), proto::Status::UNAVAILABLE);
+  EXPECT_NE(reply->status().message().find("too many connections"), std::string::npos);
+  first.close();
+  third.close();
+  // Once a slot is free, new clients are served again (the server notices the close shortly).
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    Client retry = daemon_.connect();
+    auto r = retry.call(health(), kCallTimeoutS);
+    if (r.ok() && r->status().code() == proto::Status::OK) return;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ADD_FAILURE() << "no slot became free after a client left";
+}
+
+TEST_F(DaemonTest, StartsEmptyWithoutAModelAndRefusesABadConfig) {
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+  Client client = daemon_.connect();
+  EXPECT_EQ(call(client, get_objects()).objects().objects_size(), 0);
+  EXPECT_NE(daemon_.log().find("starting empty"), std::string::npos) << daemon_.log();
+  ASSERT_EQ(daemon_.terminate(), std::optional<int>(0));
+
+  const fs::path bad = tmp_ / "bad.yaml";
+  std::ofstream(bad) << "server:\n  prot: 7878\n";
+  const auto result = run_command({daemon_binary().string(), "--config", bad.string()}, tmp_);
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("server.prot"), std::string::npos) << result.err;
+  EXPECT_EQ(run_command({daemon_binary().string(), "--help"}, tmp_).exit_code, 0);
+  EXPECT_EQ(run_command({daemon_binary().string(), "--port", "x"}, tmp_).exit_code, 2);
+}
+
+}  // namespace
+}  // namespace scenewatch::test

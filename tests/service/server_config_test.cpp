@@ -1,0 +1,88 @@
+#include "scenewatch/service/daemon_config.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "test_data.h"
+
+namespace scenewatch::service {
+namespace {
+namespace fs = std::filesystem;
+
+class ServerConfigTest : public ::testing::Test {
+ protected:
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(tmp_, ec);
+  }
+  fs::path write(const std::string& text) {
+    const fs::path path = tmp_ / "scenewatchd.yaml";
+    std::ofstream(path) << text;
+    return path;
+  }
+  fs::path tmp_ = test::make_temp_dir("config");
+};
+
+TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
+  auto loaded = load_daemon_config(test::source_dir() / "config" / "scenewatchd.yaml");
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  const ServerConfig defaults;
+  const ServerConfig& s = loaded->server;
+  EXPECT_EQ(s.address, defaults.address);
+  EXPECT_EQ(s.port, kDefaultPort);
+  EXPECT_EQ(s.max_message_bytes, defaults.max_message_bytes);
+  EXPECT_DOUBLE_EQ(s.read_timeout_s, defaults.read_timeout_s);
+  EXPECT_EQ(s.max_queued_bytes, defaults.max_queued_bytes);
+  EXPECT_EQ(s.max_connections, defaults.max_connections);
+  EXPECT_EQ(s.io_threads, defaults.io_threads);
+  EXPECT_TRUE(s.data_roots.empty());
+  EXPECT_TRUE(s.model_dir.empty());
+  const pipeline::Config pipeline_defaults;
+  EXPECT_DOUBLE_EQ(loaded->pipeline.background.resolution_m, pipeline_defaults.background.resolution_m);
+  EXPECT_DOUBLE_EQ(loaded->pipeline.segmentation.voxel_size_m, pipeline_defaults.segmentation.voxel_size_m);
+  EXPECT_EQ(loaded->pipeline.segmentation.min_cluster_points, pipeline_defaults.segmentation.min_cluster_points);
+  EXPECT_EQ(loaded->pipeline.max_event_log, pipeline_defaults.max_event_log);
+}
+
+TEST_F(ServerConfigTest, RelativePathsAreRelativeToTheConfigFile) {
+  fs::create_directories(tmp_ / "data");
+  auto loaded = load_daemon_config(write("server:\n  data_roots: [data]\n  model_dir: state/model\n  port: 0\n"));
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  ASSERT_EQ(loaded->server.data_roots.size(), 1u);
+  EXPECT_EQ(loaded->server.data_roots[0], tmp_ / "data");
+  EXPECT_EQ(loaded->server.model_dir, tmp_ / "state" / "model");
+  EXPECT_EQ(loaded->server.port, 0);
+}
+
+TEST_F(ServerConfigTest, ErrorsNameTheKey) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"server:\n  bogus: 1\n", "server.bogus"},
+      {"server:\n  port: 70000\n", "server.port"},
+      {"server:\n  port: -1\n", "server.port"},
+      {"server:\n  port: seven\n", "server.port"},
+      {"server:\n  read_timeout_s: 0\n", "server.read_timeout_s"},
+      {"server:\n  max_message_bytes: 10\n", "server.max_message_bytes"},
+      {"server:\n  max_queued_bytes: 100\n", "server.max_queued_bytes"},
+      {"server:\n  io_threads: 0\n", "server.io_threads"},
+      {"server:\n  data_roots: [does-not-exist]\n", "server.data_roots[0]"},
+      {"server: 5\n", "server"},
+      {"segmentation:\n  voxel_size_m: -1\n", "segmentation.voxel_size_m"},
+      {"bogus_section:\n  a: 1\n", "bogus_section"},
+  };
+  for (const auto& [text, key] : cases) {
+    auto loaded = load_daemon_config(write(text));
+    ASSERT_FALSE(loaded.ok()) << text;
+    EXPECT_NE(loaded.error().message.find(key), std::string::npos) << text << " -> " << loaded.error().message;
+  }
+}
+
+TEST_F(ServerConfigTest, MissingFileIsNotFound) {
+  auto loaded = load_daemon_config(tmp_ / "nope.yaml");
+  ASSERT_FALSE(loaded.ok());
+  EXPECT_EQ(loaded.error().code, ErrorCode::kNotFound);
+  EXPECT_NE(loaded.error().message.find("nope.yaml"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace scenewatch::service
