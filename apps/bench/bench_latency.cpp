@@ -1,12 +1,135 @@
-// Request latency of GetObjects over loopback against a running scenewatchd (filled in once the
-// service client is available; prints a note otherwise).
+// Request latency over loopback against the real scenewatchd, started as a user starts it:
+// GetObjects (the scene snapshot, serialised) next to Health (the transport's floor), after a
+// real Kinect frame has been ingested so that there are objects to return.
 #include "bench.h"
 
-namespace scenewatch::bench {
+#ifdef SCENEWATCH_BENCH_HAS_SERVICE
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
-int run_latency(const Options&) {
-  std::printf("\n== GetObjects latency: the service module is not built; skipped\n");
+#include <cstdlib>
+#include <string>
+
+#include "scenewatch/io/sequence.h"
+#include "scenewatch/service/client.h"
+
+namespace scenewatch::bench {
+namespace {
+
+// scenewatchd on a free port; stops it (SIGTERM) when destroyed.
+class Daemon {
+ public:
+  bool start(const std::filesystem::path& model_dir) {
+    const std::string binary = std::string(SCENEWATCH_BINARY_DIR) + "/apps/scenewatchd/scenewatchd";
+    const std::string config = std::string(SCENEWATCH_SOURCE_DIR) + "/config/scenewatchd.yaml";
+    int out[2];
+    if (::pipe(out) != 0) return false;
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      ::dup2(out[1], STDOUT_FILENO);
+      ::close(out[0]);
+      const std::string dir = model_dir.string();
+      ::execl(binary.c_str(), binary.c_str(), "--config", config.c_str(), "--port", "0", "--model-dir", dir.c_str(),
+              static_cast<char*>(nullptr));
+      std::_Exit(127);
+    }
+    ::close(out[1]);
+    std::string line;
+    char c;
+    pollfd p{out[0], POLLIN, 0};
+    while (::poll(&p, 1, 20000) > 0 && ::read(out[0], &c, 1) == 1) {
+      if (c == '\n') break;
+      line += c;
+    }
+    ::close(out[0]);
+    const std::string prefix = "listening on 127.0.0.1:";
+    if (line.rfind(prefix, 0) != 0) return false;
+    port_ = static_cast<std::uint16_t>(std::stoi(line.substr(prefix.size())));
+    return true;
+  }
+  ~Daemon() {
+    if (pid_ > 0) {
+      ::kill(pid_, SIGTERM);
+      ::waitpid(pid_, nullptr, 0);
+    }
+  }
+  std::uint16_t port() const { return port_; }
+
+ private:
+  pid_t pid_ = -1;
+  std::uint16_t port_ = 0;
+};
+
+}  // namespace
+
+int run_latency(const Options& o) {
+  const auto model_dir = std::filesystem::temp_directory_path() / ("scenewatch-bench-" + std::to_string(::getpid()));
+  Daemon daemon;
+  if (!daemon.start(model_dir)) {
+    std::fprintf(stderr, "latency: could not start scenewatchd (build it first: scripts/build --target scenewatchd)\n");
+    return 1;
+  }
+  auto client = service::Client::connect("127.0.0.1", daemon.port());
+  if (!client) {
+    std::fprintf(stderr, "latency: %s\n", client.error().message.c_str());
+    return 1;
+  }
+  auto frame = io::load_cloud_frame(o.data_dir / "mosd/learn/learn13.pcd");
+  if (!frame) {
+    std::fprintf(stderr, "latency: %s\n", frame.error().message.c_str());
+    return 1;
+  }
+  proto::Request ingest;
+  *ingest.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+  auto ingested = client->call(ingest, 60);
+  if (!ingested || !service::status_of(*ingested).ok()) {
+    std::fprintf(stderr, "latency: ingest failed\n");
+    return 1;
+  }
+  constexpr int kCalls = 3000;
+  auto measure = [&](const proto::Request& request, std::vector<double>& us) {
+    for (int i = 0; i < kCalls + 100; ++i) {
+      const auto t0 = std::chrono::steady_clock::now();
+      auto r = client->call(request, 10);
+      const double t = std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count();
+      if (!r) return false;
+      if (i >= 100) us.push_back(t);  // the first 100 warm up
+    }
+    return true;
+  };
+  proto::Request health, objects;
+  health.mutable_health();
+  objects.mutable_get_objects();
+  std::vector<double> health_us, objects_us;
+  if (!measure(health, health_us) || !measure(objects, objects_us)) {
+    std::fprintf(stderr, "latency: a request failed\n");
+    return 1;
+  }
+  auto reply = client->call(objects, 10);
+  const int n_objects = reply ? reply->objects().objects_size() : -1;
+  std::printf("\n== Request latency over loopback: one client, %d sequential calls each, scene of mOSD learn13 (%d objects)\n",
+              kCalls, n_objects);
+  std::printf("%-34s %10s %10s %10s %10s\n", "request", "p50 us", "p99 us", "max us", "p50 ratio");
+  std::printf("%-34s %10.1f %10.1f %10.1f %10s\n", "Health (transport floor)", quantile(health_us, 0.5), quantile(health_us, 0.99),
+              quantile(health_us, 1.0), "1.00");
+  std::printf("%-34s %10.1f %10.1f %10.1f %9.2fx\n", "GetObjects", quantile(objects_us, 0.5), quantile(objects_us, 0.99),
+              quantile(objects_us, 1.0), quantile(objects_us, 0.5) / quantile(health_us, 0.5));
+  std::error_code ec;
+  std::filesystem::remove_all(model_dir, ec);
   return 0;
 }
 
 }  // namespace scenewatch::bench
+
+#else
+
+namespace scenewatch::bench {
+int run_latency(const Options&) {
+  std::printf("\n== Request latency: built without the service module; skipped\n");
+  return 0;
+}
+}  // namespace scenewatch::bench
+
+#endif
