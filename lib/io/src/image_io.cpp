@@ -81,6 +81,14 @@ Status check_buffer(const fs::path& path, const Image& image, const std::vector<
   return {};
 }
 
+// Copies a continuous or padded single-channel 16-bit Mat into a row-major buffer.
+void copy_rows(const cv::Mat& m, std::vector<std::uint16_t>& out) {
+  out.resize(m.total());
+  for (int r = 0; r < m.rows; ++r) {
+    std::memcpy(out.data() + static_cast<std::size_t>(r) * m.cols, m.ptr(r), m.cols * sizeof(std::uint16_t));
+  }
+}
+
 }  // namespace
 
 Result<ColorImage> read_color_png(const fs::path& path) {
@@ -112,10 +120,7 @@ Result<DepthImage> read_depth_png(const fs::path& path) {
   DepthImage out;
   out.width = m->cols;
   out.height = m->rows;
-  out.depth_mm.resize(m->total());
-  for (int r = 0; r < m->rows; ++r) {
-    std::memcpy(out.depth_mm.data() + static_cast<std::size_t>(r) * m->cols, m->ptr(r), m->cols * 2);
-  }
+  copy_rows(*m, out.depth_mm);
   return out;
 }
 
@@ -125,10 +130,7 @@ Result<LabelImage> read_label_png(const fs::path& path) {
   LabelImage out;
   out.width = m->cols;
   out.height = m->rows;
-  out.labels.resize(m->total());
-  for (int r = 0; r < m->rows; ++r) {
-    std::memcpy(out.labels.data() + static_cast<std::size_t>(r) * m->cols, m->ptr(r), m->cols * 2);
-  }
+  copy_rows(*m, out.labels);
   return out;
 }
 

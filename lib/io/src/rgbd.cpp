@@ -1,5 +1,6 @@
 // RGB-D back-projection and the small text formats: intrinsics, 4x4 poses, TUM trajectories.
 #include <cmath>
+#include <functional>
 #include <fstream>
 #include <iomanip>
 #include <limits>
@@ -14,18 +15,27 @@ namespace {
 
 std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
 
-// Reads every whitespace-separated number of a small text file; '#' starts a comment.
-Result<std::vector<double>> read_numbers(const fs::path& path) {
+// Calls f(line_no, line) for every line of a text file with '#' comments cut off; stops at the
+// first error f returns.
+Status for_each_line(const fs::path& path, const std::function<Status(int, const std::string&)>& f) {
   std::error_code ec;
   if (!fs::exists(path, ec)) return not_found(quoted(path) + ": no such file");
   std::ifstream in(path);
   if (!in) return io_error(quoted(path) + ": cannot open for reading");
-  std::vector<double> values;
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {
     ++line_no;
     if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+    if (auto st = f(line_no, line); !st) return st;
+  }
+  return {};
+}
+
+// Reads every whitespace-separated number of a small text file.
+Result<std::vector<double>> read_numbers(const fs::path& path) {
+  std::vector<double> values;
+  auto st = for_each_line(path, [&](int line_no, const std::string& line) -> Status {
     std::istringstream ls(line);
     std::string token;
     while (ls >> token) {
@@ -36,7 +46,9 @@ Result<std::vector<double>> read_numbers(const fs::path& path) {
       }
       values.push_back(v);
     }
-  }
+    return {};
+  });
+  if (!st) return st.error();
   return values;
 }
 
@@ -148,17 +160,9 @@ Status write_pose_matrix(const fs::path& path, const Pose& T_world_camera) {
 }
 
 Result<std::vector<StampedPose>> read_tum(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return not_found(quoted(path) + ": no such file");
-  std::ifstream in(path);
-  if (!in) return io_error(quoted(path) + ": cannot open for reading");
   std::vector<StampedPose> poses;
-  std::string line;
-  int line_no = 0;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-    if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
+  auto st = for_each_line(path, [&](int line_no, const std::string& line) -> Status {
+    if (line.find_first_not_of(" \t\r") == std::string::npos) return {};
     std::istringstream ls(line);
     double v[8];
     int n = 0;
@@ -179,7 +183,9 @@ Result<std::vector<StampedPose>> read_tum(const fs::path& path) {
     sp.T_world_camera.linear() = q.normalized().toRotationMatrix();
     sp.T_world_camera.translation() = Eigen::Vector3d(v[1], v[2], v[3]);
     poses.push_back(sp);
-  }
+    return {};
+  });
+  if (!st) return st.error();
   if (poses.empty()) return invalid_argument(quoted(path) + ": no poses");
   return poses;
 }
