@@ -347,19 +347,20 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     plane.area_m2 = area;
     const Eigen::Vector3d origin_on_plane = -model.d * model.n;
     for (const Vec2& h : frame.hull2d) plane.hull.push_back(origin_on_plane + h.x() * frame.u + h.y() * frame.v);
+    for (int v : part) in_plane[v] = static_cast<char>(1 + out.planes.size());
+    // One pass over the points in index order: the inlier list comes out sorted.
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (int v : part) {
-      in_plane[v] = 1;
-      for (const int* it = grid.members_begin(v); it != grid.members_end(v); ++it) {
-        const Eigen::Vector3f q = cloud[*it].getVector3fMap();
-        const double h = model.distance(q);
-        if (std::abs(h) < cfg.plane_distance_m && h < cfg.min_object_height_m) {
-          plane.indices.push_back(*it);
-          sum += q.cast<double>();
-        }
+    const char mark = static_cast<char>(1 + out.planes.size());
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const int v = grid.point_voxel[i];
+      if (v < 0 || in_plane[v] != mark) continue;
+      const Eigen::Vector3f q = cloud[i].getVector3fMap();
+      const double h = model.distance(q);
+      if (std::abs(h) < cfg.plane_distance_m && h < cfg.min_object_height_m) {
+        plane.indices.push_back(static_cast<int>(i));
+        sum += q.cast<double>();
       }
     }
-    std::sort(plane.indices.begin(), plane.indices.end());
     plane.inlier_count = plane.indices.size();
     plane.centroid = plane.inlier_count > 0 ? Eigen::Vector3d(sum / static_cast<double>(plane.inlier_count)) : origin_on_plane;
     out.planes.push_back(std::move(plane));
@@ -420,30 +421,34 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     groups[group_of[root]].push_back(object_voxels[i]);
   }
 
-  for (const auto& voxels : groups) {
-    const int p = owner[voxels.front()];
-    const PlaneModel& model = frames[p].model;
-    ObjectCluster obj;
-    obj.plane_id = p;
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    Eigen::Vector3d rgb = Eigen::Vector3d::Zero();
-    for (int v : voxels) {
-      for (const int* it = grid.members_begin(v); it != grid.members_end(v); ++it) {
-        const PointT& q = cloud[*it];
-        const double h = model.distance(q.getVector3fMap());
-        if (h < cfg.min_object_height_m || h > cfg.max_object_height_m) continue;
-        obj.indices.push_back(*it);
-        sum += q.getVector3fMap().cast<double>();
-        rgb += Eigen::Vector3d(q.r, q.g, q.b);
-      }
-    }
+  // Points of each group, in one pass over the cloud in index order (lists come out sorted);
+  // only points at object height above their plane count.
+  std::vector<int> voxel_group(nvox, -1);
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (int v : groups[g]) voxel_group[v] = static_cast<int>(g);
+  std::vector<ObjectCluster> candidates(groups.size());
+  std::vector<Eigen::Vector3d> sums(groups.size(), Eigen::Vector3d::Zero()), rgbs(groups.size(), Eigen::Vector3d::Zero());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const int v = grid.point_voxel[i];
+    if (v < 0 || voxel_group[v] < 0) continue;
+    const int g = voxel_group[v];
+    const PointT& q = cloud[i];
+    const double h = frames[owner[v]].model.distance(q.getVector3fMap());
+    if (h < cfg.min_object_height_m || h > cfg.max_object_height_m) continue;
+    candidates[g].indices.push_back(static_cast<int>(i));
+    sums[g] += q.getVector3fMap().cast<double>();
+    rgbs[g] += Eigen::Vector3d(q.r, q.g, q.b);
+  }
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    ObjectCluster& obj = candidates[g];
     const int n = static_cast<int>(obj.indices.size());
     if (n < cfg.min_cluster_points || n > cfg.max_cluster_points) continue;
-    std::sort(obj.indices.begin(), obj.indices.end());
+    const int p = owner[groups[g].front()];
+    obj.plane_id = p;
     obj.point_count = obj.indices.size();
-    obj.centroid = sum / n;
-    obj.mean_rgb = (rgb / n).cast<float>();
-    obj.box = box_on_plane(cloud, obj.indices, model.n);
+    obj.centroid = sums[g] / n;
+    obj.mean_rgb = (rgbs[g] / n).cast<float>();
+    obj.box = box_on_plane(cloud, obj.indices, frames[p].model.n);
     out.objects.push_back(std::move(obj));
   }
   std::stable_sort(out.objects.begin(), out.objects.end(),

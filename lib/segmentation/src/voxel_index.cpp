@@ -9,18 +9,28 @@ VoxelIndex::VoxelIndex(const Cloud& cloud, double voxel_size_m) : size(voxel_siz
   point_voxel.assign(cloud.size(), -1);
   lookup.reserve(cloud.size() / 8 + 16);
   std::vector<Eigen::Vector3f> sums;
+  // Neighbouring points of an organized cloud mostly share a voxel: remember the last one and
+  // skip the hash lookup when the key repeats.
+  std::uint64_t last_key = ~std::uint64_t{0};
+  int last_voxel = -1;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const PointT& p = cloud.points[i];
     if (!is_valid(p)) continue;
     const int x = static_cast<int>(std::floor(p.x * inv));
     const int y = static_cast<int>(std::floor(p.y * inv));
     const int z = static_cast<int>(std::floor(p.z * inv));
-    auto [it, inserted] = lookup.try_emplace(pack(x, y, z), static_cast<int>(sums.size()));
-    const int v = it->second;
-    if (inserted) {
-      sums.emplace_back(Eigen::Vector3f::Zero());
-      coords.push_back({x, y, z});
-      member_offsets.push_back(0);
+    const std::uint64_t key = pack(x, y, z);
+    int v = last_voxel;
+    if (key != last_key) {
+      auto [it, inserted] = lookup.try_emplace(key, static_cast<int>(sums.size()));
+      v = it->second;
+      if (inserted) {
+        sums.emplace_back(Eigen::Vector3f::Zero());
+        coords.push_back({x, y, z});
+        member_offsets.push_back(0);
+      }
+      last_key = key;
+      last_voxel = v;
     }
     sums[v] += p.getVector3fMap();
     ++member_offsets[v];
