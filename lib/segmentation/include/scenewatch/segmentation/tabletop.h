@@ -33,8 +33,8 @@ struct Config {
 Status validate(const Config& config);
 
 struct Segmentation {
-  std::vector<Plane> planes;          ///< largest first
-  std::vector<ObjectCluster> objects; ///< largest first
+  std::vector<Plane> planes;          ///< in the order found: most voxel inliers first
+  std::vector<ObjectCluster> objects; ///< most points first
 };
 
 /// Segments one cloud (organized or not). The sensor is at sensor_origin in the cloud's frame;
