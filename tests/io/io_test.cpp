@@ -300,6 +300,8 @@ TEST_F(IoTest, RedkitchenSequence) {
   ASSERT_TRUE(seq.ok()) << seq.error().message;
   EXPECT_EQ(seq->frames.size(), 50u);
   EXPECT_EQ(seq->frames.front().name, "frame-000150");
+  EXPECT_EQ(seq->intrinsics.width, 640) << "image size from the first frame's PNG header";
+  EXPECT_EQ(seq->intrinsics.height, 480);
   ASSERT_TRUE(seq->frames.front().T_world_camera.has_value());
   auto frame = load_sequence_frame(*seq, 0);
   ASSERT_TRUE(frame.ok()) << frame.error().message;

@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cstring>
+#include <fstream>
 #include <system_error>
 
 #include "scenewatch/io/image_io.h"
@@ -132,6 +133,22 @@ Result<LabelImage> read_label_png(const fs::path& path) {
   out.height = m->rows;
   copy_rows(*m, out.labels);
   return out;
+}
+
+Result<std::pair<int, int>> read_png_size(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return not_found(quoted(path) + ": cannot open");
+  unsigned char head[24];
+  in.read(reinterpret_cast<char*>(head), sizeof(head));
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (!in || std::memcmp(head, kSignature, 8) != 0 || std::memcmp(head + 12, "IHDR", 4) != 0) {
+    return invalid_argument(quoted(path) + ": not a PNG file");
+  }
+  auto be32 = [&](int at) {
+    return static_cast<int>((std::uint32_t{head[at]} << 24) | (std::uint32_t{head[at + 1]} << 16) |
+                            (std::uint32_t{head[at + 2]} << 8) | head[at + 3]);
+  };
+  return std::make_pair(be32(16), be32(20));
 }
 
 Status write_color_png(const fs::path& path, const ColorImage& image) {

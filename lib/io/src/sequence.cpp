@@ -60,6 +60,11 @@ Result<Sequence> open_sequence(const fs::path& dir) {
     seq.frames.push_back(std::move(e));
   }
 
+  auto size = read_png_size(seq.frames.front().depth);
+  if (!size) return size.error();
+  seq.intrinsics.width = size->first;
+  seq.intrinsics.height = size->second;
+
   // Poses: per-frame 4x4 files (7-Scenes) take precedence over a trajectory file.
   const bool per_frame_poses = std::all_of(seq.frames.begin(), seq.frames.end(), [&](const SequenceEntry& e) {
     return fs::exists(dir / (e.name + ".pose.txt"), ec);

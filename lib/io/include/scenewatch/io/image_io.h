@@ -1,6 +1,7 @@
 #pragma once
 /// PNG images: 8-bit colour, 16-bit depth in millimetres, 16-bit labels.
 #include <filesystem>
+#include <utility>
 
 #include "scenewatch/core/image.h"
 #include "scenewatch/core/result.h"
@@ -13,6 +14,9 @@ Result<ColorImage> read_color_png(const std::filesystem::path& path);
 Result<DepthImage> read_depth_png(const std::filesystem::path& path);
 /// Reads a 16-bit (or 8-bit) single-channel label PNG.
 Result<LabelImage> read_label_png(const std::filesystem::path& path);
+
+/// Width and height of a PNG from its IHDR chunk, without decoding the image.
+Result<std::pair<int, int>> read_png_size(const std::filesystem::path& path);
 
 /// Writers; each checks the buffer size against width and height.
 Status write_color_png(const std::filesystem::path& path, const ColorImage& image);
