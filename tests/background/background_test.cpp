@@ -131,6 +131,23 @@ TEST(OccupancyMap, ClearBoxFreesKnownVoxelsOnly) {
   EXPECT_EQ(map.query({0.3, 0.3, 2.0}), Occupancy::kOccupied) << "outside the box nothing changes";
 }
 
+// A box far larger than the map: coarse free leaves inside it are set as they are (no expansion
+// to voxels), so this stays cheap; afterwards every known voxel in it is free.
+TEST(OccupancyMap, ClearingAHugeBoxIsBounded) {
+  OccupancyMap map(at(0.02));
+  map.insert(wall(), Pose::Identity());
+  const Aabb huge{{-50, -50, -50}, {50, 50, 50}};
+  const BoxOccupancy before = map.query_box(huge);
+  ASSERT_GT(before.occupied_voxels, 0u);
+  const std::size_t changed = map.clear_box(huge);
+  EXPECT_EQ(changed, before.occupied_voxels + before.free_voxels) << "every known voxel, counted once";
+  const BoxOccupancy after = map.query_box(huge);
+  EXPECT_EQ(after.occupied_voxels, 0u);
+  EXPECT_EQ(after.free_voxels, changed);
+  EXPECT_EQ(map.query({0, 0, 2.0}), Occupancy::kFree);
+  EXPECT_EQ(map.query({0, 0, 2.2}), Occupancy::kUnknown);
+}
+
 TEST(OccupancyMap, SaveLoadOtAndBt) {
   const fs::path dir = test::make_temp_dir("bg");
   OccupancyMap map(at(0.04));

@@ -220,6 +220,7 @@ TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
   ASSERT_EQ(snap->objects.size(), 1u) << "the cube was gone at the second save";
   EXPECT_EQ(snap->planes.size(), 1u);
   EXPECT_EQ(wm.stats().frames_processed, 2u);
+  EXPECT_DOUBLE_EQ(snap->last_stamp_s, 2.0) << "the last frame's stamp";
   EXPECT_EQ(wm.events_since(0).size(), 3u) << "2 appeared + 1 gone";
   EXPECT_EQ(wm.query_box({{-0.22, -0.18, 0.18}, {-0.18, -0.12, 0.22}}).state, background::Occupancy::kOccupied)
       << "the map came back: the tall box's top";

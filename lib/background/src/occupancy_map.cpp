@@ -313,17 +313,29 @@ std::size_t OccupancyMap::clear_box(const Aabb& box) {
   OcTreeKey lo, hi;
   if (!box.valid() || !key_range(tree, box, lo, hi)) return 0;
   const float free_log = tree.getClampingThresMinLog();
-  // Collect first: changing values while iterating would invalidate the iterator.
+  const double res = tree.getResolution();
+  std::size_t changed = 0;
+  // A leaf wholly inside the box is set as it is, however coarse; only leaves that straddle a face
+  // of the box are visited voxel by voxel, so memory stays bounded by the box's surface, not its
+  // volume. Keys are collected first: changing the tree while iterating would invalidate the
+  // iterator.
   std::vector<OcTreeKey> keys;
   for (auto it = tree.begin_leafs_bbx(lo, hi), end = tree.end_leafs_bbx(); it != end; ++it) {
     const octomap::point3d c = it.getCoordinate();
-    const double size = it.getSize(), res = tree.getResolution();
-    // Only the part of a coarse leaf inside the box is cleared: visit its finest keys.
+    const double size = it.getSize();
+    long first[3], last[3];
+    bool inside = true;
+    for (int i = 0; i < 3; ++i) {
+      first[i] = tree.coordToKey(c(i) - size / 2 + res / 2);
+      last[i] = tree.coordToKey(c(i) + size / 2 - res / 2);
+      inside = inside && first[i] >= lo[i] && last[i] <= hi[i];
+    }
+    if (inside) {
+      it->setLogOdds(free_log);
+      changed += static_cast<std::size_t>(last[0] - first[0] + 1) * (last[1] - first[1] + 1) * (last[2] - first[2] + 1);
+      continue;
+    }
     OcTreeKey k;
-    const long first[3] = {tree.coordToKey(c(0) - size / 2 + res / 2), tree.coordToKey(c(1) - size / 2 + res / 2),
-                           tree.coordToKey(c(2) - size / 2 + res / 2)};
-    const long last[3] = {tree.coordToKey(c(0) + size / 2 - res / 2), tree.coordToKey(c(1) + size / 2 - res / 2),
-                          tree.coordToKey(c(2) + size / 2 - res / 2)};
     for (long x = std::max<long>(first[0], lo[0]); x <= std::min<long>(last[0], hi[0]); ++x)
       for (long y = std::max<long>(first[1], lo[1]); y <= std::min<long>(last[1], hi[1]); ++y)
         for (long z = std::max<long>(first[2], lo[2]); z <= std::min<long>(last[2], hi[2]); ++z) {
@@ -335,7 +347,7 @@ std::size_t OccupancyMap::clear_box(const Aabb& box) {
   }
   for (const auto& k : keys) tree.setNodeValue(k, free_log, /*lazy_eval=*/true);
   refresh_inner(tree);
-  return keys.size();
+  return changed + keys.size();
 }
 
 void OccupancyMap::reset() {

@@ -82,6 +82,7 @@ struct WorkingMemory::Impl {
   std::uint64_t next_object_id = 1;
   std::uint64_t frames = 0, points = 0;
   double total_ms = 0, last_ms = 0;
+  double last_stamp_s = 0.0;
 
   std::shared_ptr<const SceneSnapshot> snapshot;  // read and written with std::atomic_load/store
 
@@ -97,7 +98,7 @@ struct WorkingMemory::Impl {
     s->frames_processed = frames;
     s->planes = planes;
     s->objects = objects;
-    s->last_stamp_s = objects.empty() ? 0.0 : objects.back().last_seen_s;
+    s->last_stamp_s = last_stamp_s;
     std::atomic_store(&snapshot, std::shared_ptr<const SceneSnapshot>(std::move(s)));
   }
 
@@ -271,6 +272,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   m.planes = result.planes;
   for (auto& p : m.planes) p.indices.clear();
   ++m.frames;
+  m.last_stamp_s = frame.stamp_s;
   m.points += result.insert_stats.points;
   result.total_ms = ms_since(t0);
   m.last_ms = result.total_ms;
@@ -330,6 +332,7 @@ void WorkingMemory::reset() {
   impl_->planes.clear();
   impl_->frames = impl_->points = 0;
   impl_->total_ms = impl_->last_ms = 0;
+  impl_->last_stamp_s = 0.0;
   impl_->publish();
 }
 
@@ -342,7 +345,8 @@ Status WorkingMemory::save(const fs::path& model_dir) const {
       if (auto st = m.map.save(dir / "background.ot"); !st) return st;
     }
     nlohmann::json scene = {{"format", "scenewatch-model"}, {"version", 1}, {"frames_processed", m.frames},
-                            {"points_processed", m.points}, {"next_object_id", m.next_object_id}};
+                            {"points_processed", m.points}, {"next_object_id", m.next_object_id},
+                            {"last_stamp_s", m.last_stamp_s}};
     scene["objects"] = nlohmann::json::array();
     for (const auto& o : m.objects) {
       nlohmann::json j = to_json(o);
@@ -385,7 +389,9 @@ Status WorkingMemory::load(const fs::path& model_dir) {
   std::vector<Plane> planes;
   std::deque<Event> events;
   std::uint64_t frames = 0, points = 0, next_object_id = 1, next_event_id = 1;
+  double last_stamp_s = 0.0;
   try {
+    last_stamp_s = scene.value("last_stamp_s", 0.0);
     frames = scene.at("frames_processed").get<std::uint64_t>();
     points = scene.value("points_processed", std::uint64_t{0});
     next_object_id = scene.at("next_object_id").get<std::uint64_t>();
@@ -430,6 +436,7 @@ Status WorkingMemory::load(const fs::path& model_dir) {
   m.planes = std::move(planes);
   m.frames = frames;
   m.points = points;
+  m.last_stamp_s = last_stamp_s;
   m.next_object_id = next_object_id;
   {
     std::lock_guard<std::mutex> events_lock(m.events_mutex);
