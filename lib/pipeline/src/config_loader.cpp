@@ -63,6 +63,7 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("max_normal_angle_deg", g.max_normal_angle_deg); },
                            [&] { return s.read("min_object_height_m", g.min_object_height_m); },
                            [&] { return s.read("max_object_height_m", g.max_object_height_m); },
+                           [&] { return s.read("height_noise_sigmas", g.height_noise_sigmas); },
                            [&] { return s.read("cluster_tolerance_m", g.cluster_tolerance_m); },
                            [&] { return s.read("min_cluster_points", g.min_cluster_points); },
                            [&] { return s.read("max_cluster_points", g.max_cluster_points); });
