@@ -156,6 +156,20 @@ TEST(Tabletop, UpVectorRejectsALargerWall) {
   EXPECT_EQ(constrained.objects.size(), 3u);
 }
 
+// A panel standing on the table but rising to 1 m (the foot of a wall, a cabinet's side) is part
+// of a taller structure, not an object on the table; the three objects stay.
+TEST(Tabletop, StructuresTallerThanObjectsAreNotObjects) {
+  Scene s = tabletop();
+  std::mt19937 rng(4);
+  for (float y = -0.3f; y <= 0.3f; y += 0.004f)
+    for (float z = 0.012f; z <= 1.0f; z += 0.004f) add_point(s, {0.45f, y, z}, 0, rng);
+  s.cloud.width = static_cast<std::uint32_t>(s.cloud.size());
+  const Segmentation seg = segment(s.cloud, upright(), Eigen::Vector3d(0, -1, 1.5));
+  ASSERT_EQ(seg.planes.size(), 1u);
+  EXPECT_EQ(seg.objects.size(), 3u);
+  for (const auto& o : seg.objects) EXPECT_LT(o.centroid.x(), 0.3) << "no cluster on the panel at x = 0.45";
+}
+
 TEST(Tabletop, NormalPointsTowardsTheSensor) {
   const Scene s = tabletop();
   const Segmentation below = segment(s.cloud, Config{}, Eigen::Vector3d(0, 0, -1));

@@ -413,18 +413,29 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
   UnionFind uf(object_voxels.size());
   const int reach = static_cast<int>(std::ceil(cfg.cluster_tolerance_m / cfg.voxel_size_m));
   const float tol2 = static_cast<float>(cfg.cluster_tolerance_m * cfg.cluster_tolerance_m);
+  // An object standing on a plane ends below max_object_height_m. A voxel that touches non-plane
+  // voxels higher than that above its own plane belongs to a larger structure (the foot of a
+  // wall, a cabinet) and takes its cluster out.
+  std::vector<char> attached(object_voxels.size(), 0);
   for (std::size_t i = 0; i < object_voxels.size(); ++i) {
     const int v = object_voxels[i];
     const auto& c = grid.coords[v];
     for (int dx = -reach; dx <= reach; ++dx)
       for (int dy = -reach; dy <= reach; ++dy)
         for (int dz = -reach; dz <= reach; ++dz) {
+          const int w = grid.find(c[0] + dx, c[1] + dy, c[2] + dz);
+          if (w < 0 || (centroids[w] - centroids[v]).squaredNorm() > tol2) continue;
+          if (local[w] < 0) {
+            if (!in_plane[w] && frames[owner[v]].model.distance(centroids[w]) > cfg.max_object_height_m) attached[i] = 1;
+            continue;
+          }
           // Each unordered pair once: only neighbours after this voxel in lexicographic order.
           if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) continue;
-          const int w = grid.find(c[0] + dx, c[1] + dy, c[2] + dz);
-          if (w < 0 || local[w] < 0 || owner[w] != owner[v]) continue;
-          if ((centroids[w] - centroids[v]).squaredNorm() <= tol2) uf.unite(static_cast<int>(i), local[w]);
+          if (owner[w] == owner[v]) uf.unite(static_cast<int>(i), local[w]);
         }
+  }
+  for (std::size_t i = 0; i < object_voxels.size(); ++i) {
+    if (attached[i]) attached[uf.find(static_cast<int>(i))] = 1;
   }
   std::vector<std::vector<int>> groups;
   std::vector<int> group_of(object_voxels.size(), -1);
@@ -440,8 +451,10 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
   // Points of each group, in one pass over the cloud in index order (lists come out sorted);
   // only points at object height above their plane count.
   std::vector<int> voxel_group(nvox, -1);
-  for (std::size_t g = 0; g < groups.size(); ++g)
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (attached[uf.find(local[groups[g].front()])]) continue;  // part of a taller structure
     for (int v : groups[g]) voxel_group[v] = static_cast<int>(g);
+  }
   std::vector<ObjectCluster> candidates(groups.size());
   std::vector<Eigen::Vector3d> sums(groups.size(), Eigen::Vector3d::Zero()), rgbs(groups.size(), Eigen::Vector3d::Zero());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
