@@ -17,6 +17,7 @@
 #include "bulk_update.h"
 #include "ray_set.h"
 #include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/core/hash.h"
 
 namespace scenewatch::background {
 namespace fs = std::filesystem;
@@ -33,15 +34,6 @@ OcTreeKey unpack(std::uint64_t v) {
                    static_cast<octomap::key_type>(v & 0xffff));
 }
 
-// Packed keys differ in low bits only; mix them so that power-of-two tables spread them.
-struct KeyHash {
-  std::size_t operator()(std::uint64_t x) const {
-    x ^= x >> 33;
-    x *= 0xff51afd7ed558ccdULL;
-    x ^= x >> 33;
-    return static_cast<std::size_t>(x);
-  }
-};
 
 struct ColorSum {
   std::uint32_t r = 0, g = 0, b = 0, n = 0;
@@ -68,7 +60,7 @@ struct OccupancyMap::Impl {
   BulkColorOcTree tree;
   // The last insert's endpoints (with their colour) and ray voxels, kept for
   // freed_by_last_insert(); scratch buffers reused between frames.
-  tsl::robin_map<std::uint64_t, ColorSum, KeyHash> endpoints;
+  tsl::robin_map<std::uint64_t, ColorSum, MixHash64> endpoints;
   RaySet rays;
   std::vector<std::uint64_t> clipped_ends, updates, scratch;
 };

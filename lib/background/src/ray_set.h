@@ -10,6 +10,8 @@
 #include <octomap/OcTreeKey.h>
 #include <tsl/robin_set.h>
 
+#include "scenewatch/core/hash.h"
+
 namespace scenewatch::background {
 
 class RaySet {
@@ -29,13 +31,6 @@ class RaySet {
   void clear();
 
  private:
-  struct Hash {
-    std::size_t operator()(std::uint64_t x) const {
-      x ^= x >> 33;
-      x *= 0xff51afd7ed558ccdULL;
-      return static_cast<std::size_t>(x ^ (x >> 33));
-    }
-  };
   using Bits = std::vector<std::uint64_t>;
   static constexpr std::uint64_t kMaxBitmapVoxels = std::uint64_t{1} << 30;  // 128 MiB per bitmap
 
@@ -71,7 +66,7 @@ class RaySet {
   octomap::OcTreeKey lo_{0, 0, 0};
   std::uint32_t dim_[3] = {0, 0, 0};
   Bits free_bits_, end_bits_;
-  tsl::robin_set<std::uint64_t, Hash> free_set_, end_set_;
+  tsl::robin_set<std::uint64_t, MixHash64> free_set_, end_set_;
 };
 
 template <typename F>

@@ -151,11 +151,8 @@ bool inside_convex(const std::vector<Vec2>& hull, const Vec2& p) {
 // Largest 8-connected group of the inlier voxels on a 2D grid of cell `cell_m` in the plane.
 std::vector<int> largest_component(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
                                    const Eigen::Vector3d& u, const Eigen::Vector3d& v, double cell_m) {
-  struct CellHash {
-    std::size_t operator()(std::uint64_t x) const { return static_cast<std::size_t>(x * 0x9e3779b97f4a7c15ULL >> 17); }
-  };
   auto key = [](long a, long b) { return (static_cast<std::uint64_t>(a + (1 << 30)) << 32) | static_cast<std::uint64_t>(b + (1 << 30)); };
-  tsl::robin_map<std::uint64_t, int, CellHash> cells;
+  tsl::robin_map<std::uint64_t, int, MixHash64> cells;
   std::vector<std::pair<long, long>> cell_coords;
   std::vector<int> voxel_cell(inliers.size());
   for (std::size_t i = 0; i < inliers.size(); ++i) {

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "scenewatch/core/cloud.h"
+#include "scenewatch/core/hash.h"
 
 namespace scenewatch::segmentation {
 
@@ -32,20 +33,13 @@ struct VoxelIndex {
   const int* members_end(int v) const { return member_points.data() + member_offsets[v + 1]; }
 
  private:
-  struct Hash {
-    std::size_t operator()(std::uint64_t x) const {
-      x ^= x >> 31;
-      x *= 0x9e3779b97f4a7c15ULL;
-      return static_cast<std::size_t>(x ^ (x >> 29));
-    }
-  };
   static std::uint64_t pack(int x, int y, int z) {
     constexpr std::uint64_t kMask = (1u << 21) - 1;  // +-1M voxels per axis
     return ((static_cast<std::uint64_t>(x + (1 << 20)) & kMask) << 42) |
            ((static_cast<std::uint64_t>(y + (1 << 20)) & kMask) << 21) |
            (static_cast<std::uint64_t>(z + (1 << 20)) & kMask);
   }
-  tsl::robin_map<std::uint64_t, int, Hash> lookup;
+  tsl::robin_map<std::uint64_t, int, MixHash64> lookup;
 };
 
 }  // namespace scenewatch::segmentation
