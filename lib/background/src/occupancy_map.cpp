@@ -17,6 +17,7 @@
 #include "bulk_update.h"
 #include "ray_set.h"
 #include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/core/files.h"
 #include "scenewatch/core/hash.h"
 
 namespace scenewatch::background {
@@ -39,7 +40,6 @@ struct ColorSum {
   std::uint32_t r = 0, g = 0, b = 0, n = 0;
 };
 
-std::string quoted(const fs::path& p) { return "'" + p.string() + "'"; }
 
 // ColorOcTree::updateInnerOccupancy() dereferences the root without checking it (OctoMap 1.9.7):
 // on an empty tree it crashes.
@@ -372,8 +372,7 @@ Status OccupancyMap::save(const fs::path& path) const {
 }
 
 Status OccupancyMap::load(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return not_found(quoted(path) + ": no such file");
+  if (auto st = check_readable_file(path); !st) return st;
   const std::string ext = path.extension().string();
   auto loaded = std::make_unique<Impl>(config_);
   if (ext == ".bt") {

@@ -14,6 +14,7 @@
 #include <mutex>
 #include <system_error>
 
+#include "scenewatch/core/files.h"
 #include "scenewatch/io/cloud_io.h"
 
 namespace scenewatch::io {
@@ -25,17 +26,6 @@ namespace {
 void quiet_pcl() {
   static std::once_flag once;
   std::call_once(once, [] { pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS); });
-}
-
-std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
-
-Status check_readable_file(const fs::path& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return not_found(quoted(path) + ": no such file");
-  if (!fs::is_regular_file(path, ec)) return invalid_argument(quoted(path) + ": not a regular file");
-  std::ifstream probe(path, std::ios::binary);
-  if (!probe) return io_error(quoted(path) + ": cannot open for reading");
-  return {};
 }
 
 const pcl::PCLPointField* find_field(const pcl::PCLPointCloud2& cloud, const std::string& name) {

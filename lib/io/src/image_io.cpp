@@ -7,6 +7,7 @@
 #include <fstream>
 #include <system_error>
 
+#include "scenewatch/core/files.h"
 #include "scenewatch/io/image_io.h"
 
 namespace scenewatch::io {
@@ -14,12 +15,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
-
 Result<cv::Mat> read_png(const fs::path& path) {
+  if (auto st = check_readable_file(path); !st) return st.error();
   std::error_code ec;
-  if (!fs::exists(path, ec)) return not_found(quoted(path) + ": no such file");
-  if (!fs::is_regular_file(path, ec)) return invalid_argument(quoted(path) + ": not a regular file");
   if (fs::file_size(path, ec) == 0) return invalid_argument(quoted(path) + ": empty file");
   cv::Mat image;
   try {
@@ -136,8 +134,8 @@ Result<LabelImage> read_label_png(const fs::path& path) {
 }
 
 Result<std::pair<int, int>> read_png_size(const fs::path& path) {
+  if (auto st = check_readable_file(path); !st) return st.error();
   std::ifstream in(path, std::ios::binary);
-  if (!in) return not_found(quoted(path) + ": cannot open");
   unsigned char head[24];
   in.read(reinterpret_cast<char*>(head), sizeof(head));
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};

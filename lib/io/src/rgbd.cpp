@@ -6,6 +6,7 @@
 #include <limits>
 #include <sstream>
 
+#include "scenewatch/core/files.h"
 #include "scenewatch/io/rgbd.h"
 
 namespace scenewatch::io {
@@ -13,15 +14,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
-
 // Calls f(line_no, line) for every line of a text file with '#' comments cut off; stops at the
 // first error f returns.
 Status for_each_line(const fs::path& path, const std::function<Status(int, const std::string&)>& f) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) return not_found(quoted(path) + ": no such file");
+  if (auto st = check_readable_file(path); !st) return st;
   std::ifstream in(path);
-  if (!in) return io_error(quoted(path) + ": cannot open for reading");
   std::string line;
   int line_no = 0;
   while (std::getline(in, line)) {
