@@ -149,7 +149,7 @@ TEST(OccupancyMap, ClearingAHugeBoxIsBounded) {
 }
 
 TEST(OccupancyMap, SaveLoadOtAndBt) {
-  const fs::path dir = test::make_temp_dir("bg");
+  const test::TempDir dir("bg");
   OccupancyMap map(at(0.04));
   map.insert(wall(), Pose::Identity());
   ASSERT_TRUE(map.save(dir / "m.ot").ok());
@@ -180,7 +180,6 @@ TEST(OccupancyMap, SaveLoadOtAndBt) {
   OccupancyMap from_plain(at(0.02));
   ASSERT_TRUE(from_plain.load(dir / "plain.ot").ok());
   EXPECT_EQ(from_plain.query({1, 1, 1}), Occupancy::kOccupied);
-  fs::remove_all(dir);
 }
 
 TEST(OccupancyMap, ResetAndValidate) {

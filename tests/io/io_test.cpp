@@ -19,13 +19,11 @@ namespace fs = std::filesystem;
 
 class IoTest : public ::testing::Test {
  protected:
-  void SetUp() override { dir_ = test::make_temp_dir("io"); }
-  void TearDown() override { fs::remove_all(dir_); }
   fs::path write_text(const std::string& name, const std::string& text) {
     std::ofstream(dir_ / name, std::ios::binary) << text;
     return dir_ / name;
   }
-  fs::path dir_;
+  test::TempDir dir_{"io"};
 };
 
 Cloud small_cloud() {

@@ -12,8 +12,6 @@ namespace fs = std::filesystem;
 
 class ConfigTest : public ::testing::Test {
  protected:
-  void SetUp() override { dir_ = test::make_temp_dir("config"); }
-  void TearDown() override { fs::remove_all(dir_); }
   Status load(const std::string& yaml, Config& c) {
     std::ofstream(dir_ / "c.yaml") << yaml;
     auto root = load_yaml_file(dir_ / "c.yaml", pipeline_sections());
@@ -25,7 +23,7 @@ class ConfigTest : public ::testing::Test {
     auto st = load(yaml, c);
     return st.ok() ? std::string("(no error)") : st.error().message;
   }
-  fs::path dir_;
+  test::TempDir dir_{"config"};
 };
 
 TEST_F(ConfigTest, ReadsEveryKnownKey) {

@@ -200,7 +200,7 @@ TEST(WorkingMemory, OccupancyQueriesClearAndReset) {
 }
 
 TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
-  const fs::path dir = test::make_temp_dir("model");
+  const test::TempDir dir("model");
   {
     WorkingMemory wm(test_config());
     EXPECT_EQ(wm.load(dir).error().code, ErrorCode::kNotFound) << "nothing saved yet";
@@ -211,7 +211,7 @@ TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
   }
   EXPECT_TRUE(fs::is_symlink(dir / "current"));
   std::size_t snapshots = 0;
-  for (const auto& e : fs::directory_iterator(dir)) snapshots += e.path().filename().string().rfind("snap-", 0) == 0;
+  for (const auto& e : fs::directory_iterator(dir.path())) snapshots += e.path().filename().string().rfind("snap-", 0) == 0;
   EXPECT_EQ(snapshots, 1u) << "older snapshots are removed";
 
   WorkingMemory wm(test_config());
@@ -238,7 +238,6 @@ TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
   ASSERT_FALSE(st.ok());
   EXPECT_NE(st.error().message.find("scene.json"), std::string::npos);
   EXPECT_EQ(wm.snapshot()->objects.size(), 2u);
-  fs::remove_all(dir);
 }
 
 TEST(WorkingMemory, ReadersRunWhileFramesAreProcessed) {

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <stdexcept>
+#include <system_error>
 #include <string>
 
 namespace scenewatch::test {
@@ -21,6 +22,25 @@ inline std::filesystem::path make_temp_dir(const std::string& tag) {
   if (::mkdtemp(pattern.data()) == nullptr) throw std::runtime_error("mkdtemp failed for " + pattern);
   return pattern;
 }
+
+/// A fresh temporary directory removed when the object goes out of scope, even when an assertion
+/// ends the test early.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& tag) : path_(make_temp_dir(tag)) {}
+  ~TempDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+  std::filesystem::path operator/(const std::filesystem::path& p) const { return path_ / p; }
+  operator const std::filesystem::path&() const { return path_; }  // NOLINT: used as a path
+
+ private:
+  std::filesystem::path path_;
+};
 
 }  // namespace scenewatch::test
 
