@@ -67,6 +67,18 @@ nlohmann::json to_json(const proto::Event& event) {
                       {"centroid_world", to_json(event.centroid_world())},
                       {"detail", event.detail()}};
   j["object_id"] = event.has_object_id() ? nlohmann::json(event.object_id()) : nlohmann::json(nullptr);
+  nlohmann::json evidence = nlohmann::json::object();
+  for (const auto& [name, value] : event.evidence()) evidence[name] = value;
+  j["evidence"] = evidence;
+  if (event.has_region()) {
+    const auto& r = event.region();
+    j["region"] = {{"x", r.x()}, {"y", r.y()}, {"width", r.width()}, {"height", r.height()}, {"area", r.area()}};
+  }
+  if (event.has_displacement_world()) j["displacement_world"] = to_json(event.displacement_world());
+  if (event.indices_before_size() > 0)
+    j["indices_before"] = std::vector<int>(event.indices_before().begin(), event.indices_before().end());
+  if (event.indices_after_size() > 0)
+    j["indices_after"] = std::vector<int>(event.indices_after().begin(), event.indices_after().end());
   return j;
 }
 

@@ -70,6 +70,9 @@ json to_json(const Event& e) {
             {"score", e.score}, {"box_min", vec(e.box_world.min)}, {"box_max", vec(e.box_world.max)},
             {"centroid", vec(e.centroid_world)}, {"detail", e.detail}};
   if (e.object_id) j["object_id"] = *e.object_id;
+  if (!e.evidence.empty()) j["evidence"] = e.evidence;
+  if (e.region) j["region"] = {e.region->x, e.region->y, e.region->width, e.region->height, e.region->area};
+  if (e.displacement_world) j["displacement"] = vec(*e.displacement_world);
   return j;
 }
 
@@ -116,6 +119,13 @@ Result<Event> event_from_json(const json& j) {
     e.centroid_world = vec3(j.at("centroid"));
     e.detail = j.value("detail", "");
     if (j.contains("object_id")) e.object_id = j.at("object_id").get<std::uint64_t>();
+    if (j.contains("evidence")) e.evidence = j.at("evidence").get<std::map<std::string, double>>();
+    if (j.contains("region")) {
+      const auto& r = j.at("region");
+      e.region = PixelRegion{r.at(0).get<int>(), r.at(1).get<int>(), r.at(2).get<int>(), r.at(3).get<int>(),
+                             r.at(4).get<std::uint32_t>()};
+    }
+    if (j.contains("displacement")) e.displacement_world = vec3(j.at("displacement"));
     return e;
   });
 }

@@ -140,6 +140,18 @@ void to_proto(const Event& event, proto::Event* out) {
   to_proto(event.centroid_world, out->mutable_centroid_world());
   if (event.object_id) out->set_object_id(*event.object_id);
   out->set_detail(event.detail);
+  for (const auto& [name, value] : event.evidence) (*out->mutable_evidence())[name] = value;
+  if (event.region) {
+    auto* r = out->mutable_region();
+    r->set_x(event.region->x);
+    r->set_y(event.region->y);
+    r->set_width(event.region->width);
+    r->set_height(event.region->height);
+    r->set_area(event.region->area);
+  }
+  if (event.displacement_world) to_proto(*event.displacement_world, out->mutable_displacement_world());
+  out->mutable_indices_before()->Add(event.indices_before.begin(), event.indices_before.end());
+  out->mutable_indices_after()->Add(event.indices_after.begin(), event.indices_after.end());
 }
 
 void to_proto(const Pose& pose, proto::Pose* out) {
