@@ -4,6 +4,7 @@
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/geometry.h"
+#include "scenewatch/core/mesh.h"
 #include "scenewatch/core/result.h"
 
 namespace scenewatch {
@@ -70,6 +71,14 @@ Aabb OrientedBox::aabb() const {
   const Eigen::Matrix3d r = rotation.toRotationMatrix();
   const Eigen::Vector3d half = 0.5 * (r.cwiseAbs() * extents);
   return {center - half, center + half};
+}
+
+void ColoredMesh::append(const ColoredMesh& other) {
+  const auto offset = static_cast<std::uint32_t>(vertices.size());
+  vertices.insert(vertices.end(), other.vertices.begin(), other.vertices.end());
+  colors.insert(colors.end(), other.colors.begin(), other.colors.end());
+  triangles.reserve(triangles.size() + other.triangles.size());
+  for (const auto& t : other.triangles) triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
 }
 
 std::size_t count_valid(const Cloud& cloud) {

@@ -194,4 +194,64 @@ Status write_pcd(const fs::path& path, const Cloud& cloud) {
   return {};
 }
 
+Status write_mesh_ply(const fs::path& path, const ColoredMesh& mesh) {
+  quiet_pcl();
+  if (mesh.empty()) return invalid_argument(quoted(path) + ": refusing to write a mesh without triangles");
+  if (mesh.colors.size() != mesh.vertices.size())
+    return invalid_argument(quoted(path) + ": mesh has " + std::to_string(mesh.vertices.size()) + " vertices but " +
+                            std::to_string(mesh.colors.size()) + " colours");
+  Cloud vertices;
+  vertices.resize(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+    PointT& p = vertices[i];
+    p.getVector3fMap() = mesh.vertices[i];
+    p.r = mesh.colors[i][0];
+    p.g = mesh.colors[i][1];
+    p.b = mesh.colors[i][2];
+  }
+  pcl::PolygonMesh out;
+  pcl::toPCLPointCloud2(vertices, out.cloud);
+  out.polygons.resize(mesh.triangles.size());
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    for (std::uint32_t v : mesh.triangles[i]) out.polygons[i].vertices.push_back(static_cast<pcl::index_t>(v));
+  }
+  std::error_code ec;
+  if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
+  const fs::path tmp = path.string() + ".tmp";
+  if (pcl::io::savePLYFileBinary(tmp.string(), out) < 0) {
+    fs::remove(tmp, ec);
+    return io_error(quoted(path) + ": cannot write");
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) return io_error(quoted(path) + ": cannot rename into place: " + ec.message());
+  return {};
+}
+
+Result<ColoredMesh> read_mesh_ply(const fs::path& path) {
+  quiet_pcl();
+  if (auto st = check_readable_file(path); !st) return st.error();
+  pcl::PolygonMesh in;
+  if (pcl::io::loadPLYFile(path.string(), in) < 0) return invalid_argument(quoted(path) + ": not a readable PLY mesh");
+  Cloud vertices;
+  pcl::fromPCLPointCloud2(in.cloud, vertices);
+  ColoredMesh mesh;
+  mesh.vertices.reserve(vertices.size());
+  for (const auto& p : vertices.points) {
+    mesh.vertices.push_back(p.getVector3fMap());
+    mesh.colors.push_back({p.r, p.g, p.b});
+  }
+  for (const auto& poly : in.polygons) {
+    if (poly.vertices.size() != 3) return invalid_argument(quoted(path) + ": a face is not a triangle");
+    std::array<std::uint32_t, 3> tri{};
+    for (int k = 0; k < 3; ++k) {
+      const auto v = poly.vertices[static_cast<std::size_t>(k)];
+      if (v < 0 || static_cast<std::size_t>(v) >= mesh.vertices.size())
+        return invalid_argument(quoted(path) + ": a face indexes a missing vertex");
+      tri[static_cast<std::size_t>(k)] = static_cast<std::uint32_t>(v);
+    }
+    mesh.triangles.push_back(tri);
+  }
+  return mesh;
+}
+
 }  // namespace scenewatch::io

@@ -1,0 +1,53 @@
+#pragma once
+/// The expected view at a pose: expected depth from the background mesh, and per pixel up to
+/// seven colour samples from the nearest keyframes that see the same surface point unoccluded
+/// (the seed's view-dependent image database, D5.1 section 4.2), summarised per opponent channel
+/// as the number of samples, their mean and their sum of squared deviations.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "scenewatch/background/appearance.h"
+#include "scenewatch/core/geometry.h"
+#include "scenewatch/core/image.h"
+#include "scenewatch/surprise/bayes.h"
+
+namespace scenewatch::surprise {
+
+struct ExpectedViewConfig {
+  int max_samples = kMaxSamples;  ///< reference keyframes sampled per pixel, at most 7
+  /// A keyframe sees a surface point unoccluded when its depth there agrees with the point's
+  /// depth in it within tolerance_m + tolerance_rel * depth.
+  double depth_tolerance_m = 0.01;
+  double depth_tolerance_rel = 0.02;
+};
+
+Status validate(const ExpectedViewConfig& config);
+
+struct ExpectedView {
+  int width = 0, height = 0;
+  Pose T_world_camera = Pose::Identity();
+  Intrinsics intrinsics;
+  std::vector<float> depth_m;        ///< expected depth, 0 where the model has no surface
+  std::vector<std::uint8_t> count;   ///< colour samples per pixel
+  std::array<std::vector<float>, kChannels> mean, ssd;  ///< per opponent channel
+  std::size_t reference_views = 0;   ///< keyframes that were sampled
+  std::size_t pixel_count() const { return static_cast<std::size_t>(width) * height; }
+};
+
+/// Renders the expected view of `memory` at a pose: depth from the mesh patches of the nearest
+/// keyframes, colour samples from the `max_samples` nearest keyframes.
+ExpectedView render_expected_view(const background::AppearanceMemory& memory, const Pose& T_world_camera,
+                                  const Intrinsics& intrinsics, const ExpectedViewConfig& config = {});
+
+/// The same from an expected depth and explicit reference keyframes (at most kMaxSamples used).
+ExpectedView sample_expected_view(const background::DepthMap& depth,
+                                  const std::vector<std::shared_ptr<const background::Keyframe>>& references,
+                                  const Pose& T_world_camera, const Intrinsics& intrinsics,
+                                  const ExpectedViewConfig& config = {});
+
+/// The virtual image: the mean colour per pixel (the seed's Fig. 4.4 right); black where no sample.
+ColorImage expected_color(const ExpectedView& view);
+
+}  // namespace scenewatch::surprise

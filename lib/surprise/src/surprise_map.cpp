@@ -1,0 +1,211 @@
+#include "scenewatch/surprise/surprise_map.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+namespace scenewatch::surprise {
+namespace {
+
+float percentile(std::vector<float>& values, double q) {
+  const std::size_t k = static_cast<std::size_t>(q * static_cast<double>(values.size() - 1) + 0.5);
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+}  // namespace
+
+Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage& observed, const SurpriseKernel& kernel) {
+  if (observed.width != view.width || observed.height != view.height)
+    return invalid_argument("observed image is " + std::to_string(observed.width) + "x" + std::to_string(observed.height) +
+                            " but the expected view is " + std::to_string(view.width) + "x" + std::to_string(view.height));
+  const std::size_t n = view.pixel_count();
+  if (observed.rgb.size() != 3 * n) return invalid_argument("observed image buffer does not match its size");
+  SurpriseMap map;
+  map.width = view.width;
+  map.height = view.height;
+  std::array<std::vector<float>, kChannels> obs;
+  for (auto& o : obs) o.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    float opp[kChannels];
+    to_opponent(observed.rgb[3 * i], observed.rgb[3 * i + 1], observed.rgb[3 * i + 2], opp);
+    for (int c = 0; c < kChannels; ++c) obs[c][i] = opp[c];
+  }
+  map.total.assign(n, 0.0f);
+  for (int c = 0; c < kChannels; ++c) {
+    map.channel[c].resize(n);
+    kernel.run(view.count.data(), view.mean[c].data(), view.ssd[c].data(), obs[c].data(), map.channel[c].data(), n);
+    for (std::size_t i = 0; i < n; ++i) map.total[i] += map.channel[c][i];
+  }
+  for (std::size_t i = 0; i < n; ++i) map.known_pixels += std::isnan(map.total[i]) ? 0 : 1;
+  return map;
+}
+
+Status validate(const RegionConfig& c) {
+  if (!(c.threshold_low >= 0)) return invalid_argument("surprise.threshold_low must be >= 0");
+  if (!(c.threshold_high >= c.threshold_low)) return invalid_argument("surprise.threshold_high must be >= threshold_low");
+  if (c.open_radius_px < 0 || c.open_radius_px > 16) return invalid_argument("surprise.open_radius_px must be in [0, 16]");
+  if (c.min_area_px < 1) return invalid_argument("surprise.min_area_px must be >= 1");
+  if (c.min_extent_px < 0) return invalid_argument("surprise.min_extent_px must be >= 0");
+  return {};
+}
+
+std::vector<SurpriseRegion> find_regions(const SurpriseMap& map, const ExpectedView& view, const DepthImage* observed_depth,
+                                         const RegionConfig& config) {
+  std::vector<SurpriseRegion> regions;
+  const int w = map.width, h = map.height;
+  if (w == 0 || h == 0) return regions;
+  cv::Mat low(h, w, CV_8U), high(h, w, CV_8U);
+  for (int i = 0; i < w * h; ++i) {
+    const float s = map.total[static_cast<std::size_t>(i)];
+    low.data[i] = s >= config.threshold_low ? 255 : 0;  // NaN compares false: unknown is never surprising
+    high.data[i] = s >= config.threshold_high ? 255 : 0;
+  }
+  if (config.open_radius_px > 0) {
+    const int k = 2 * config.open_radius_px + 1;
+    cv::morphologyEx(low, low, cv::MORPH_OPEN, cv::getStructuringElement(cv::MORPH_ELLIPSE, {k, k}));
+  }
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(low, labels, stats, centroids, 8, CV_32S);
+  std::vector<char> seeded(static_cast<std::size_t>(count), 0);
+  for (int i = 0; i < w * h; ++i) {
+    if (high.data[i]) seeded[static_cast<std::size_t>(labels.ptr<int>()[i])] = 1;
+  }
+  const int min_extent = static_cast<int>(std::lround(config.min_extent_px * w / 640.0));
+  std::vector<int> region_of(static_cast<std::size_t>(count), -1);
+  for (int l = 1; l < count; ++l) {
+    if (!seeded[static_cast<std::size_t>(l)]) continue;
+    const int area = stats.at<int>(l, cv::CC_STAT_AREA);
+    const int bw = stats.at<int>(l, cv::CC_STAT_WIDTH), bh = stats.at<int>(l, cv::CC_STAT_HEIGHT);
+    if (area < config.min_area_px || bw < min_extent || bh < min_extent) continue;
+    region_of[static_cast<std::size_t>(l)] = static_cast<int>(regions.size());
+    SurpriseRegion r;
+    r.region = {stats.at<int>(l, cv::CC_STAT_LEFT), stats.at<int>(l, cv::CC_STAT_TOP), bw, bh,
+                static_cast<std::uint32_t>(area)};
+    regions.push_back(r);
+  }
+  for (int i = 0; i < w * h; ++i) {
+    const int r = region_of[static_cast<std::size_t>(labels.ptr<int>()[i])];
+    if (r >= 0) regions[static_cast<std::size_t>(r)].pixels.push_back(static_cast<std::uint32_t>(i));
+  }
+  const Intrinsics& K = view.intrinsics;
+  for (SurpriseRegion& r : regions) {
+    std::array<double, kChannels> sum{};
+    double sum_total = 0;
+    std::size_t known = 0;
+    std::array<std::vector<float>, 3> coords;
+    for (std::uint32_t i : r.pixels) {
+      if (!std::isnan(map.total[i])) {
+        for (int c = 0; c < kChannels; ++c) {
+          r.peak[c] = std::max(r.peak[c], static_cast<double>(map.channel[c][i]));
+          sum[c] += map.channel[c][i];
+        }
+        r.peak_total = std::max(r.peak_total, static_cast<double>(map.total[i]));
+        sum_total += map.total[i];
+        ++known;
+      }
+      float z = view.depth_m.empty() ? 0.0f : view.depth_m[i];
+      if (observed_depth && observed_depth->depth_mm.size() == view.pixel_count()) {
+        const std::uint16_t mm = observed_depth->depth_mm[i];
+        if (mm != 0 && mm != 65535 && (z <= 0.0f || mm * 0.001f < z)) z = mm * 0.001f;
+      }
+      if (z <= 0.0f || !K.valid()) continue;
+      const int u = static_cast<int>(i % static_cast<std::uint32_t>(w)), v = static_cast<int>(i / static_cast<std::uint32_t>(w));
+      const Eigen::Vector3d p = view.T_world_camera * Eigen::Vector3d((u - K.cx) / K.fx * z, (v - K.cy) / K.fy * z, z);
+      for (int k = 0; k < 3; ++k) coords[k].push_back(static_cast<float>(p[k]));
+    }
+    if (known > 0) {
+      for (int c = 0; c < kChannels; ++c) r.mean[c] = sum[c] / static_cast<double>(known);
+      r.mean_total = sum_total / static_cast<double>(known);
+    }
+    r.points_3d = coords[0].size();
+    if (r.points_3d > 0) {
+      // 2nd to 98th percentile per axis: a few mixed pixels at depth edges do not stretch the box.
+      for (int k = 0; k < 3; ++k) {
+        r.box_world.min[k] = percentile(coords[k], 0.02);
+        r.box_world.max[k] = percentile(coords[k], 0.98);
+        r.centroid_world[k] = percentile(coords[k], 0.5);
+      }
+    }
+  }
+  std::sort(regions.begin(), regions.end(),
+            [](const SurpriseRegion& a, const SurpriseRegion& b) { return a.peak_total > b.peak_total; });
+  return regions;
+}
+
+Event to_event(const SurpriseRegion& r, double stamp_s) {
+  Event e;
+  e.stamp_s = stamp_s;
+  e.level = EventLevel::kMismatch;
+  e.kind = EventKind::kAppearanceChange;
+  e.score = r.mean_total;
+  e.box_world = r.box_world;
+  e.centroid_world = r.centroid_world;
+  e.region = r.region;
+  for (int c = 0; c < kChannels; ++c) {
+    e.evidence[std::string("kl_peak_") + channel_name(c)] = r.peak[c];
+    e.evidence[std::string("kl_mean_") + channel_name(c)] = r.mean[c];
+  }
+  e.evidence["kl_peak_total"] = r.peak_total;
+  e.evidence["kl_mean_total"] = r.mean_total;
+  e.evidence["area_px"] = r.region.area;
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "appearance differs over %u px, mean KL %.1f nats (peak %.1f)", r.region.area,
+                r.mean_total, r.peak_total);
+  e.detail = buf;
+  return e;
+}
+
+ColorImage heatmap_overlay(const SurpriseMap& map, const ColorImage& observed, double saturation) {
+  ColorImage out;
+  out.width = map.width;
+  out.height = map.height;
+  out.rgb.assign(3 * static_cast<std::size_t>(map.width) * map.height, 0);
+  cv::Mat scaled(map.height, map.width, CV_8U);
+  for (std::size_t i = 0; i < map.total.size(); ++i) {
+    const float s = map.total[i];
+    scaled.data[i] = std::isnan(s) ? 0 : static_cast<std::uint8_t>(std::clamp(255.0 * s / saturation, 0.0, 255.0));
+  }
+  cv::Mat colored;
+  cv::applyColorMap(scaled, colored, cv::COLORMAP_JET);  // BGR
+  const bool have_obs = observed.width == map.width && observed.height == map.height;
+  for (std::size_t i = 0; i < map.total.size(); ++i) {
+    const std::uint8_t* bgr = colored.data + 3 * i;
+    float grey = 128.0f;
+    if (have_obs) grey = (observed.rgb[3 * i] + observed.rgb[3 * i + 1] + observed.rgb[3 * i + 2]) / 3.0f;
+    if (std::isnan(map.total[i])) {
+      for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<std::uint8_t>(0.5f * grey + 40.0f);
+      continue;
+    }
+    for (int k = 0; k < 3; ++k) out.rgb[3 * i + k] = static_cast<std::uint8_t>(0.35f * grey + 0.65f * bgr[2 - k]);
+  }
+  return out;
+}
+
+Status write_surprise_tiff(const std::filesystem::path& path, const SurpriseMap& map) {
+  if (map.width == 0 || map.height == 0) return invalid_argument("'" + path.string() + "': empty surprise map");
+  cv::Mat m(map.height, map.width, CV_32F, const_cast<float*>(map.total.data()));
+  const std::filesystem::path tmp = path.string() + ".tmp.tiff";
+  bool ok = false;
+  try {
+    ok = cv::imwrite(tmp.string(), m);
+  } catch (const cv::Exception& e) {
+    return io_error("'" + path.string() + "': cannot write TIFF: " + e.what());
+  }
+  std::error_code ec;
+  if (!ok) {
+    std::filesystem::remove(tmp, ec);
+    return io_error("'" + path.string() + "': cannot write TIFF");
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) return io_error("'" + path.string() + "': cannot rename into place: " + ec.message());
+  return {};
+}
+
+}  // namespace scenewatch::surprise
