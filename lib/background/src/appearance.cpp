@@ -247,7 +247,8 @@ bool AppearanceMemory::is_new_view(const Pose& T_world_camera) const {
 Result<std::uint64_t> AppearanceMemory::add(Keyframe keyframe) {
   if (auto st = check_keyframe(keyframe); !st) return st.error();
   keyframe.id = impl_->next_id++;
-  auto patch = std::make_shared<Patch>(triangulate(keyframe, config_.mesh_stride_px, config_.mesh_max_depth_jump));
+  const int stride = std::max(1, static_cast<int>(std::lround(config_.mesh_stride_px * keyframe.intrinsics.width / 640.0)));
+  auto patch = std::make_shared<Patch>(triangulate(keyframe, stride, config_.mesh_max_depth_jump));
   Entry entry{std::make_shared<const Keyframe>(std::move(keyframe)), std::move(patch)};
   impl_->bytes += entry.bytes();
   impl_->entries.push_back(std::move(entry));

@@ -10,8 +10,46 @@ Status validate(const ExpectedViewConfig& c) {
     return invalid_argument("surprise.max_samples must be in [1, " + std::to_string(kMaxSamples) + "]");
   if (!(c.depth_tolerance_m >= 0)) return invalid_argument("surprise.depth_tolerance_m must be >= 0");
   if (!(c.depth_tolerance_rel >= 0)) return invalid_argument("surprise.depth_tolerance_rel must be >= 0");
+  if (c.fill_holes_px < 0 || c.fill_holes_px > 640) return invalid_argument("surprise.fill_holes_px must be in [0, 640]");
+  if (!(c.fill_holes_max_jump >= 0)) return invalid_argument("surprise.fill_holes_max_jump must be >= 0");
   return {};
 }
+
+namespace {
+
+// Fills runs of missing depth along one line (stride apart) no longer than max_gap whose two ends
+// agree within tolerance, by linear interpolation: the holes glass and grazing angles leave in
+// every keyframe's depth, which would otherwise leave the surface behind them without samples.
+void fill_line(float* d, int n, std::ptrdiff_t stride, int max_gap, float rel) {
+  int last = -1;
+  for (int i = 0; i < n; ++i) {
+    const float z = d[i * stride];
+    if (z <= 0.0f) continue;
+    if (last >= 0 && i - last > 1 && i - last - 1 <= max_gap) {
+      const float z0 = d[last * stride];
+      if (std::abs(z - z0) <= rel * std::min(z, z0)) {
+        for (int k = last + 1; k < i; ++k) d[k * stride] = z0 + (z - z0) * static_cast<float>(k - last) / static_cast<float>(i - last);
+      }
+    }
+    last = i;
+  }
+}
+
+void fill_depth_holes(std::vector<float>* depth, int w, int h, const ExpectedViewConfig& config) {
+  const int max_gap = static_cast<int>(std::lround(config.fill_holes_px * w / 640.0));
+  if (max_gap <= 0) return;
+  const float rel = static_cast<float>(config.fill_holes_max_jump);
+  std::vector<float> horizontal = *depth;
+  for (int v = 0; v < h; ++v) fill_line(horizontal.data() + static_cast<std::size_t>(v) * w, w, 1, max_gap, rel);
+  for (int u = 0; u < w; ++u) fill_line(depth->data() + u, h, w, max_gap, rel);
+  // A pixel filled both ways takes the nearer surface; filled one way, that one.
+  for (std::size_t i = 0; i < depth->size(); ++i) {
+    const float a = horizontal[i], b = (*depth)[i];
+    if (a > 0.0f && (b <= 0.0f || a < b)) (*depth)[i] = a;
+  }
+}
+
+}  // namespace
 
 ExpectedView render_expected_view(const background::AppearanceMemory& memory, const Pose& T_world_camera,
                                   const Intrinsics& K, const ExpectedViewConfig& config) {
@@ -35,6 +73,7 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
   const std::size_t npix = view.pixel_count();
   view.depth_m = depth.depth_m;
   view.depth_m.resize(npix, 0.0f);
+  fill_depth_holes(&view.depth_m, K.width, K.height, config);
   view.count.assign(npix, 0);
   std::array<std::vector<float>, kChannels> sum, sumsq;
   for (int c = 0; c < kChannels; ++c) {
@@ -75,9 +114,9 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
         if (!(ur >= 0.0f && vr >= 0.0f && ur < umax && vr < vmax)) continue;
         // Unoccluded: the keyframe's own depth at that pixel agrees with the point's depth in it.
         const int ui = static_cast<int>(ur + 0.5f), vi = static_cast<int>(vr + 0.5f);
+        // Where the keyframe has no depth (glass, grazing surfaces) nothing refutes the sample.
         const std::uint16_t mm = rdepth[static_cast<std::size_t>(vi) * rw + ui];
-        if (mm == 0 || mm == 65535) continue;
-        if (std::abs(mm * 0.001f - q.z()) > tol_m + tol_rel * q.z()) continue;
+        if (mm != 0 && mm != 65535 && std::abs(mm * 0.001f - q.z()) > tol_m + tol_rel * q.z()) continue;
         // Bilinear colour.
         const int u0 = static_cast<int>(ur), v0 = static_cast<int>(vr);
         const float fu = ur - u0, fv = vr - v0;

@@ -30,11 +30,12 @@ namespace scenewatch::background {
 struct AppearanceConfig {
   bool enabled = true;
   /// A view is new when, to every keyframe, the camera moved this far or turned this much.
-  double keyframe_min_translation_m = 0.10;
-  double keyframe_min_rotation_deg = 10.0;
-  std::size_t max_keyframes = 60;
+  /// Denser keyframes give better colour samples (the seed used every image of its first circle).
+  double keyframe_min_translation_m = 0.05;
+  double keyframe_min_rotation_deg = 5.0;
+  std::size_t max_keyframes = 150;
   std::size_t memory_budget_mb = 512;   ///< images plus mesh patches
-  int mesh_stride_px = 4;               ///< grid step of the triangulation
+  int mesh_stride_px = 4;               ///< grid step of the triangulation, per 640 pixels of width
   /// An edge is cut where neighbouring depths differ by more than this fraction of the depth.
   double mesh_max_depth_jump = 0.05;
   int depth_views = 3;                  ///< patches of this many nearest keyframes render the expected depth

@@ -39,7 +39,7 @@ void from_opponent(const float opp[kChannels], float rgb[3]);
 /// for a colour noise sigma0 in opponent units (1/255 per grey level).
 struct Prior {
   double a0 = 1.0;
-  double b0 = 1e-3;  ///< sigma0 ~ 0.032, about 8 grey levels
+  double b0 = 2.5e-4;  ///< sigma0 = 0.016, about 4 grey levels
 };
 
 /// KL(Gamma(a_p, b_p) || Gamma(a_q, b_q)) in nats, shape-rate parametrisation, closed form in

@@ -21,6 +21,10 @@ struct ExpectedViewConfig {
   /// depth in it within tolerance_m + tolerance_rel * depth.
   double depth_tolerance_m = 0.01;
   double depth_tolerance_rel = 0.02;
+  /// Holes in the expected depth up to this many pixels wide (per 640 pixels of image width)
+  /// are filled when the surfaces on both sides agree within fill_holes_max_jump of the depth.
+  int fill_holes_px = 40;
+  double fill_holes_max_jump = 0.05;
 };
 
 Status validate(const ExpectedViewConfig& config);
