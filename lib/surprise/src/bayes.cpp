@@ -46,34 +46,6 @@ double bayesian_surprise(const double* samples, int n, double observed, const Pr
   return gamma_kl(a1, b1, a, b);
 }
 
-float fast_log(float x) {
-  std::uint32_t bits;
-  std::memcpy(&bits, &x, sizeof bits);
-  int e = static_cast<int>((bits >> 23) & 0xffu) - 126;  // x = m * 2^e, m in [0.5, 1)
-  bits = (bits & 0x007fffffu) | 0x3f000000u;
-  float m;
-  std::memcpy(&m, &bits, sizeof m);
-  // Cephes: bring m into [sqrt(1/2), sqrt(2)) and take log(1 + f) by a polynomial.
-  const bool small = m < 0.707106781186547524f;
-  e -= small ? 1 : 0;
-  const float f = small ? (m + m - 1.0f) : (m - 1.0f);
-  const float z = f * f;
-  float y = 7.0376836292e-2f;
-  y = y * f - 1.1514610310e-1f;
-  y = y * f + 1.1676998740e-1f;
-  y = y * f - 1.2420140846e-1f;
-  y = y * f + 1.4249322787e-1f;
-  y = y * f - 1.6668057665e-1f;
-  y = y * f + 2.0000714765e-1f;
-  y = y * f - 2.4999993993e-1f;
-  y = y * f + 3.3333331174e-1f;
-  y = y * f * z;
-  const float fe = static_cast<float>(e);
-  y += -2.12194440e-4f * fe;
-  y += -0.5f * z;
-  return f + y + 0.693359375f * fe;
-}
-
 SurpriseKernel::SurpriseKernel(Prior prior, int min_samples) : prior_(prior), min_samples_(min_samples) {
   for (int n = 0; n <= kMaxSamples; ++n) {
     const double a = prior.a0 + 0.5 * n, a1 = a + 0.5;
@@ -81,6 +53,7 @@ SurpriseKernel::SurpriseKernel(Prior prior, int min_samples) : prior_(prior), mi
     a1_[n] = static_cast<float>(a1);
     c_[n] = static_cast<float>(0.5 * boost::math::digamma(a1) - boost::math::lgamma(a1) + boost::math::lgamma(a));
     valid_[n] = (n >= std::max(1, min_samples)) ? 1.0f : 0.0f;
+    cn_[n] = valid_[n] != 0.0f ? c_[n] : std::numeric_limits<float>::quiet_NaN();
   }
 }
 
@@ -94,15 +67,55 @@ float SurpriseKernel::at(int n, float mean, float ssd, float observed) const {
 
 void SurpriseKernel::run(const std::uint8_t* n, const float* mean, const float* ssd, const float* observed,
                          float* out, std::size_t count) const {
+  const float* means[kChannels] = {mean, nullptr, nullptr};
+  const float* ssds[kChannels] = {ssd, nullptr, nullptr};
+  const float* obs[kChannels] = {observed, nullptr, nullptr};
+  float* outs[kChannels] = {out, nullptr, nullptr};
+  run_channels(1, n, means, ssds, obs, outs, nullptr, count);
+}
+
+// Compiled twice, for AVX2 + FMA and for the x86-64 baseline (SSE2); the loader picks the clone the
+// CPU supports (GCC function multi-versioning), so the binary stays portable.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+__attribute__((target_clones("avx2,fma", "default")))
+#endif
+void SurpriseKernel::run_channels(int channels, const std::uint8_t* n, const float* const* mean, const float* const* ssd,
+                                  const float* const* observed, float* const* out, float* total,
+                                  std::size_t count) const {
+  // Blocks: the constants per pixel are gathered once (scalar), then each channel is one
+  // branch-free arithmetic loop the compiler vectorises. An unknown pixel has C = NaN, which the
+  // arithmetic carries into the result.
+  constexpr std::size_t kBlock = 512;
+  alignas(32) float a[kBlock], a1[kBlock], c[kBlock];
   const float b0 = static_cast<float>(prior_.b0);
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (std::size_t i = 0; i < count; ++i) {
-    const int k = n[i] > kMaxSamples ? kMaxSamples : n[i];
-    const float b = b0 + 0.5f * ssd[i];
-    const float d = observed[i] - mean[i];
-    const float r = b / (b + 0.5f * d * d);
-    const float kl = c_[k] - a_[k] * fast_log(r) + a1_[k] * (r - 1.0f);
-    out[i] = valid_[k] != 0.0f ? kl : nan;
+  for (std::size_t start = 0; start < count; start += kBlock) {
+    const std::size_t len = std::min(kBlock, count - start);
+    for (std::size_t i = 0; i < len; ++i) {
+      const int k = std::min<int>(n[start + i], kMaxSamples);
+      a[i] = a_[k];
+      a1[i] = a1_[k];
+      c[i] = cn_[k];
+    }
+    for (int ch = 0; ch < channels; ++ch) {
+      const float* mu = mean[ch] + start;
+      const float* s = ssd[ch] + start;
+      const float* x = observed[ch] + start;
+      float* o = out[ch] + start;
+      for (std::size_t i = 0; i < len; ++i) {
+        const float b = b0 + 0.5f * s[i];
+        const float d = x[i] - mu[i];
+        const float r = b / (b + 0.5f * d * d);
+        o[i] = c[i] - a[i] * fast_log(r) + a1[i] * (r - 1.0f);
+      }
+      if (total) {
+        float* t = total + start;
+        if (ch == 0) {
+          for (std::size_t i = 0; i < len; ++i) t[i] = o[i];
+        } else {
+          for (std::size_t i = 0; i < len; ++i) t[i] += o[i];
+        }
+      }
+    }
   }
 }
 

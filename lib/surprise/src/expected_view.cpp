@@ -75,78 +75,87 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
   view.depth_m.resize(npix, 0.0f);
   fill_depth_holes(&view.depth_m, K.width, K.height, config);
   view.count.assign(npix, 0);
-  std::array<std::vector<float>, kChannels> sum, sumsq;
-  for (int c = 0; c < kChannels; ++c) {
-    sum[c].assign(npix, 0.0f);
-    sumsq[c].assign(npix, 0.0f);
-  }
   std::vector<float> xn(static_cast<std::size_t>(K.width)), yn(static_cast<std::size_t>(K.height));
   for (int u = 0; u < K.width; ++u) xn[static_cast<std::size_t>(u)] = static_cast<float>((u - K.cx) / K.fx);
   for (int v = 0; v < K.height; ++v) yn[static_cast<std::size_t>(v)] = static_cast<float>((v - K.cy) / K.fy);
-
-  const std::size_t used = std::min(references.size(), static_cast<std::size_t>(std::min(config.max_samples, kMaxSamples)));
-  const float tol_m = static_cast<float>(config.depth_tolerance_m), tol_rel = static_cast<float>(config.depth_tolerance_rel);
-  for (std::size_t r = 0; r < used; ++r) {
-    const background::Keyframe& kf = *references[r];
-    const Intrinsics& Kr = kf.intrinsics;
-    const int rw = kf.depth.width, rh = kf.depth.height;
-    if (rw < 2 || rh < 2) continue;
-    ++view.reference_views;
-    const Eigen::Isometry3d T_ref_cam = kf.T_world_camera.inverse() * T_world_camera;
-    Eigen::Matrix3d Kmat = Eigen::Matrix3d::Identity();
-    Kmat << Kr.fx, 0, Kr.cx, 0, Kr.fy, Kr.cy, 0, 0, 1;
-    const Eigen::Matrix3f A = (Kmat * T_ref_cam.linear()).cast<float>();
-    const Eigen::Vector3f b = (Kmat * T_ref_cam.translation()).cast<float>();
-    const std::uint16_t* rdepth = kf.depth.depth_mm.data();
-    const std::uint8_t* rgb = kf.color.rgb.data();
-    const float umax = static_cast<float>(rw - 1), vmax = static_cast<float>(rh - 1);
-    for (int v = 0; v < K.height; ++v) {
-      const std::size_t row = static_cast<std::size_t>(v) * K.width;
-      const Eigen::Vector3f base = A.col(1) * yn[static_cast<std::size_t>(v)] + A.col(2);
-      for (int u = 0; u < K.width; ++u) {
-        const std::size_t i = row + static_cast<std::size_t>(u);
-        const float z = view.depth_m[i];
-        if (z <= 0.0f) continue;
-        const Eigen::Vector3f q = z * (A.col(0) * xn[static_cast<std::size_t>(u)] + base) + b;
-        if (q.z() <= 0.05f) continue;
-        const float iz = 1.0f / q.z();
-        const float ur = q.x() * iz, vr = q.y() * iz;
-        if (!(ur >= 0.0f && vr >= 0.0f && ur < umax && vr < vmax)) continue;
-        // Unoccluded: the keyframe's own depth at that pixel agrees with the point's depth in it.
-        const int ui = static_cast<int>(ur + 0.5f), vi = static_cast<int>(vr + 0.5f);
-        // Where the keyframe has no depth (glass, grazing surfaces) nothing refutes the sample.
-        const std::uint16_t mm = rdepth[static_cast<std::size_t>(vi) * rw + ui];
-        if (mm != 0 && mm != 65535 && std::abs(mm * 0.001f - q.z()) > tol_m + tol_rel * q.z()) continue;
-        // Bilinear colour.
-        const int u0 = static_cast<int>(ur), v0 = static_cast<int>(vr);
-        const float fu = ur - u0, fv = vr - v0;
-        const std::uint8_t* p00 = rgb + 3 * (static_cast<std::size_t>(v0) * rw + u0);
-        const std::uint8_t* p10 = p00 + 3;
-        const std::uint8_t* p01 = p00 + 3 * static_cast<std::size_t>(rw);
-        const std::uint8_t* p11 = p01 + 3;
-        const float w00 = (1 - fu) * (1 - fv), w10 = fu * (1 - fv), w01 = (1 - fu) * fv, w11 = fu * fv;
-        constexpr float s = 1.0f / 255.0f;
-        const float R = (w00 * p00[0] + w10 * p10[0] + w01 * p01[0] + w11 * p11[0]) * s;
-        const float G = (w00 * p00[1] + w10 * p10[1] + w01 * p01[1] + w11 * p11[1]) * s;
-        const float B = (w00 * p00[2] + w10 * p10[2] + w01 * p01[2] + w11 * p11[2]) * s;
-        const float opp[kChannels] = {(R + G + B) * (1.0f / 3.0f), R - G, B - 0.5f * (R + G)};
-        for (int c = 0; c < kChannels; ++c) {
-          sum[c][i] += opp[c];
-          sumsq[c][i] += opp[c] * opp[c];
-        }
-        ++view.count[i];
-      }
-    }
-  }
   for (int c = 0; c < kChannels; ++c) {
     view.mean[c].assign(npix, 0.0f);
     view.ssd[c].assign(npix, 0.0f);
-    for (std::size_t i = 0; i < npix; ++i) {
-      const int n = view.count[i];
+  }
+
+  // Per reference: the projection of a point of this camera, q = A p + b (pixel coordinates times
+  // depth in the reference), and its images.
+  struct Ref {
+    Eigen::Matrix3f A;
+    Eigen::Vector3f b;
+    const std::uint16_t* depth;
+    const std::uint8_t* rgb;
+    int width;
+    float umax, vmax;
+  };
+  std::vector<Ref> refs;
+  const std::size_t wanted = static_cast<std::size_t>(std::min(config.max_samples, kMaxSamples));
+  for (std::size_t r = 0; r < references.size() && refs.size() < wanted; ++r) {
+    const background::Keyframe& kf = *references[r];
+    const Intrinsics& Kr = kf.intrinsics;
+    if (kf.depth.width < 2 || kf.depth.height < 2) continue;
+    const Eigen::Isometry3d T_ref_cam = kf.T_world_camera.inverse() * T_world_camera;
+    Eigen::Matrix3d Kmat;
+    Kmat << Kr.fx, 0, Kr.cx, 0, Kr.fy, Kr.cy, 0, 0, 1;
+    refs.push_back({(Kmat * T_ref_cam.linear()).cast<float>(), (Kmat * T_ref_cam.translation()).cast<float>(),
+                    kf.depth.depth_mm.data(), kf.color.rgb.data(), kf.depth.width,
+                    static_cast<float>(kf.depth.width - 1), static_cast<float>(kf.depth.height - 1)});
+  }
+  view.reference_views = refs.size();
+
+  const float tol_m = static_cast<float>(config.depth_tolerance_m), tol_rel = static_cast<float>(config.depth_tolerance_rel);
+  for (int v = 0; v < K.height; ++v) {
+    const std::size_t row = static_cast<std::size_t>(v) * K.width;
+    for (int u = 0; u < K.width; ++u) {
+      const std::size_t i = row + static_cast<std::size_t>(u);
+      const float z = view.depth_m[i];
+      if (z <= 0.0f) continue;
+      const Eigen::Vector3f p(xn[static_cast<std::size_t>(u)] * z, yn[static_cast<std::size_t>(v)] * z, z);
+      float sum[kChannels] = {0, 0, 0}, sumsq[kChannels] = {0, 0, 0};
+      int n = 0;
+      for (const Ref& ref : refs) {
+        const Eigen::Vector3f q = ref.A * p + ref.b;
+        if (q.z() <= 0.05f) continue;
+        const float iz = 1.0f / q.z();
+        const float ur = q.x() * iz, vr = q.y() * iz;
+        if (!(ur >= 0.0f && vr >= 0.0f && ur < ref.umax && vr < ref.vmax)) continue;
+        // Unoccluded: the keyframe's own depth at that pixel agrees with the point's depth in it.
+        // Where the keyframe has no depth (glass, grazing surfaces) nothing refutes the sample.
+        const int ui = static_cast<int>(ur + 0.5f), vi = static_cast<int>(vr + 0.5f);
+        const std::uint16_t mm = ref.depth[static_cast<std::size_t>(vi) * ref.width + ui];
+        if (mm != 0 && mm != 65535 && std::abs(mm * 0.001f - q.z()) > tol_m + tol_rel * q.z()) continue;
+        // Bilinear colour in 8-bit fixed-point weights: one conversion per channel, not four.
+        const int u0 = static_cast<int>(ur), v0 = static_cast<int>(vr);
+        const int wu = static_cast<int>((ur - u0) * 256.0f), wv = static_cast<int>((vr - v0) * 256.0f);
+        const std::uint8_t* p00 = ref.rgb + 3 * (static_cast<std::size_t>(v0) * ref.width + u0);
+        const std::uint8_t* p10 = p00 + 3;
+        const std::uint8_t* p01 = p00 + 3 * static_cast<std::size_t>(ref.width);
+        const std::uint8_t* p11 = p01 + 3;
+        const int w00 = (256 - wu) * (256 - wv), w10 = wu * (256 - wv), w01 = (256 - wu) * wv, w11 = wu * wv;
+        constexpr float s = 1.0f / (255.0f * 65536.0f);
+        const float R = static_cast<float>(w00 * p00[0] + w10 * p10[0] + w01 * p01[0] + w11 * p11[0]) * s;
+        const float G = static_cast<float>(w00 * p00[1] + w10 * p10[1] + w01 * p01[1] + w11 * p11[1]) * s;
+        const float B = static_cast<float>(w00 * p00[2] + w10 * p10[2] + w01 * p01[2] + w11 * p11[2]) * s;
+        const float opp[kChannels] = {(R + G + B) * (1.0f / 3.0f), R - G, B - 0.5f * (R + G)};
+        for (int c = 0; c < kChannels; ++c) {
+          sum[c] += opp[c];
+          sumsq[c] += opp[c] * opp[c];
+        }
+        ++n;
+      }
+      view.count[i] = static_cast<std::uint8_t>(n);
       if (n == 0) continue;
-      const float mean = sum[c][i] / n;
-      view.mean[c][i] = mean;
-      view.ssd[c][i] = std::max(0.0f, sumsq[c][i] - sum[c][i] * mean);
+      const float inv = 1.0f / static_cast<float>(n);
+      for (int c = 0; c < kChannels; ++c) {
+        const float mean = sum[c] * inv;
+        view.mean[c][i] = mean;
+        view.ssd[c][i] = std::max(0.0f, sumsq[c] - sum[c] * mean);
+      }
     }
   }
   return view;

@@ -37,12 +37,19 @@ Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage&
     to_opponent(observed.rgb[3 * i], observed.rgb[3 * i + 1], observed.rgb[3 * i + 2], opp);
     for (int c = 0; c < kChannels; ++c) obs[c][i] = opp[c];
   }
-  map.total.assign(n, 0.0f);
+  map.total.resize(n);
+  const float* means[kChannels];
+  const float* ssds[kChannels];
+  const float* observed_ch[kChannels];
+  float* outs[kChannels];
   for (int c = 0; c < kChannels; ++c) {
     map.channel[c].resize(n);
-    kernel.run(view.count.data(), view.mean[c].data(), view.ssd[c].data(), obs[c].data(), map.channel[c].data(), n);
-    for (std::size_t i = 0; i < n; ++i) map.total[i] += map.channel[c][i];
+    means[c] = view.mean[c].data();
+    ssds[c] = view.ssd[c].data();
+    observed_ch[c] = obs[c].data();
+    outs[c] = map.channel[c].data();
   }
+  kernel.run_channels(kChannels, view.count.data(), means, ssds, observed_ch, outs, map.total.data(), n);
   for (std::size_t i = 0; i < n; ++i) map.known_pixels += std::isnan(map.total[i]) ? 0 : 1;
   return map;
 }

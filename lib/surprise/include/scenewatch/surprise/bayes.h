@@ -12,6 +12,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstring>
 
 namespace scenewatch::surprise {
 
@@ -52,7 +53,34 @@ double bayesian_surprise(const double* samples, int n, double observed, const Pr
 
 /// Natural logarithm for positive normal floats, branch-free so that loops over it vectorise
 /// (Cephes' logf polynomial; error below 2 ulp on (0, inf)).
-float fast_log(float x);
+inline float fast_log(float x) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const std::int32_t e0 = static_cast<std::int32_t>((bits >> 23) & 0xffu) - 126;  // x = m * 2^e, m in [0.5, 1)
+  bits = (bits & 0x007fffffu) | 0x3f000000u;
+  float m;
+  std::memcpy(&m, &bits, sizeof m);
+  // Cephes: bring m into [sqrt(1/2), sqrt(2)) and take log(1 + f) by a polynomial.
+  // m < sqrt(1/2), compared on the bits (positive floats order like integers): a float compare
+  // may trap on NaN, so GCC would keep a branch and not vectorise loops over this function.
+  const float small = static_cast<float>(static_cast<std::int32_t>(bits < 0x3f3504f3u));
+  const float fe = static_cast<float>(e0) - small;
+  const float f = m + m * small - 1.0f;
+  const float z = f * f;
+  float y = 7.0376836292e-2f;
+  y = y * f - 1.1514610310e-1f;
+  y = y * f + 1.1676998740e-1f;
+  y = y * f - 1.2420140846e-1f;
+  y = y * f + 1.4249322787e-1f;
+  y = y * f - 1.6668057665e-1f;
+  y = y * f + 2.0000714765e-1f;
+  y = y * f - 2.4999993993e-1f;
+  y = y * f + 3.3333331174e-1f;
+  y = y * f * z;
+  y += -2.12194440e-4f * fe;
+  y += -0.5f * z;
+  return f + y + 0.693359375f * fe;
+}
 
 /// The per-pixel surprise with the constants per n precomputed. Thread safe after construction.
 class SurpriseKernel {
@@ -64,6 +92,9 @@ class SurpriseKernel {
   /// squared deviations from it, and the observed value; writes the KL in nats (NaN: unknown).
   void run(const std::uint8_t* n, const float* mean, const float* ssd, const float* observed, float* out,
            std::size_t count) const;
+  /// `channels` channels at once (pointer arrays), also summing them into `total` when not null.
+  void run_channels(int channels, const std::uint8_t* n, const float* const* mean, const float* const* ssd,
+                    const float* const* observed, float* const* out, float* total, std::size_t count) const;
   /// The same for one pixel (float, fast log).
   float at(int n, float mean, float ssd, float observed) const;
 
@@ -75,6 +106,7 @@ class SurpriseKernel {
   int min_samples_;
   // Per n = 0..kMaxSamples: a, a' and C(n); valid[n] is 0 below min_samples.
   std::array<float, kMaxSamples + 1> a_{}, a1_{}, c_{}, valid_{};
+  std::array<float, kMaxSamples + 1> cn_{};  ///< C(n), NaN below min_samples
 };
 
 }  // namespace scenewatch::surprise
