@@ -22,7 +22,8 @@ Status YamlSection::finish() const {
 }
 
 const std::vector<std::string>& pipeline_sections() {
-  static const std::vector<std::string> kSections = {"background", "segmentation", "tracking", "events"};
+  static const std::vector<std::string> kSections = {"background", "segmentation", "tracking",
+                                                     "appearance", "surprise", "events"};
   return kSections;
 }
 
@@ -80,6 +81,42 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
     if (auto st = s.check_is_map(); !st) return st;
     if (auto st = read_all([&] { return s.read("match_distance_m", c.tracking.match_distance_m); },
                            [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); });
+        !st)
+      return st;
+    if (auto st = s.finish(); !st) return st;
+  }
+  {
+    YamlSection s(root["appearance"], "appearance");
+    if (auto st = s.check_is_map(); !st) return st;
+    background::AppearanceConfig& a = c.appearance;
+    if (auto st = read_all([&] { return s.read("enabled", a.enabled); },
+                           [&] { return s.read("keyframe_min_translation_m", a.keyframe_min_translation_m); },
+                           [&] { return s.read("keyframe_min_rotation_deg", a.keyframe_min_rotation_deg); },
+                           [&] { return s.read("max_keyframes", a.max_keyframes); },
+                           [&] { return s.read("memory_budget_mb", a.memory_budget_mb); },
+                           [&] { return s.read("mesh_stride_px", a.mesh_stride_px); },
+                           [&] { return s.read("mesh_max_depth_jump", a.mesh_max_depth_jump); },
+                           [&] { return s.read("depth_views", a.depth_views); });
+        !st)
+      return st;
+    if (auto st = s.finish(); !st) return st;
+  }
+  {
+    YamlSection s(root["surprise"], "surprise");
+    if (auto st = s.check_is_map(); !st) return st;
+    surprise::SurpriseConfig& u = c.surprise;
+    if (auto st = read_all([&] { return s.read("enabled", u.enabled); }, [&] { return s.read("a0", u.prior.a0); },
+                           [&] { return s.read("b0", u.prior.b0); }, [&] { return s.read("min_samples", u.min_samples); },
+                           [&] { return s.read("max_samples", u.view.max_samples); },
+                           [&] { return s.read("depth_tolerance_m", u.view.depth_tolerance_m); },
+                           [&] { return s.read("depth_tolerance_rel", u.view.depth_tolerance_rel); },
+                           [&] { return s.read("fill_holes_px", u.view.fill_holes_px); },
+                           [&] { return s.read("fill_holes_max_jump", u.view.fill_holes_max_jump); },
+                           [&] { return s.read("threshold_high", u.regions.threshold_high); },
+                           [&] { return s.read("threshold_low", u.regions.threshold_low); },
+                           [&] { return s.read("open_radius_px", u.regions.open_radius_px); },
+                           [&] { return s.read("min_area_px", u.regions.min_area_px); },
+                           [&] { return s.read("min_extent_px", u.regions.min_extent_px); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

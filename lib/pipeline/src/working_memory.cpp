@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "appearance_stage.h"
 #include "model_store.h"
 
 namespace scenewatch::pipeline {
@@ -67,13 +68,15 @@ constexpr std::size_t kSamplesPerObject = 200;
 }  // namespace
 
 struct WorkingMemory::Impl {
-  explicit Impl(const Config& c) : map(c.background), snapshot(std::make_shared<SceneSnapshot>()) {}
+  explicit Impl(const Config& c)
+      : map(c.background), appearance(c.appearance, c.surprise), snapshot(std::make_shared<SceneSnapshot>()) {}
 
   // process() and the other writers hold this for their whole duration.
   mutable std::mutex writer;
   // Guards `map` between writers and concurrent occupancy readers.
   mutable std::shared_mutex map_mutex;
   background::OccupancyMap map;
+  AppearanceStage appearance;  // keyframes, mesh and image surprise; locks itself for readers
 
   // Owned by the writer.
   std::vector<TrackedObject> objects;
@@ -125,6 +128,8 @@ Status validate(const Config& c) {
   if (!(c.tracking.match_distance_m > 0 && c.tracking.match_distance_m < 5)) return invalid_argument("tracking.match_distance_m: must be in (0, 5) m");
   if (!(c.tracking.gone_free_fraction > 0 && c.tracking.gone_free_fraction <= 1)) return invalid_argument("tracking.gone_free_fraction: must be in (0, 1]");
   if (c.max_event_log < 1) return invalid_argument("events.max_log: must be >= 1");
+  if (auto st = background::validate(c.appearance); !st) return st;
+  if (auto st = surprise::validate(c.surprise); !st) return st;
   return {};
 }
 
@@ -191,6 +196,12 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
       if (cluster_match[c] < 0) prior_free[c] = free_fraction(samples[c]);
     }
   }
+
+  // Image-based surprise against the appearance memory, then its keyframe update.
+  const auto t_surprise = Clock::now();
+  result.surprise = m.appearance.process(frame);
+  result.surprise_ms = ms_since(t_surprise);
+  if (result.surprise) events.insert(events.end(), result.surprise->events.begin(), result.surprise->events.end());
 
   // Update the background.
   const auto t_ins = Clock::now();
@@ -294,6 +305,9 @@ Stats WorkingMemory::stats() const {
     s.last_frame_ms = impl_->last_ms;
     s.mean_frame_ms = impl_->frames ? impl_->total_ms / impl_->frames : 0.0;
     s.tracked_objects = impl_->objects.size();
+    s.keyframes = impl_->appearance.keyframes();
+    s.mesh_triangles = impl_->appearance.triangles();
+    s.appearance_memory_bytes = impl_->appearance.memory_bytes();
     std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
     s.map_leaf_nodes = impl_->map.num_leaf_nodes();
     s.map_occupied_leaves = impl_->map.num_occupied_leaves();
@@ -327,6 +341,7 @@ void WorkingMemory::reset() {
     std::unique_lock<std::shared_mutex> write(impl_->map_mutex);
     impl_->map.reset();
   }
+  impl_->appearance.reset();
   impl_->objects.clear();
   impl_->object_samples.clear();
   impl_->planes.clear();
@@ -365,6 +380,7 @@ Status WorkingMemory::save(const fs::path& model_dir) const {
       scene["next_event_id"] = m.next_event_id;
       for (const auto& e : m.events) log += to_json(e).dump() + "\n";
     }
+    if (auto st = m.appearance.save(dir); !st) return st;
     if (auto st = write_file_synced(dir / "scene.json", scene.dump(2)); !st) return st;
     return write_file_synced(dir / "events.jsonl", log);
   });
@@ -426,6 +442,8 @@ Status WorkingMemory::load(const fs::path& model_dir) {
 
   std::lock_guard<std::mutex> lock(impl_->writer);
   Impl& m = *impl_;
+  // Keyframes last among the reads: AppearanceStage::load changes nothing when it fails.
+  if (auto st = m.appearance.load(*dir); !st) return st;
   {
     std::unique_lock<std::shared_mutex> write(m.map_mutex);
     m.map = std::move(map);
@@ -467,5 +485,14 @@ std::vector<Event> WorkingMemory::events_since(std::uint64_t since, std::size_t 
   }
   return out;
 }
+
+Result<std::shared_ptr<const SurpriseResult>> WorkingMemory::surprise(const Frame& observation) const {
+  if (auto st = validate_frame(observation); !st) return st.error();
+  return impl_->appearance.evaluate(observation);
+}
+
+std::shared_ptr<const SurpriseResult> WorkingMemory::last_surprise() const { return impl_->appearance.last(); }
+
+Status WorkingMemory::write_mesh(const fs::path& path) const { return impl_->appearance.write_mesh(path); }
 
 }  // namespace scenewatch::pipeline

@@ -63,6 +63,16 @@ Status validate(const RegionConfig& c) {
   return {};
 }
 
+Status validate(const SurpriseConfig& c) {
+  if (auto st = validate(c.view); !st) return st;
+  if (auto st = validate(c.regions); !st) return st;
+  if (!(c.prior.a0 > 0)) return invalid_argument("surprise.a0 must be > 0");
+  if (!(c.prior.b0 > 0)) return invalid_argument("surprise.b0 must be > 0");
+  if (c.min_samples < 1 || c.min_samples > kMaxSamples)
+    return invalid_argument("surprise.min_samples must be in [1, " + std::to_string(kMaxSamples) + "]");
+  return {};
+}
+
 std::vector<SurpriseRegion> find_regions(const SurpriseMap& map, const ExpectedView& view, const DepthImage* observed_depth,
                                          const RegionConfig& config) {
   std::vector<SurpriseRegion> regions;

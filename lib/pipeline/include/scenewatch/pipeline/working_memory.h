@@ -12,12 +12,14 @@
 #include <shared_mutex>
 #include <vector>
 
+#include "scenewatch/background/appearance.h"
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
 #include "scenewatch/segmentation/tabletop.h"
+#include "scenewatch/surprise/surprise_map.h"
 
 namespace scenewatch::pipeline {
 
@@ -33,7 +35,20 @@ struct Config {
   background::Config background;
   segmentation::Config segmentation;
   TrackingConfig tracking;
+  background::AppearanceConfig appearance;  ///< keyframes and mesh (posed RGB-D frames only)
+  surprise::SurpriseConfig surprise;        ///< image-based Bayesian surprise
   std::size_t max_event_log = 10000;  ///< events kept in memory for GetEvents
+};
+
+/// The image-based surprise of one observation against the appearance memory.
+struct SurpriseResult {
+  surprise::SurpriseMap map;
+  std::vector<Event> events;  ///< APPEARANCE_CHANGE regions (ids set only when emitted by process())
+  std::size_t reference_views = 0;
+  Pose T_world_camera = Pose::Identity();
+  Intrinsics intrinsics;
+  double stamp_s = 0.0;
+  double ms = 0.0;
 };
 
 Status validate(const Config& config);
@@ -45,7 +60,8 @@ struct FrameResult {
   std::vector<ObjectCluster> objects;   ///< world frame, indices into the frame's cloud
   std::vector<Event> events;
   background::InsertStats insert_stats;
-  double segment_ms = 0, insert_ms = 0, total_ms = 0;
+  std::shared_ptr<const SurpriseResult> surprise;  ///< null: the frame had no pose or no keyframes existed yet
+  double segment_ms = 0, insert_ms = 0, surprise_ms = 0, total_ms = 0;
 };
 
 /// An immutable view of the scene, swapped atomically after each frame: readers never wait for
@@ -65,6 +81,7 @@ struct Stats {
   double map_resolution_m = 0;
   double last_frame_ms = 0, mean_frame_ms = 0;
   std::size_t tracked_objects = 0;
+  std::size_t keyframes = 0, mesh_triangles = 0, appearance_memory_bytes = 0;
 };
 
 using EventCallback = std::function<void(const Event&)>;
@@ -97,6 +114,14 @@ class WorkingMemory {
   void unsubscribe(int token);
   /// Events with id > since, oldest first, at most max_count.
   std::vector<Event> events_since(std::uint64_t since, std::size_t max_count = 1000) const;
+
+  /// The surprise of an observation (organized, with intrinsics, colour and usually a pose)
+  /// against the appearance memory. Nothing in the model changes. kNotFound before any keyframe.
+  Result<std::shared_ptr<const SurpriseResult>> surprise(const Frame& observation) const;
+  /// The surprise of the last processed frame that had one (null before).
+  std::shared_ptr<const SurpriseResult> last_surprise() const;
+  /// Writes the background's textured mesh as PLY. kNotFound before any keyframe.
+  Status write_mesh(const std::filesystem::path& path) const;
 
   const Config& config() const { return config_; }
 

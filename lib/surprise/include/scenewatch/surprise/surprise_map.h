@@ -53,6 +53,18 @@ struct SurpriseRegion {
 std::vector<SurpriseRegion> find_regions(const SurpriseMap& map, const ExpectedView& view,
                                          const DepthImage* observed_depth, const RegionConfig& config);
 
+/// Everything the image-based surprise needs, as the `surprise:` config section.
+struct SurpriseConfig {
+  bool enabled = true;
+  ExpectedViewConfig view;
+  Prior prior;
+  /// Fewer reference samples at a pixel: unknown. 1 lets a static camera (one keyframe) work,
+  /// with the prior alone setting the colour noise.
+  int min_samples = 1;
+  RegionConfig regions;
+};
+Status validate(const SurpriseConfig& config);
+
 /// An APPEARANCE_CHANGE event (level MISMATCH) with the region's evidence.
 Event to_event(const SurpriseRegion& region, double stamp_s);
 

@@ -1,0 +1,131 @@
+#include "appearance_stage.h"
+
+#include <chrono>
+#include <mutex>
+
+#include "scenewatch/io/cloud_io.h"
+
+namespace scenewatch::pipeline {
+namespace {
+
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// An organized frame with intrinsics and colour: the only kind the image path can use.
+Status check_observation(const Frame& frame) {
+  const std::string where = frame.source.empty() ? std::string("frame") : "frame from '" + frame.source + "'";
+  if (!frame.cloud || frame.cloud->height <= 1) return invalid_argument(where + ": surprise needs an organized (RGB-D) frame");
+  if (!frame.intrinsics) return invalid_argument(where + ": surprise needs camera intrinsics");
+  if (!frame.has_color) return invalid_argument(where + ": surprise needs colour");
+  return {};
+}
+
+}  // namespace
+
+AppearanceStage::AppearanceStage(const background::AppearanceConfig& appearance, const surprise::SurpriseConfig& surprise)
+    : appearance_config_(appearance), config_(surprise), kernel_(surprise.prior, surprise.min_samples), memory_(appearance) {}
+
+Result<std::shared_ptr<SurpriseResult>> AppearanceStage::compute(const Frame& frame, const background::Keyframe& observed) const {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Pose pose = frame.pose_or_identity();
+  auto result = std::make_shared<SurpriseResult>();
+  const surprise::ExpectedView view = surprise::render_expected_view(memory_, pose, *frame.intrinsics, config_.view);
+  auto map = surprise::compute_surprise(view, observed.color, kernel_);
+  if (!map) return map.error();
+  for (const auto& region : surprise::find_regions(*map, view, &observed.depth, config_.regions)) {
+    result->events.push_back(surprise::to_event(region, frame.stamp_s));
+  }
+  result->map = std::move(*map);
+  result->reference_views = view.reference_views;
+  result->T_world_camera = pose;
+  result->intrinsics = *frame.intrinsics;
+  result->stamp_s = frame.stamp_s;
+  result->ms = ms_since(t0);
+  return result;
+}
+
+std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& frame) {
+  if (!appearance_config_.enabled && !config_.enabled) return nullptr;
+  // Without a pose the camera frame would be taken as the world: keyframes from a moving camera
+  // would then be placed wrongly, so only posed frames take part.
+  if (!frame.T_world_camera || !check_observation(frame).ok()) return nullptr;
+  auto observed = background::keyframe_from_frame(frame);
+  if (!observed) return nullptr;
+  std::shared_ptr<const SurpriseResult> result;
+  {
+    std::shared_lock<std::shared_mutex> read(mutex_);
+    if (config_.enabled && memory_.size() > 0) {
+      auto computed = compute(frame, *observed);
+      if (computed) result = std::move(*computed);
+    }
+  }
+  std::unique_lock<std::shared_mutex> write(mutex_);
+  if (result) last_ = result;
+  if (appearance_config_.enabled) (void)memory_.consider(std::move(*observed));
+  return result;
+}
+
+Result<std::shared_ptr<const SurpriseResult>> AppearanceStage::evaluate(const Frame& observation) const {
+  if (auto st = check_observation(observation); !st) return st.error();
+  auto observed = background::keyframe_from_frame(observation);
+  if (!observed) return observed.error();
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  if (memory_.size() == 0) return not_found("the appearance memory has no keyframes yet: ingest posed RGB-D frames first");
+  auto computed = compute(observation, *observed);
+  if (!computed) return computed.error();
+  return std::shared_ptr<const SurpriseResult>(std::move(*computed));
+}
+
+std::shared_ptr<const SurpriseResult> AppearanceStage::last() const {
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  return last_;
+}
+
+Status AppearanceStage::write_mesh(const std::filesystem::path& path) const {
+  ColoredMesh mesh;
+  {
+    std::shared_lock<std::shared_mutex> read(mutex_);
+    mesh = memory_.mesh();
+  }
+  if (mesh.empty()) return not_found("the appearance memory has no mesh yet: ingest posed RGB-D frames first");
+  return io::write_mesh_ply(path, mesh);
+}
+
+Status AppearanceStage::save(const std::filesystem::path& dir) const {
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  if (auto st = memory_.save(dir / "keyframes"); !st) return st;
+  const ColoredMesh mesh = memory_.mesh();
+  if (!mesh.empty()) return io::write_mesh_ply(dir / "mesh.ply", mesh);
+  return {};
+}
+
+Status AppearanceStage::load(const std::filesystem::path& dir) {
+  background::AppearanceMemory loaded(appearance_config_);
+  if (auto st = loaded.load(dir / "keyframes"); !st) return st;
+  std::unique_lock<std::shared_mutex> write(mutex_);
+  memory_ = std::move(loaded);
+  last_.reset();
+  return {};
+}
+
+void AppearanceStage::reset() {
+  std::unique_lock<std::shared_mutex> write(mutex_);
+  memory_.clear();
+  last_.reset();
+}
+
+std::size_t AppearanceStage::keyframes() const {
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  return memory_.size();
+}
+std::size_t AppearanceStage::triangles() const {
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  return memory_.triangle_count();
+}
+std::size_t AppearanceStage::memory_bytes() const {
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  return memory_.memory_bytes();
+}
+
+}  // namespace scenewatch::pipeline

@@ -1,0 +1,49 @@
+#pragma once
+// The pipeline's appearance path: expected view at the frame's pose, Bayesian surprise, regions
+// as APPEARANCE_CHANGE events, then the keyframe memory is updated. Thread safe: process() and
+// the writers are serialised by the working memory; readers (surprise of an observation, the
+// last map, the mesh) take a shared lock.
+#include <filesystem>
+#include <memory>
+#include <shared_mutex>
+
+#include "scenewatch/background/appearance.h"
+#include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/surprise/surprise_map.h"
+
+namespace scenewatch::pipeline {
+
+class AppearanceStage {
+ public:
+  AppearanceStage(const background::AppearanceConfig& appearance, const surprise::SurpriseConfig& surprise);
+
+  /// A frame with a pose, intrinsics and an organized colour cloud: its surprise against the
+  /// memory (when the memory has keyframes), then the keyframe update. Other frames are skipped
+  /// (null result). Events come without ids.
+  std::shared_ptr<const SurpriseResult> process(const Frame& frame);
+
+  /// The surprise of an observation against the memory; nothing changes.
+  Result<std::shared_ptr<const SurpriseResult>> evaluate(const Frame& observation) const;
+  std::shared_ptr<const SurpriseResult> last() const;
+
+  Status write_mesh(const std::filesystem::path& path) const;
+  Status save(const std::filesystem::path& dir) const;
+  /// Replaces the keyframes by those in dir; on error nothing changes.
+  Status load(const std::filesystem::path& dir);
+  void reset();
+  std::size_t keyframes() const;
+  std::size_t triangles() const;
+  std::size_t memory_bytes() const;
+
+ private:
+  Result<std::shared_ptr<SurpriseResult>> compute(const Frame& frame, const background::Keyframe& observed) const;
+
+  background::AppearanceConfig appearance_config_;
+  surprise::SurpriseConfig config_;
+  surprise::SurpriseKernel kernel_;
+  mutable std::shared_mutex mutex_;
+  background::AppearanceMemory memory_;
+  std::shared_ptr<const SurpriseResult> last_;
+};
+
+}  // namespace scenewatch::pipeline

@@ -1,0 +1,102 @@
+// The appearance path inside the working memory: posed RGB-D frames of the simulator's cup_added
+// build keyframes; after the cup is put on the table, APPEARANCE_CHANGE events arise where it
+// stands, and not while nothing changed. The keyframes survive save and load.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "scenewatch/io/cloud_io.h"
+#include "scenewatch/io/rgbd.h"
+#include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/sim/scenario_yaml.h"
+#include "scenewatch/sim/simulator.h"
+#include "test_data.h"
+
+namespace scenewatch::pipeline {
+namespace {
+
+Frame posed_frame(const sim::SimFrame& rendered, const Intrinsics& K, double stamp) {
+  auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, K);
+  EXPECT_TRUE(cloud.ok());
+  Frame frame;
+  frame.cloud = *cloud;
+  frame.T_world_camera = rendered.truth.T_world_camera_reported;
+  frame.intrinsics = K;
+  frame.stamp_s = stamp;
+  frame.source = "sim";
+  return frame;
+}
+
+TEST(AppearancePipeline, CupAddedRaisesAppearanceChangeWhereTheCupStands) {
+  auto loaded = sim::load_scenario(test::source_dir() / "sample_clouds/scenarios/cup_added.yaml");
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  const sim::Scenario scenario = sim::with_frames(sim::with_resolution(*loaded, 320, 240), 12);
+  auto simulator = sim::Simulator::create(scenario);
+  ASSERT_TRUE(simulator.ok()) << simulator.error().message;
+  const Eigen::Vector3d cup(-0.15, -0.08, 0.8);  // from cup_added.yaml (table top at 0.75 m)
+
+  Config config;
+  config.segmentation.up = Eigen::Vector3d::UnitZ();
+  WorkingMemory memory(config);
+  std::vector<Event> appearance[2];
+  double stamp = 0;
+  Frame last;
+  for (std::size_t phase = 0; phase < 2; ++phase) {
+    for (int f = 0; f < simulator->frame_count(phase); ++f) {
+      const Frame frame = posed_frame(simulator->render(phase, f), scenario.intrinsics, stamp += 0.1);
+      auto result = memory.process(frame);
+      ASSERT_TRUE(result.ok()) << result.error().message;
+      if (phase == 0 && f > 0) {
+        ASSERT_TRUE(result->surprise) << "frame " << f << " had a pose and keyframes existed";
+        EXPECT_GT(result->surprise->map.known_pixels, 0u);
+      }
+      for (const auto& e : result->events) {
+        if (e.kind != EventKind::kAppearanceChange) continue;
+        appearance[phase].push_back(e);
+        std::printf("phase %zu frame %d: %s\n", phase, f, e.detail.c_str());
+      }
+      last = frame;
+    }
+  }
+  EXPECT_TRUE(appearance[0].empty()) << "nothing changed in the first phase";
+  ASSERT_FALSE(appearance[1].empty()) << "the cup was not noticed";
+  std::size_t at_cup = 0;
+  for (const auto& e : appearance[1]) {
+    ASSERT_TRUE(e.region.has_value());
+    EXPECT_GT(e.evidence.at("kl_peak_total"), 0.0);
+    EXPECT_EQ(e.level, EventLevel::kMismatch);
+    at_cup += (e.centroid_world.head<2>() - cup.head<2>()).norm() < 0.08 ? 1 : 0;
+  }
+  EXPECT_GE(at_cup, appearance[1].size() * 8 / 10) << "events away from the cup";
+  EXPECT_GE(memory.stats().keyframes, 1u);
+
+  // The keyframes and the mesh are saved with the model and come back.
+  test::TempDir dir("appearance-model");
+  ASSERT_TRUE(memory.save(dir.path()).ok());
+  EXPECT_TRUE(std::filesystem::exists(dir / "current" / "mesh.ply"));
+  WorkingMemory restored(config);
+  ASSERT_TRUE(restored.load(dir.path()).ok());
+  EXPECT_EQ(restored.stats().keyframes, memory.stats().keyframes);
+  auto a = memory.surprise(last), b = restored.surprise(last);
+  ASSERT_TRUE(a.ok() && b.ok());
+  EXPECT_EQ((*a)->events.size(), (*b)->events.size());
+  EXPECT_EQ((*a)->map.known_pixels, (*b)->map.known_pixels);
+
+  // Bad observations are refused with the reason; an unposed cloud file is not an image.
+  Frame unorganized = last;
+  auto flat = std::make_shared<Cloud>(*last.cloud);
+  flat->width = static_cast<std::uint32_t>(flat->size());
+  flat->height = 1;
+  unorganized.cloud = flat;
+  unorganized.intrinsics.reset();
+  auto refused = memory.surprise(unorganized);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("organized"), std::string::npos) << refused.error().message;
+  WorkingMemory empty(config);
+  auto none = empty.surprise(last);
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.error().code, ErrorCode::kNotFound);
+}
+
+}  // namespace
+}  // namespace scenewatch::pipeline
