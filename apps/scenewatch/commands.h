@@ -4,6 +4,9 @@
 #include <string>
 #include <vector>
 
+#include "scenewatch.pb.h"
+#include "scenewatch/core/frame.h"
+#include "scenewatch/core/result.h"
 #include "scenewatch/service/server_config.h"
 
 namespace scenewatch::cli {
@@ -36,6 +39,33 @@ int run_save(const RemoteOptions& options);
 int run_load(const RemoteOptions& options);
 int run_events(const RemoteOptions& options, std::uint64_t since, std::uint32_t max_count);
 int run_watch(const RemoteOptions& options);
+
+struct SurpriseOptions {
+  std::string observed;                 ///< frame spec (see frame_spec.h); empty: the daemon's last map
+  std::vector<std::string> references;  ///< frame specs; empty: ask the daemon
+  std::string out_png;                  ///< heatmap over the observed image
+  std::string raw_tiff;                 ///< float32 surprise per pixel
+  std::string expected_png;             ///< the expected (virtual) image
+  std::string mesh_ply;                 ///< the references' textured mesh
+  std::string intrinsics;               ///< 3x3 K file for cloud files (else recovered)
+  std::string config;                   ///< YAML: its appearance and surprise sections
+  double saturation = 24.0;             ///< heatmap scale in nats
+  bool json = false;
+};
+/// Image-based surprise of an observed frame against reference frames (offline), or against the
+/// daemon's appearance memory when no reference is given.
+int run_surprise(const SurpriseOptions& options, const RemoteOptions& remote);
+
+/// The daemon's surprise map (GetSurpriseMap): of `observed` when set, else of its last frame.
+struct RemoteSurprise {
+  int width = 0, height = 0;
+  std::vector<float> total;
+  std::uint64_t known_pixels = 0;
+  std::uint32_t reference_views = 0;
+  std::vector<proto::Event> regions;
+  double compute_ms = 0;
+};
+Result<RemoteSurprise> fetch_surprise(const RemoteOptions& options, const Frame* observed);
 
 struct SegmentOptions {
   std::string file;

@@ -101,7 +101,10 @@ nlohmann::json to_json(const proto::StatsReply& s) {
           {"mean_frame_ms", s.mean_frame_ms()},
           {"tracked_objects", s.tracked_objects()},
           {"connections", s.connections()},
-          {"uptime_s", s.uptime_s()}};
+          {"uptime_s", s.uptime_s()},
+          {"keyframes", s.keyframes()},
+          {"mesh_triangles", s.mesh_triangles()},
+          {"appearance_memory_bytes", s.appearance_memory_bytes()}};
 }
 
 nlohmann::json to_json(const proto::IngestReply& ingest) {

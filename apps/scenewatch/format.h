@@ -2,6 +2,7 @@
 // Output of the CLI: protocol messages as JSON (nlohmann) and as human-readable text.
 #include <nlohmann/json.hpp>
 
+#include <iostream>
 #include <string>
 
 #include "scenewatch.pb.h"
@@ -29,5 +30,28 @@ std::string text(const proto::Plane& plane);
 std::string text(const proto::Object& object);
 std::string text(const proto::Cluster& cluster);
 std::string text(const proto::Event& event);
+
+/// Progress of a sequence on stderr, for terminals.
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled) {}
+  ~ProgressBar() { clear(); }
+  void draw(std::size_t done, std::size_t total, const std::string& label) {
+    if (!enabled_) return;
+    constexpr std::size_t kWidth = 30;
+    const std::size_t filled = total == 0 ? kWidth : done * kWidth / total;
+    std::cerr << "\r\033[K[" << std::string(filled, '#') << std::string(kWidth - filled, '.') << "] " << done << "/"
+              << total << " " << label << std::flush;
+    shown_ = true;
+  }
+  void clear() {
+    if (enabled_ && shown_) std::cerr << "\r\033[K" << std::flush;
+    shown_ = false;
+  }
+
+ private:
+  bool enabled_;
+  bool shown_ = false;
+};
 
 }  // namespace scenewatch::cli

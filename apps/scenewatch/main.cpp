@@ -116,6 +116,39 @@ int main(int argc, char** argv) {
   segment->add_flag("--plane-indices", segment_options.plane_indices, "with --json: also list plane inlier indices");
   segment->callback([&] { action = [&] { return run_segment(segment_options); }; });
 
+  SurpriseOptions surprise_options;
+  auto* surprise = app.add_subcommand(
+      "surprise",
+      "image-based Bayesian surprise of an observed RGB-D frame: offline against --reference frames, or "
+      "from the daemon's appearance memory when no reference is given");
+  surprise->footer(
+      "Frames: FILE.pcd|FILE.ply (an organized cloud, same camera as its references; intrinsics are recovered "
+      "from its points unless --intrinsics), SEQDIR (every frame of a sequence, with its poses), SEQDIR:N (frame "
+      "N, 0-based), SEQDIR:A-B.\n"
+      "Examples:\n"
+      "  scenewatch surprise after/:40 --reference before/ --out heat.png --raw kl.tiff\n"
+      "  scenewatch surprise learn13.pcd --reference learn12.pcd --json\n"
+      "  scenewatch surprise --out heat.png          (the daemon's last posed frame)");
+  surprise->add_option("observed", surprise_options.observed, "the observed frame (optional with the daemon)");
+  surprise->add_option("--reference,-r", surprise_options.references,
+                       "reference frames (repeatable); without any, the daemon is asked");
+  surprise->add_option("--out,-o", surprise_options.out_png, "write the surprise as a heatmap over the observed image (PNG)");
+  surprise->add_option("--raw", surprise_options.raw_tiff, "write the total surprise per pixel, KL in nats, as 32-bit float TIFF (NaN: unknown)");
+  surprise->add_option("--expected", surprise_options.expected_png, "offline: write the expected (virtual) image (PNG)");
+  surprise->add_option("--mesh", surprise_options.mesh_ply, "offline: write the references' textured mesh (PLY)");
+  surprise->add_option("--intrinsics", surprise_options.intrinsics, "3x3 camera matrix file for cloud files");
+  surprise->add_option("--config", surprise_options.config, "YAML config (its appearance and surprise sections are used)");
+  surprise->add_option("--saturation", surprise_options.saturation, "heatmap scale: nats shown as the hottest colour")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  add_remote_options(surprise, remote);  // --json among them: regions as APPEARANCE_CHANGE events
+  surprise->callback([&] {
+    action = [&] {
+      surprise_options.json = remote.json;
+      return run_surprise(surprise_options, remote);
+    };
+  });
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

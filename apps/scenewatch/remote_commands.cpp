@@ -61,29 +61,6 @@ std::string naming(const std::string& path, const std::string& message) {
   return message.find(path) != std::string::npos ? message : path + ": " + message;
 }
 
-/// Progress of a sequence on stderr, for terminals.
-class ProgressBar {
- public:
-  explicit ProgressBar(bool enabled) : enabled_(enabled) {}
-  ~ProgressBar() { clear(); }
-  void draw(std::size_t done, std::size_t total, const std::string& label) {
-    if (!enabled_) return;
-    constexpr std::size_t kWidth = 30;
-    const std::size_t filled = total == 0 ? kWidth : done * kWidth / total;
-    std::cerr << "\r\033[K[" << std::string(filled, '#') << std::string(kWidth - filled, '.') << "] " << done << "/"
-              << total << " " << label << std::flush;
-    shown_ = true;
-  }
-  void clear() {
-    if (enabled_ && shown_) std::cerr << "\r\033[K" << std::flush;
-    shown_ = false;
-  }
-
- private:
-  bool enabled_;
-  bool shown_ = false;
-};
-
 void print_ingest(const RemoteOptions& options, const std::string& source, const proto::IngestReply& reply) {
   if (options.json) {
     json j = to_json(reply);
@@ -103,6 +80,33 @@ volatile sig_atomic_t g_interrupted = 0;
 void on_interrupt(int) { g_interrupted = 1; }
 
 }  // namespace
+
+Result<RemoteSurprise> fetch_surprise(const RemoteOptions& options, const Frame* observed) {
+  auto client = connect(options);
+  if (!client) return client.error();
+  proto::Request request;
+  auto* msg = request.mutable_get_surprise_map();
+  if (observed) *msg->mutable_frame() = service::make_ingest_frame(*observed);
+  auto response = client->call(std::move(request), options.timeout_s);
+  if (!response) return response.error();
+  if (response->status().code() != proto::Status::OK) {
+    const auto code = response->status().code() == proto::Status::NOT_FOUND ? ErrorCode::kNotFound : ErrorCode::kInvalidArgument;
+    return Error{code, service::to_string(response->status().code()) + ": " + response->status().message()};
+  }
+  if (!response->has_surprise_map()) return Error{ErrorCode::kInternal, "the daemon answered without a surprise map"};
+  const auto& reply = response->surprise_map();
+  RemoteSurprise out;
+  out.width = static_cast<int>(reply.width());
+  out.height = static_cast<int>(reply.height());
+  auto total = service::decode_float_map(reply.total(), static_cast<std::size_t>(out.width) * out.height, "surprise_map.total");
+  if (!total) return total.error();
+  out.total = std::move(*total);
+  out.known_pixels = reply.known_pixels();
+  out.reference_views = reply.reference_views();
+  out.regions.assign(reply.regions().begin(), reply.regions().end());
+  out.compute_ms = reply.compute_ms();
+  return out;
+}
 
 int fail(const std::string& message) {
   std::cerr << "scenewatch: " << message << std::endl;
@@ -132,6 +136,8 @@ int run_stats(const RemoteOptions& options) {
               << "tracked objects    " << s.tracked_objects() << "\n"
               << "map                " << s.map_occupied_leaves() << " occupied of " << s.map_leaf_nodes()
               << " leaves at " << s.map_resolution_m() << " m, " << s.map_memory_bytes() / 1024 << " KiB\n"
+              << "appearance         " << s.keyframes() << " keyframes, " << s.mesh_triangles() << " mesh triangles, "
+              << s.appearance_memory_bytes() / (1024 * 1024) << " MiB\n"
               << "frame time         last " << s.last_frame_ms() << " ms, mean " << s.mean_frame_ms() << " ms\n"
               << "connections        " << s.connections() << "\n"
               << "uptime             " << static_cast<long>(s.uptime_s()) << " s" << std::endl;

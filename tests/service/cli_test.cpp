@@ -194,6 +194,61 @@ TEST_F(CliTest, DaemonCommands) {
   EXPECT_NE(result.err.find("INVALID_ARGUMENT"), std::string::npos) << result.err;
 }
 
+TEST_F(CliTest, SurpriseOfflineOnAnMosdPair) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn12.pcd");
+  const fs::path learn = data_dir() / "mosd/learn";
+  // learn12 -> learn13: same camera, an object is added.
+  const auto result = cli({"surprise", (learn / "learn13.pcd").string(), "--reference", (learn / "learn12.pcd").string(),
+                           "--out", (tmp_ / "heat.png").string(), "--raw", (tmp_ / "kl.tiff").string(), "--expected",
+                           (tmp_ / "expected.png").string(), "--mesh", (tmp_ / "mesh.ply").string(), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json j = parse(result.out);
+  EXPECT_EQ(j.at("width"), 640);
+  EXPECT_EQ(j.at("keyframes"), 1);
+  EXPECT_GT(j.at("known_pixels").get<std::size_t>(), 100000u);
+  ASSERT_GE(j.at("regions").size(), 1u);
+  EXPECT_EQ(j.at("regions")[0].at("kind"), "APPEARANCE_CHANGE");
+  EXPECT_TRUE(j.at("regions")[0].at("evidence").contains("kl_peak_luminance"));
+  for (const char* name : {"heat.png", "expected.png", "mesh.ply"}) EXPECT_GT(fs::file_size(tmp_ / name), 1000u) << name;
+  EXPECT_GE(fs::file_size(tmp_ / "kl.tiff"), 640u * 480u * 4u);
+  auto mesh = io::read_mesh_ply(tmp_ / "mesh.ply");
+  ASSERT_TRUE(mesh.ok()) << mesh.error().message;
+  EXPECT_GT(mesh->triangles.size(), 10000u);
+
+  // Without an observation there is nothing to compare; a frame number past the end is named.
+  auto bad = cli({"surprise", "--reference", (learn / "learn12.pcd").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("observed frame"), std::string::npos) << bad.err;
+  bad = cli({"surprise", (source_dir() / "sample_clouds/tabletop").string() + ":999", "--reference",
+             (source_dir() / "sample_clouds/tabletop").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find(":999"), std::string::npos) << bad.err;
+}
+
+TEST_F(CliTest, SurpriseFromTheDaemon) {
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, ""));
+  const std::string sequence = (source_dir() / "sample_clouds/tabletop").string();
+  auto result = remote({"surprise"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("NOT_FOUND"), std::string::npos) << result.err;
+  // The first posed frame becomes a keyframe; the same view again is compared with it.
+  ASSERT_EQ(remote({"ingest", sequence}).exit_code, 0);
+  ASSERT_EQ(remote({"ingest", sequence}).exit_code, 0);
+  result = remote({"surprise", "--json", "--out", (tmp_ / "last.png").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  json j = parse(result.out);
+  EXPECT_GT(j.at("known_pixels").get<std::size_t>(), 10000u);
+  EXPECT_EQ(j.at("reference_views"), 1);
+  EXPECT_EQ(j.at("regions").size(), 0u) << "the same view again is not surprising";
+  EXPECT_TRUE(fs::exists(tmp_ / "last.png"));
+  // An observation sent with the call is compared without changing the model.
+  result = remote({"surprise", sequence + ":0", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_GT(parse(result.out).at("known_pixels").get<std::size_t>(), 10000u);
+  result = remote({"stats", "--json"});
+  EXPECT_EQ(parse(result.out).at("frames_processed"), 2);
+}
+
 TEST_F(CliTest, WatchPrintsEventsUntilInterrupted) {
   SCENEWATCH_REQUIRE_DATA(kMug);
   ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, ""));

@@ -1,4 +1,5 @@
 // RGB-D back-projection and the small text formats: intrinsics, 4x4 poses, TUM trajectories.
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <fstream>
@@ -197,6 +198,49 @@ Status write_tum(const fs::path& path, const std::vector<StampedPose>& poses) {
        << " " << t.y() << " " << t.z() << " " << q.x() << " " << q.y() << " " << q.z() << " " << q.w() << "\n";
   }
   return write_text(path, os.str());
+}
+
+Result<Intrinsics> estimate_intrinsics(const Cloud& cloud) {
+  if (cloud.height <= 1) return invalid_argument("intrinsics can only be recovered from an organized cloud");
+  // Two independent line fits: u against x/z, v against y/z.
+  double su = 0, sa = 0, saa = 0, sau = 0, sv = 0, sb = 0, sbb = 0, sbv = 0;
+  std::size_t n = 0;
+  for (std::uint32_t v = 0; v < cloud.height; ++v) {
+    for (std::uint32_t u = 0; u < cloud.width; ++u) {
+      const PointT& p = cloud.at(u, v);
+      if (!is_valid(p) || p.z <= 0) continue;
+      const double a = p.x / p.z, b = p.y / p.z;
+      su += u; sa += a; saa += a * a; sau += a * u;
+      sv += v; sb += b; sbb += b * b; sbv += b * v;
+      ++n;
+    }
+  }
+  if (n < 100) return invalid_argument("too few valid points (" + std::to_string(n) + ") to recover intrinsics");
+  const double dn = static_cast<double>(n);
+  const double da = dn * saa - sa * sa, db = dn * sbb - sb * sb;
+  if (da <= 0 || db <= 0) return invalid_argument("the cloud's points do not spread enough to recover intrinsics");
+  Intrinsics K;
+  K.fx = (dn * sau - sa * su) / da;
+  K.cx = (su - K.fx * sa) / dn;
+  K.fy = (dn * sbv - sb * sv) / db;
+  K.cy = (sv - K.fy * sb) / dn;
+  K.width = static_cast<int>(cloud.width);
+  K.height = static_cast<int>(cloud.height);
+  double worst = 0;
+  std::size_t checked = 0;
+  for (std::uint32_t v = 0; v < cloud.height; v += 7) {
+    for (std::uint32_t u = 0; u < cloud.width; u += 7) {
+      const PointT& p = cloud.at(u, v);
+      if (!is_valid(p) || p.z <= 0) continue;
+      worst = std::max({worst, std::abs(K.fx * p.x / p.z + K.cx - u), std::abs(K.fy * p.y / p.z + K.cy - v)});
+      ++checked;
+    }
+  }
+  if (!K.valid() || worst > 0.5) {
+    return invalid_argument("the organized cloud is not a pinhole projection (worst residual " + std::to_string(worst) +
+                            " px); give the intrinsics explicitly");
+  }
+  return K;
 }
 
 }  // namespace scenewatch::io

@@ -265,4 +265,18 @@ proto::IngestFrame make_ingest_frame(const Frame& frame) {
   return msg;
 }
 
+proto::Event make_event_message(const Event& event) {
+  proto::Event msg;
+  convert::to_proto(event, &msg);
+  return msg;
+}
+
+Result<std::vector<float>> decode_float_map(const std::string& bytes, std::size_t expected, const std::string& field) {
+  auto values = convert::decode_floats(bytes, field);
+  if (!values) return values.error();
+  if (values->size() != expected)
+    return invalid_argument(field + ": " + std::to_string(values->size()) + " values, expected " + std::to_string(expected));
+  return values;
+}
+
 }  // namespace scenewatch::service

@@ -29,6 +29,24 @@ float get_float_le(const char* in) {
   return value;
 }
 
+}  // namespace
+
+std::string encode_floats(const std::vector<float>& values) {
+  std::string out(4 * values.size(), '\0');
+  for (std::size_t i = 0; i < values.size(); ++i) put_float_le(values[i], &out[4 * i]);
+  return out;
+}
+
+Result<std::vector<float>> decode_floats(const std::string& bytes, const std::string& field) {
+  if (bytes.size() % 4 != 0)
+    return invalid_argument(field + ": " + std::to_string(bytes.size()) + " bytes is not a whole number of float32");
+  std::vector<float> out(bytes.size() / 4);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = get_float_le(&bytes[4 * i]);
+  return out;
+}
+
+namespace {
+
 proto::Event::Level to_proto(EventLevel level) {
   switch (level) {
     case EventLevel::kMismatch: return proto::Event::MISMATCH;

@@ -26,6 +26,10 @@ void to_proto(const Event& event, proto::Event* out);
 void to_proto(const Pose& pose, proto::Pose* out);
 void to_proto(const Intrinsics& intrinsics, proto::Intrinsics* out);
 
+/// Floats as little-endian float32 bytes, and back (error when the size is not a multiple of 4).
+std::string encode_floats(const std::vector<float>& values);
+Result<std::vector<float>> decode_floats(const std::string& bytes, const std::string& field);
+
 /// Cloud -> xyz (little-endian float32) and, when has_color, rgb bytes.
 void encode_cloud(const Cloud& cloud, bool has_color, proto::Cloud* out);
 

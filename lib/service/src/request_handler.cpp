@@ -31,6 +31,7 @@ Route route_of(proto::Request::CallCase call) {
   switch (call) {
     case proto::Request::kQueryOccupancy:
     case proto::Request::kStats:
+    case proto::Request::kGetSurpriseMap:
       return Route::kQuery;
     case proto::Request::kIngestFrame:
     case proto::Request::kIngestFile:
@@ -175,6 +176,7 @@ struct RequestHandler::Impl {
       case proto::Request::kLoadModel: return load_model(response);
       case proto::Request::kSubscribe: return subscribe(context, response);
       case proto::Request::kGetEvents: return get_events(request.get_events(), response);
+      case proto::Request::kGetSurpriseMap: return get_surprise_map(request.get_surprise_map(), response);
       case proto::Request::CALL_NOT_SET: break;
     }
     // Not reached for a known call: the empty oneof is answered by the caller.
@@ -202,12 +204,15 @@ struct RequestHandler::Impl {
     out->set_last_frame_ms(s.last_frame_ms);
     out->set_mean_frame_ms(s.mean_frame_ms);
     out->set_tracked_objects(s.tracked_objects);
+    out->set_keyframes(s.keyframes);
+    out->set_mesh_triangles(s.mesh_triangles);
+    out->set_appearance_memory_bytes(s.appearance_memory_bytes);
     out->set_connections(connections ? static_cast<std::uint32_t>(connections()) : 0);
     out->set_uptime_s(uptime_s());
     return {};
   }
 
-  Status ingest_frame(const proto::IngestFrame& msg, proto::Response& response) {
+  static Result<Frame> decode_frame(const proto::IngestFrame& msg) {
     if (!msg.has_cloud()) return invalid_argument("cloud is missing");
     auto cloud = convert::decode_cloud(msg.cloud());
     if (!cloud) return cloud.error();
@@ -233,7 +238,43 @@ struct RequestHandler::Impl {
     if (!std::isfinite(msg.stamp_s())) return invalid_argument("stamp_s is not finite");
     frame.stamp_s = msg.stamp_s();
     frame.source = msg.source().empty() ? std::string("api") : msg.source().substr(0, kMaxSourceLabel);
-    return process(frame, response);
+    return frame;
+  }
+
+  Status ingest_frame(const proto::IngestFrame& msg, proto::Response& response) {
+    auto frame = decode_frame(msg);
+    if (!frame) return frame.error();
+    return process(*frame, response);
+  }
+
+  Status get_surprise_map(const proto::GetSurpriseMap& msg, proto::Response& response) {
+    std::shared_ptr<const pipeline::SurpriseResult> result;
+    if (msg.has_frame()) {
+      auto frame = decode_frame(msg.frame());
+      if (!frame) return frame.error();
+      auto computed = memory.surprise(*frame);
+      if (!computed) return computed.error();
+      result = *computed;
+    } else {
+      result = memory.last_surprise();
+      if (!result) return not_found("no surprise map yet: ingest posed RGB-D frames (the first one becomes a keyframe)");
+    }
+    auto* out = response.mutable_surprise_map();
+    const auto& map = result->map;
+    out->set_width(static_cast<std::uint32_t>(map.width));
+    out->set_height(static_cast<std::uint32_t>(map.height));
+    out->set_total(convert::encode_floats(map.total));
+    if (msg.include_channels()) {
+      for (const auto& channel : map.channel) out->add_channels(convert::encode_floats(channel));
+    }
+    out->set_known_pixels(map.known_pixels);
+    out->set_reference_views(static_cast<std::uint32_t>(result->reference_views));
+    for (const auto& event : result->events) convert::to_proto(event, out->add_regions());
+    convert::to_proto(result->T_world_camera, out->mutable_pose());
+    convert::to_proto(result->intrinsics, out->mutable_intrinsics());
+    out->set_stamp_s(result->stamp_s);
+    out->set_compute_ms(result->ms);
+    return {};
   }
 
   Result<fs::path> resolve_under_roots(const fs::path& requested) const {

@@ -16,6 +16,11 @@ namespace scenewatch::io {
 Result<CloudPtr> rgbd_to_cloud(const ColorImage& color, const DepthImage& depth, const Intrinsics& K,
                                double max_depth_m = 10.0);
 
+/// Recovers pinhole intrinsics from an organized cloud in its camera frame by least squares on
+/// u = fx x/z + cx and v = fy y/z + cy over its valid points. Error when the cloud is not
+/// organized, has too few valid points, or is not a pinhole projection (residual over 0.5 px).
+Result<Intrinsics> estimate_intrinsics(const Cloud& organized);
+
 /// Reads a 3x3 camera matrix (whitespace separated, as 7-Scenes' camera-intrinsics.txt); width
 /// and height are left 0 for the caller to fill from the images.
 Result<Intrinsics> read_intrinsics(const std::filesystem::path& path);

@@ -5,8 +5,10 @@
 #include <deque>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "scenewatch.pb.h"
+#include "scenewatch/core/event.h"
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/service/frame_parser.h"
@@ -70,5 +72,9 @@ std::string to_string(proto::Status::Code code);
 /// Builds the IngestFrame message of a frame: cloud (xyz, and rgb when it has colour), pose,
 /// intrinsics, stamp and source.
 proto::IngestFrame make_ingest_frame(const Frame& frame);
+/// The wire form of an event (for printing library events the way the daemon's are printed).
+proto::Event make_event_message(const Event& event);
+/// Decodes a float32 map of a SurpriseMapReply, checking it holds `expected` values.
+Result<std::vector<float>> decode_float_map(const std::string& bytes, std::size_t expected, const std::string& field);
 
 }  // namespace scenewatch::service

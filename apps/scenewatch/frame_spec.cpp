@@ -1,0 +1,94 @@
+#include "frame_spec.h"
+
+#include <filesystem>
+
+#include "scenewatch/io/rgbd.h"
+#include "scenewatch/io/sequence.h"
+
+namespace scenewatch::cli {
+namespace fs = std::filesystem;
+namespace {
+
+struct Parsed {
+  std::string path;
+  bool sequence = false;
+  std::size_t first = 0, last = 0;  // inclusive; last = SIZE_MAX: to the end
+};
+
+Result<std::size_t> parse_index(const std::string& text, const std::string& spec) {
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos)
+    return invalid_argument("'" + spec + "': '" + text + "' is not a frame number");
+  return static_cast<std::size_t>(std::stoull(text));
+}
+
+Result<Parsed> parse(const std::string& spec) {
+  Parsed p;
+  p.path = spec;
+  p.last = static_cast<std::size_t>(-1);
+  std::error_code ec;
+  const auto colon = spec.rfind(':');
+  if (!fs::exists(spec, ec) && colon != std::string::npos) {
+    p.path = spec.substr(0, colon);
+    const std::string range = spec.substr(colon + 1);
+    const auto dash = range.find('-');
+    auto first = parse_index(range.substr(0, dash), spec);
+    if (!first) return first.error();
+    p.first = p.last = *first;
+    if (dash != std::string::npos) {
+      auto last = parse_index(range.substr(dash + 1), spec);
+      if (!last) return last.error();
+      if (*last < *first) return invalid_argument("'" + spec + "': the range ends before it starts");
+      p.last = *last;
+    }
+    if (!io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png)");
+  }
+  if (!fs::exists(p.path, ec)) return not_found("'" + p.path + "': no such file or folder");
+  p.sequence = fs::is_directory(p.path, ec);
+  if (p.sequence && !io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png)");
+  return p;
+}
+
+}  // namespace
+
+Result<std::size_t> count_frames(const std::string& spec) {
+  auto p = parse(spec);
+  if (!p) return p.error();
+  if (!p->sequence) return std::size_t{1};
+  auto seq = io::open_sequence(p->path);
+  if (!seq) return seq.error();
+  const std::size_t n = seq->frames.size();
+  if (p->first >= n) return invalid_argument("'" + spec + "': the sequence has " + std::to_string(n) + " frames");
+  return std::min(p->last, n - 1) - p->first + 1;
+}
+
+Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& intrinsics,
+                      const std::function<Status(Frame)>& each) {
+  auto p = parse(spec);
+  if (!p) return p.error();
+  if (!p->sequence) {
+    auto frame = io::load_cloud_frame(p->path);
+    if (!frame) return frame.error();
+    if (intrinsics) {
+      frame->intrinsics = *intrinsics;
+      frame->intrinsics->width = static_cast<int>(frame->cloud->width);
+      frame->intrinsics->height = static_cast<int>(frame->cloud->height);
+    } else if (!frame->intrinsics && frame->cloud->height > 1) {
+      auto K = io::estimate_intrinsics(*frame->cloud);
+      if (!K) return Error{K.error().code, "'" + p->path + "': " + K.error().message};
+      frame->intrinsics = *K;
+    }
+    return each(std::move(*frame));
+  }
+  auto seq = io::open_sequence(p->path);
+  if (!seq) return seq.error();
+  const std::size_t n = seq->frames.size();
+  if (p->first >= n) return invalid_argument("'" + spec + "': the sequence has " + std::to_string(n) + " frames");
+  for (std::size_t i = p->first; i <= std::min(p->last, n - 1); ++i) {
+    auto frame = io::load_sequence_frame(*seq, i);
+    if (!frame) return frame.error();
+    if (auto st = each(std::move(*frame)); !st) return st;
+  }
+  return {};
+}
+
+}  // namespace scenewatch::cli

@@ -1,0 +1,26 @@
+#pragma once
+// Frames named on the command line:
+//   FILE.pcd | FILE.ply     one cloud in its camera frame (identity pose); organized clouds get
+//                           intrinsics recovered from their points unless given
+//   SEQDIR                  every frame of a sequence folder (with its poses and intrinsics)
+//   SEQDIR:N                frame N (0-based) of a sequence
+//   SEQDIR:A-B              frames A to B inclusive
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "scenewatch/core/frame.h"
+#include "scenewatch/core/result.h"
+
+namespace scenewatch::cli {
+
+/// How many frames a spec names (opens sequences, reads no images).
+Result<std::size_t> count_frames(const std::string& spec);
+
+/// Loads the frames of a spec in order, calling `each` for every one (stops at its error).
+/// `intrinsics` replaces the recovered intrinsics of cloud files.
+Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& intrinsics,
+                      const std::function<Status(Frame)>& each);
+
+}  // namespace scenewatch::cli

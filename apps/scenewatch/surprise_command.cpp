@@ -1,0 +1,201 @@
+// scenewatch surprise: the image-based Bayesian surprise of an observed frame, offline against
+// reference frames (the appearance memory is built here, no daemon), or from the daemon.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <optional>
+
+#include "commands.h"
+#include "format.h"
+#include "frame_spec.h"
+#include "scenewatch/background/appearance.h"
+#include "scenewatch/io/cloud_io.h"
+#include "scenewatch/io/image_io.h"
+#include "scenewatch/io/rgbd.h"
+#include "scenewatch/pipeline/config_loader.h"
+#include "scenewatch/service/client.h"
+#include "scenewatch/surprise/surprise_map.h"
+
+namespace scenewatch::cli {
+namespace {
+
+using nlohmann::json;
+
+Result<pipeline::Config> load_config(const std::string& path) {
+  pipeline::Config config;
+  if (path.empty()) return config;
+  std::vector<std::string> sections = pipeline::pipeline_sections();
+  sections.push_back("server");
+  auto root = pipeline::load_yaml_file(path, sections);
+  if (!root) return root.error();
+  if (Status s = pipeline::read_pipeline_config(*root, config); !s) return Error{s.error().code, path + ": " + s.error().message};
+  return config;
+}
+
+struct Outcome {
+  surprise::SurpriseMap map;
+  std::vector<proto::Event> regions;
+  std::size_t keyframes = 0, references_read = 0, reference_views = 0;
+  double compute_ms = 0;
+  std::optional<ColorImage> observed_color;
+};
+
+Status write_outputs(const SurpriseOptions& o, const Outcome& out, std::vector<std::string>& written) {
+  if (!o.out_png.empty()) {
+    const ColorImage background = out.observed_color.value_or(ColorImage{});
+    if (auto st = io::write_color_png(o.out_png, surprise::heatmap_overlay(out.map, background, o.saturation)); !st) return st;
+    written.push_back(o.out_png);
+  }
+  if (!o.raw_tiff.empty()) {
+    if (auto st = surprise::write_surprise_tiff(o.raw_tiff, out.map); !st) return st;
+    written.push_back(o.raw_tiff);
+  }
+  return {};
+}
+
+int print(const SurpriseOptions& o, const Outcome& out, const std::vector<std::string>& written) {
+  if (o.json) {
+    json regions = json::array();
+    for (const auto& e : out.regions) regions.push_back(to_json(e));
+    json j = {{"observed", o.observed},         {"width", out.map.width},
+              {"height", out.map.height},        {"known_pixels", out.map.known_pixels},
+              {"reference_views", out.reference_views}, {"regions", regions},
+              {"compute_ms", out.compute_ms},    {"written", written}};
+    if (!o.references.empty()) {
+      j["references"] = o.references;
+      j["reference_frames"] = out.references_read;
+      j["keyframes"] = out.keyframes;
+    }
+    std::cout << j.dump() << std::endl;
+    return kExitOk;
+  }
+  if (!o.references.empty())
+    std::cout << "memory: " << out.keyframes << " keyframes from " << out.references_read << " reference frames\n";
+  const double total = static_cast<double>(out.map.width) * out.map.height;
+  std::printf("%s: %dx%d, %.0f%% of the pixels known, %zu reference views, %.1f ms\n",
+              o.observed.empty() ? "last frame" : o.observed.c_str(), out.map.width, out.map.height,
+              total > 0 ? 100.0 * out.map.known_pixels / total : 0.0, out.reference_views, out.compute_ms);
+  std::printf("%zu surprising region%s\n", out.regions.size(), out.regions.size() == 1 ? "" : "s");
+  std::fflush(stdout);
+  for (const auto& e : out.regions) std::cout << text(e) << "\n";
+  for (const auto& w : written) std::cout << "wrote " << w << "\n";
+  std::cout << std::flush;
+  return kExitOk;
+}
+
+Result<Outcome> offline(const SurpriseOptions& o) {
+  auto config = load_config(o.config);
+  if (!config) return config.error();
+  std::optional<Intrinsics> intrinsics;
+  if (!o.intrinsics.empty()) {
+    auto K = io::read_intrinsics(o.intrinsics);
+    if (!K) return K.error();
+    intrinsics = *K;
+  }
+  // The observation first: a bad one should fail before minutes of reference loading.
+  std::optional<background::Keyframe> observed;
+  std::optional<Frame> observed_frame;
+  {
+    auto n = count_frames(o.observed);
+    if (!n) return n.error();
+    if (*n != 1) return invalid_argument("'" + o.observed + "' names " + std::to_string(*n) + " frames; the observation must be one (SEQDIR:N)");
+    auto st = for_each_frame(o.observed, intrinsics, [&](Frame f) -> Status {
+      auto kf = background::keyframe_from_frame(f);
+      if (!kf) return kf.error();
+      if (!f.has_color) return invalid_argument("'" + o.observed + "' has no colour");
+      observed = std::move(*kf);
+      observed_frame = std::move(f);
+      return {};
+    });
+    if (!st) return st.error();
+  }
+  background::AppearanceMemory memory(config->appearance);
+  std::size_t total = 0, done = 0;
+  for (const auto& spec : o.references) {
+    auto n = count_frames(spec);
+    if (!n) return n.error();
+    total += *n;
+  }
+  ProgressBar bar(::isatty(STDERR_FILENO) != 0);
+  for (const auto& spec : o.references) {
+    auto st = for_each_frame(spec, intrinsics, [&](Frame f) -> Status {
+      bar.draw(++done, total, f.source);
+      if (!memory.is_new_view(f.pose_or_identity())) return {};
+      auto kf = background::keyframe_from_frame(f);
+      if (!kf) return kf.error();
+      auto added = memory.add(std::move(*kf));
+      if (!added) return Error{added.error().code, f.source + ": " + added.error().message};
+      return {};
+    });
+    bar.clear();
+    if (!st) return st.error();
+  }
+  Outcome out;
+  out.keyframes = memory.size();
+  out.references_read = done;
+  const auto t0 = std::chrono::steady_clock::now();
+  const surprise::SurpriseConfig& sc = config->surprise;
+  const surprise::ExpectedView view =
+      surprise::render_expected_view(memory, observed->T_world_camera, observed->intrinsics, sc.view);
+  auto map = surprise::compute_surprise(view, observed->color, surprise::SurpriseKernel(sc.prior, sc.min_samples));
+  if (!map) return map.error();
+  for (const auto& region : surprise::find_regions(*map, view, &observed->depth, sc.regions))
+    out.regions.push_back(service::make_event_message(surprise::to_event(region, observed->stamp_s)));
+  out.compute_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  out.reference_views = view.reference_views;
+  out.map = std::move(*map);
+  out.observed_color = observed->color;
+  if (!o.expected_png.empty()) {
+    if (auto st = io::write_color_png(o.expected_png, surprise::expected_color(view)); !st) return st.error();
+  }
+  if (!o.mesh_ply.empty()) {
+    if (auto st = io::write_mesh_ply(o.mesh_ply, memory.mesh()); !st) return st.error();
+  }
+  return out;
+}
+
+Result<Outcome> remote(const SurpriseOptions& o, const RemoteOptions& r) {
+  std::optional<Frame> observed;
+  if (!o.observed.empty()) {
+    auto st = for_each_frame(o.observed, std::nullopt, [&](Frame f) -> Status {
+      if (observed) return invalid_argument("'" + o.observed + "' names several frames; the observation must be one");
+      observed = std::move(f);
+      return {};
+    });
+    if (!st) return st.error();
+  }
+  auto got = fetch_surprise(r, observed ? &*observed : nullptr);
+  if (!got) return got.error();
+  Outcome out;
+  out.map.width = got->width;
+  out.map.height = got->height;
+  out.map.total = std::move(got->total);
+  out.map.known_pixels = got->known_pixels;
+  out.regions = std::move(got->regions);
+  out.reference_views = got->reference_views;
+  out.compute_ms = got->compute_ms;
+  if (observed) {
+    auto kf = background::keyframe_from_frame(*observed);
+    if (kf) out.observed_color = kf->color;
+  }
+  return out;
+}
+
+}  // namespace
+
+int run_surprise(const SurpriseOptions& o, const RemoteOptions& r) {
+  if (!o.expected_png.empty() && o.references.empty()) return fail("--expected needs --reference (offline)");
+  if (!o.mesh_ply.empty() && o.references.empty()) return fail("--mesh needs --reference (offline)");
+  if (!o.references.empty() && o.observed.empty()) return fail("an observed frame is needed with --reference");
+  auto out = o.references.empty() ? remote(o, r) : offline(o);
+  if (!out) return fail(out.error().message);
+  std::vector<std::string> written;
+  if (!o.expected_png.empty()) written.push_back(o.expected_png);
+  if (!o.mesh_ply.empty()) written.push_back(o.mesh_ply);
+  if (auto st = write_outputs(o, *out, written); !st) return fail(st.error().message);
+  return print(o, *out, written);
+}
+
+}  // namespace scenewatch::cli
