@@ -111,6 +111,7 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("depth_tolerance_m", u.view.depth_tolerance_m); },
                            [&] { return s.read("depth_tolerance_rel", u.view.depth_tolerance_rel); },
                            [&] { return s.read("fill_holes_px", u.view.fill_holes_px); },
+                           [&] { return s.read("sample_step_px", u.view.sample_step_px); },
                            [&] { return s.read("fill_holes_max_jump", u.view.fill_holes_max_jump); },
                            [&] { return s.read("threshold_high", u.regions.threshold_high); },
                            [&] { return s.read("threshold_low", u.regions.threshold_low); },

@@ -10,6 +10,7 @@ Status validate(const ExpectedViewConfig& c) {
     return invalid_argument("surprise.max_samples must be in [1, " + std::to_string(kMaxSamples) + "]");
   if (!(c.depth_tolerance_m >= 0)) return invalid_argument("surprise.depth_tolerance_m must be >= 0");
   if (!(c.depth_tolerance_rel >= 0)) return invalid_argument("surprise.depth_tolerance_rel must be >= 0");
+  if (c.sample_step_px < 1 || c.sample_step_px > 16) return invalid_argument("surprise.sample_step_px must be in [1, 16]");
   if (c.fill_holes_px < 0 || c.fill_holes_px > 640) return invalid_argument("surprise.fill_holes_px must be in [0, 640]");
   if (!(c.fill_holes_max_jump >= 0)) return invalid_argument("surprise.fill_holes_max_jump must be >= 0");
   return {};
@@ -109,52 +110,80 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
   view.reference_views = refs.size();
 
   const float tol_m = static_cast<float>(config.depth_tolerance_m), tol_rel = static_cast<float>(config.depth_tolerance_rel);
-  for (int v = 0; v < K.height; ++v) {
-    const std::size_t row = static_cast<std::size_t>(v) * K.width;
-    for (int u = 0; u < K.width; ++u) {
-      const std::size_t i = row + static_cast<std::size_t>(u);
-      const float z = view.depth_m[i];
-      if (z <= 0.0f) continue;
-      const Eigen::Vector3f p(xn[static_cast<std::size_t>(u)] * z, yn[static_cast<std::size_t>(v)] * z, z);
-      float sum[kChannels] = {0, 0, 0}, sumsq[kChannels] = {0, 0, 0};
-      int n = 0;
-      for (const Ref& ref : refs) {
-        const Eigen::Vector3f q = ref.A * p + ref.b;
-        if (q.z() <= 0.05f) continue;
-        const float iz = 1.0f / q.z();
-        const float ur = q.x() * iz, vr = q.y() * iz;
-        if (!(ur >= 0.0f && vr >= 0.0f && ur < ref.umax && vr < ref.vmax)) continue;
-        // Unoccluded: the keyframe's own depth at that pixel agrees with the point's depth in it.
-        // Where the keyframe has no depth (glass, grazing surfaces) nothing refutes the sample.
-        const int ui = static_cast<int>(ur + 0.5f), vi = static_cast<int>(vr + 0.5f);
-        const std::uint16_t mm = ref.depth[static_cast<std::size_t>(vi) * ref.width + ui];
-        if (mm != 0 && mm != 65535 && std::abs(mm * 0.001f - q.z()) > tol_m + tol_rel * q.z()) continue;
-        // Bilinear colour in 8-bit fixed-point weights: one conversion per channel, not four.
-        const int u0 = static_cast<int>(ur), v0 = static_cast<int>(vr);
-        const int wu = static_cast<int>((ur - u0) * 256.0f), wv = static_cast<int>((vr - v0) * 256.0f);
-        const std::uint8_t* p00 = ref.rgb + 3 * (static_cast<std::size_t>(v0) * ref.width + u0);
-        const std::uint8_t* p10 = p00 + 3;
-        const std::uint8_t* p01 = p00 + 3 * static_cast<std::size_t>(ref.width);
-        const std::uint8_t* p11 = p01 + 3;
-        const int w00 = (256 - wu) * (256 - wv), w10 = wu * (256 - wv), w01 = (256 - wu) * wv, w11 = wu * wv;
-        constexpr float s = 1.0f / (255.0f * 65536.0f);
-        const float R = static_cast<float>(w00 * p00[0] + w10 * p10[0] + w01 * p01[0] + w11 * p11[0]) * s;
-        const float G = static_cast<float>(w00 * p00[1] + w10 * p10[1] + w01 * p01[1] + w11 * p11[1]) * s;
-        const float B = static_cast<float>(w00 * p00[2] + w10 * p10[2] + w01 * p01[2] + w11 * p11[2]) * s;
-        const float opp[kChannels] = {(R + G + B) * (1.0f / 3.0f), R - G, B - 0.5f * (R + G)};
-        for (int c = 0; c < kChannels; ++c) {
-          sum[c] += opp[c];
-          sumsq[c] += opp[c] * opp[c];
-        }
-        ++n;
-      }
-      view.count[i] = static_cast<std::uint8_t>(n);
-      if (n == 0) continue;
-      const float inv = 1.0f / static_cast<float>(n);
+  const auto sample_pixel = [&](std::size_t i, int u, int v) {
+    const float z = view.depth_m[i];
+    const Eigen::Vector3f p(xn[static_cast<std::size_t>(u)] * z, yn[static_cast<std::size_t>(v)] * z, z);
+    float sum[kChannels] = {0, 0, 0}, sumsq[kChannels] = {0, 0, 0};
+    int n = 0;
+    for (const Ref& ref : refs) {
+      const Eigen::Vector3f q = ref.A * p + ref.b;
+      if (q.z() <= 0.05f) continue;
+      const float iz = 1.0f / q.z();
+      const float ur = q.x() * iz, vr = q.y() * iz;
+      if (!(ur >= 0.0f && vr >= 0.0f && ur < ref.umax && vr < ref.vmax)) continue;
+      // Unoccluded: the keyframe's own depth at that pixel agrees with the point's depth in it.
+      // Where the keyframe has no depth (glass, grazing surfaces) nothing refutes the sample.
+      const int ui = static_cast<int>(ur + 0.5f), vi = static_cast<int>(vr + 0.5f);
+      const std::uint16_t mm = ref.depth[static_cast<std::size_t>(vi) * ref.width + ui];
+      if (mm != 0 && mm != 65535 && std::abs(mm * 0.001f - q.z()) > tol_m + tol_rel * q.z()) continue;
+      // Bilinear colour in 8-bit fixed-point weights: one conversion per channel, not four.
+      const int u0 = static_cast<int>(ur), v0 = static_cast<int>(vr);
+      const int wu = static_cast<int>((ur - u0) * 256.0f), wv = static_cast<int>((vr - v0) * 256.0f);
+      const std::uint8_t* p00 = ref.rgb + 3 * (static_cast<std::size_t>(v0) * ref.width + u0);
+      const std::uint8_t* p10 = p00 + 3;
+      const std::uint8_t* p01 = p00 + 3 * static_cast<std::size_t>(ref.width);
+      const std::uint8_t* p11 = p01 + 3;
+      const int w00 = (256 - wu) * (256 - wv), w10 = wu * (256 - wv), w01 = (256 - wu) * wv, w11 = wu * wv;
+      constexpr float s = 1.0f / (255.0f * 65536.0f);
+      const float R = static_cast<float>(w00 * p00[0] + w10 * p10[0] + w01 * p01[0] + w11 * p11[0]) * s;
+      const float G = static_cast<float>(w00 * p00[1] + w10 * p10[1] + w01 * p01[1] + w11 * p11[1]) * s;
+      const float B = static_cast<float>(w00 * p00[2] + w10 * p10[2] + w01 * p01[2] + w11 * p11[2]) * s;
+      const float opp[kChannels] = {(R + G + B) * (1.0f / 3.0f), R - G, B - 0.5f * (R + G)};
       for (int c = 0; c < kChannels; ++c) {
-        const float mean = sum[c] * inv;
-        view.mean[c][i] = mean;
-        view.ssd[c][i] = std::max(0.0f, sumsq[c] - sum[c] * mean);
+        sum[c] += opp[c];
+        sumsq[c] += opp[c] * opp[c];
+      }
+      ++n;
+    }
+    view.count[i] = static_cast<std::uint8_t>(n);
+    if (n == 0) return;
+    const float inv = 1.0f / static_cast<float>(n);
+    for (int c = 0; c < kChannels; ++c) {
+      const float mean = sum[c] * inv;
+      view.mean[c][i] = mean;
+      view.ssd[c][i] = std::max(0.0f, sumsq[c] - sum[c] * mean);
+    }
+  };
+
+  // Samples on a grid of `step` pixels; the pixels between take their grid anchor's statistics
+  // when they lie on the same surface (depths agree), else they are sampled themselves.
+  const int step = std::max(1, static_cast<int>(std::lround(config.sample_step_px * K.width / 640.0)));
+  const int w = K.width, h = K.height;
+  for (int v = 0; v < h; v += step) {
+    for (int u = 0; u < w; u += step) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      if (view.depth_m[i] > 0.0f) sample_pixel(i, u, v);
+    }
+  }
+  if (step > 1) {
+    for (int v = 0; v < h; ++v) {
+      const int va = v - v % step;
+      for (int u = 0; u < w; ++u) {
+        if (v == va && u % step == 0) continue;
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        const float z = view.depth_m[i];
+        if (z <= 0.0f) continue;
+        const std::size_t a = static_cast<std::size_t>(va) * w + static_cast<std::size_t>(u - u % step);
+        const float za = view.depth_m[a];
+        if (za > 0.0f && std::abs(za - z) <= tol_m + tol_rel * z) {
+          view.count[i] = view.count[a];
+          for (int c = 0; c < kChannels; ++c) {
+            view.mean[c][i] = view.mean[c][a];
+            view.ssd[c][i] = view.ssd[c][a];
+          }
+        } else {
+          sample_pixel(i, u, v);
+        }
       }
     }
   }

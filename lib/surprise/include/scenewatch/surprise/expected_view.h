@@ -24,6 +24,10 @@ struct ExpectedViewConfig {
   /// Holes in the expected depth up to this many pixels wide (per 640 pixels of image width)
   /// are filled when the surfaces on both sides agree within fill_holes_max_jump of the depth.
   int fill_holes_px = 40;
+  /// Colour samples are drawn on a grid of this many pixels per 640 pixels of width (2: every
+  /// second pixel of a VGA image, every pixel at 320x240); pixels between share their grid
+  /// neighbour's samples when they lie on the same surface, else draw their own.
+  int sample_step_px = 2;
   double fill_holes_max_jump = 0.05;
 };
 
