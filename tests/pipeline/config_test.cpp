@@ -76,6 +76,23 @@ TEST_F(ConfigTest, ShippedConfigIsValid) {
   Config c;
   auto st = read_pipeline_config(*root, c);
   EXPECT_TRUE(st.ok()) << st.error().message;
+  // The shipped file documents the defaults: its values are the built-in ones.
+  const Config d;
+  EXPECT_EQ(c.appearance.keyframe_min_translation_m, d.appearance.keyframe_min_translation_m);
+  EXPECT_EQ(c.appearance.max_keyframes, d.appearance.max_keyframes);
+  EXPECT_EQ(c.appearance.mesh_stride_px, d.appearance.mesh_stride_px);
+  EXPECT_EQ(c.surprise.prior.b0, d.surprise.prior.b0);
+  EXPECT_EQ(c.surprise.min_samples, d.surprise.min_samples);
+  EXPECT_EQ(c.surprise.view.sample_step_px, d.surprise.view.sample_step_px);
+  EXPECT_EQ(c.surprise.regions.threshold_high, d.surprise.regions.threshold_high);
+}
+
+TEST_F(ConfigTest, AppearanceAndSurpriseKeysAreChecked) {
+  EXPECT_NE(error_of("surprise:\n  b0: -1\n").find("surprise.b0"), std::string::npos);
+  EXPECT_NE(error_of("surprise:\n  threshold_high: 1\n  threshold_low: 2\n").find("threshold_high"), std::string::npos);
+  EXPECT_NE(error_of("surprise:\n  max_samples: 9\n").find("max_samples"), std::string::npos);
+  EXPECT_NE(error_of("appearance:\n  mesh_stride_px: 0\n").find("appearance.mesh_stride_px"), std::string::npos);
+  EXPECT_NE(error_of("appearance:\n  keyframes: 3\n").find("keyframes"), std::string::npos) << "unknown key";
 }
 
 }  // namespace
