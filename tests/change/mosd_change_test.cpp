@@ -39,13 +39,7 @@ Scene load(int i) {
 // The camera did not move when the table pixels that both scenes label as table have the same
 // depth (the scenes of one session share the recording's exact table depth).
 bool same_camera(const Scene& a, const Scene& b) {
-  std::size_t n = 0, same = 0;
-  for (std::size_t i = 0; i < a.xyz.size(); ++i) {
-    if (a.labels[i] != 1 || b.labels[i] != 1 || !a.xyz[i].allFinite() || !b.xyz[i].allFinite()) continue;
-    ++n;
-    same += std::abs(a.xyz[i].z() - b.xyz[i].z()) < 1e-4f ? 1 : 0;
-  }
-  return n > 1000 && 2 * same > n;
+  return change::same_camera_by_labels(a.xyz, a.labels, b.xyz, b.labels);
 }
 
 TEST(MosdChange, SameCameraPairs) {

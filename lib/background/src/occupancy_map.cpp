@@ -362,6 +362,7 @@ Result<DenseGrid> OccupancyMap::dense_grid(const Aabb& box, std::size_t max_voxe
                 Eigen::Vector3d::Constant(res / 2);
   grid.state.assign(n, static_cast<std::uint8_t>(Occupancy::kUnknown));
   grid.rgb.assign(n, 0);
+  grid.probability.assign(n, 128);
   for (auto it = tree.begin_leafs_bbx(lo, hi), end = tree.end_leafs_bbx(); it != end; ++it) {
     const octomap::point3d c = it.getCoordinate();
     const double size = it.getSize();
@@ -373,12 +374,14 @@ Result<DenseGrid> OccupancyMap::dense_grid(const Aabb& box, std::size_t max_voxe
     const auto s = static_cast<std::uint8_t>(tree.isNodeOccupied(*it) ? Occupancy::kOccupied : Occupancy::kFree);
     const octomap::ColorOcTreeNode::Color col = it->getColor();
     const std::uint32_t rgb = (std::uint32_t{col.r} << 16) | (std::uint32_t{col.g} << 8) | col.b;
+    const auto prob = static_cast<std::uint8_t>(std::lround(255.0 * it->getOccupancy()));
     for (long z = first[2]; z <= last[2]; ++z)
       for (long y = first[1]; y <= last[1]; ++y)
         for (long x = first[0]; x <= last[0]; ++x) {
           const std::size_t idx = (static_cast<std::size_t>(z) * grid.ny + y) * grid.nx + x;
           grid.state[idx] = s;
           grid.rgb[idx] = rgb;
+          grid.probability[idx] = prob;
         }
   }
   return grid;

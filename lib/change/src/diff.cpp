@@ -1,6 +1,7 @@
 // Two single observations: same-camera per-pixel reasoning, or BEFORE as a map and AFTER against it.
 #include "scenewatch/change/diff.h"
 
+#include <algorithm>
 #include <chrono>
 
 namespace scenewatch::change {
@@ -72,7 +73,9 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
     result.method = DiffMethod::kMap;
     background::OccupancyMap map(options.map);
     map.insert(b, before.pose_or_identity());
-    auto mm = mismatch_against_map(map, a, after.pose_or_identity(), *K, options.change);
+    Config config = options.change;  // every surface of a one-frame map was hit once
+    config.min_surface_probability = std::min(config.min_surface_probability, options.map.prob_hit - 1e-3);
+    auto mm = mismatch_against_map(map, a, after.pose_or_identity(), *K, config);
     if (!mm) return mm.error();
     result.mismatch = std::move(*mm);
   }

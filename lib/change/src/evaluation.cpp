@@ -2,6 +2,7 @@
 #include "scenewatch/change/evaluation.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <unordered_set>
 
@@ -131,6 +132,18 @@ std::vector<TrueChange> true_changes_from_labels(const std::vector<Eigen::Vector
     out.push_back(std::move(t));
   }
   return out;
+}
+
+bool same_camera_by_labels(const std::vector<Eigen::Vector3f>& bx, const std::vector<std::uint32_t>& bl,
+                           const std::vector<Eigen::Vector3f>& ax, const std::vector<std::uint32_t>& al,
+                           std::uint32_t table_label) {
+  std::size_t n = 0, same = 0;
+  for (std::size_t i = 0; i < bx.size() && i < ax.size(); ++i) {
+    if (bl[i] != table_label || al[i] != table_label || !bx[i].allFinite() || !ax[i].allFinite()) continue;
+    ++n;
+    same += std::abs(bx[i].z() - ax[i].z()) < 1e-4f ? 1 : 0;
+  }
+  return n > 1000 && 2 * same > n;
 }
 
 }  // namespace scenewatch::change

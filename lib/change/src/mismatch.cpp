@@ -27,6 +27,8 @@ Status validate(const Config& c) {
   if (!(c.cluster_voxel_m >= 0.002 && c.cluster_voxel_m <= 0.2)) return bad("cluster_voxel_m", "must be in [0.002, 0.2] m");
   if (!(c.min_object_size_m >= 0 && c.min_object_size_m <= 2)) return bad("min_object_size_m", "must be in [0, 2] m");
   if (!(c.min_object_area_m2 >= 0 && c.min_object_area_m2 <= 1)) return bad("min_object_area_m2", "must be in [0, 1] m2");
+  if (!(c.min_surface_probability >= 0.5 && c.min_surface_probability < 1)) return bad("min_surface_probability", "must be in [0.5, 1)");
+  if (!(c.max_range_m > 0.1 && c.max_range_m <= 20)) return bad("max_range_m", "must be in (0.1, 20] m");
   if (c.min_cluster_points < 1) return bad("min_cluster_points", "must be >= 1");
   if (c.min_changed_neighbours < 0 || c.min_changed_neighbours > 8) return bad("min_changed_neighbours", "must be in [0, 8]");
   if (!(c.move_max_size_ratio >= 1)) return bad("move_max_size_ratio", "must be >= 1");
@@ -153,13 +155,13 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   box.min = box.max = T.translation();
   std::size_t valid = 0;
   for (const auto& p : cloud.points) {
-    if (!is_valid(p)) continue;
+    if (!is_valid(p) || p.z > config.max_range_m) continue;
     const Eigen::Vector3d w = (Tf * p.getVector3fMap()).cast<double>();
     box.min = box.min.cwiseMin(w);
     box.max = box.max.cwiseMax(w);
     ++valid;
   }
-  if (valid == 0) return invalid_argument("mismatch: the observation has no valid point");
+  if (valid == 0) return Mismatch{};  // nothing within range: nothing to claim
   const double res = map.resolution();
   box.min.array() -= 2 * res;
   box.max.array() += 2 * res;
@@ -176,7 +178,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   const long sx = 1, sy = grid.nx, sz = static_cast<long>(grid.nx) * grid.ny;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const PointT& p = cloud.points[i];
-    if (!is_valid(p)) continue;
+    if (!is_valid(p) || p.z > config.max_range_m) continue;
     const Eigen::Vector3d w = (Tf * p.getVector3fMap()).cast<double>();
     const long idx = grid.index_of(w);
     if (grid.at(idx) != Occupancy::kFree) continue;
@@ -214,20 +216,22 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
 
   // 3. Removed: occupied voxels whose whole projected footprint shows depth behind them by more
   //    than the tolerance. A footprint pixel at or in front of the voxel (the surface is still
-  //    there, or something occludes it) vetoes; so does a footprint mostly without depth.
+  //    there, or something occludes it) vetoes; so does one without depth (a hole at a grazing
+  //    edge may be the surface itself).
   const auto t2 = Clock::now();
   const DepthView depth = depth_view(cloud, K);
   const Eigen::Isometry3d T_camera_world = T.inverse();
+  const auto min_probability = static_cast<std::uint8_t>(std::floor(255.0 * config.min_surface_probability));
   for (std::size_t n = 0; n < grid.size(); ++n) {
-    if (grid.state[n] != static_cast<std::uint8_t>(Occupancy::kOccupied)) continue;
+    if (grid.state[n] != static_cast<std::uint8_t>(Occupancy::kOccupied) || grid.probability[n] < min_probability) continue;
     const Eigen::Vector3d c = grid.center(static_cast<long>(n));
     const Eigen::Vector3d q = T_camera_world * c;
-    if (q.z() <= res) continue;
+    if (q.z() <= res || q.z() > config.max_range_m) continue;
     const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
     const double half_px = K.fx * kHalfDiagonal * res / q.z();
     if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) continue;
     const double limit = q.z() + kHalfDiagonal * res + tolerance_m(config, q.z());
-    constexpr int kSteps = 2;  // (2 kSteps + 1)^2 samples over the footprint
+    constexpr int kSteps = 3;  // (2 kSteps + 1)^2 samples over the footprint
     int with_depth = 0, total = 0;
     float nearest = std::numeric_limits<float>::infinity();
     bool veto = false;
@@ -245,7 +249,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
         }
         nearest = std::min(nearest, z);
       }
-    if (veto || 2 * with_depth < total) continue;
+    if (veto || with_depth < total) continue;
     MissingVoxel m;
     m.center_world = c;
     m.rgb = grid.rgb[n];

@@ -7,11 +7,27 @@
 
 namespace scenewatch::change {
 
+namespace {
+constexpr double kZoneMargin_m = 0.05;
+constexpr std::size_t kMaxZones = 256;
+
+bool inside(const Aabb& box, const Eigen::Vector3d& p) {
+  return (p.array() >= box.min.array()).all() && (p.array() <= box.max.array()).all();
+}
+}  // namespace
+
 std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeCluster>& clusters,
-                                                    std::vector<ChangeCluster>* pending) {
+                                                    std::vector<ChangeCluster>* pending,
+                                                    std::vector<ChangeCluster>* absorbed) {
   const int k = config_.persistence_frames;
   std::vector<char> matched(candidates_.size(), 0);
   for (const auto& c : clusters) {
+    bool in_zone = false;
+    for (const auto& z : zones_) in_zone = in_zone || (z.kind == c.kind && inside(z.box_world, c.centroid_world));
+    if (in_zone) {
+      if (absorbed != nullptr) absorbed->push_back(c);
+      continue;
+    }
     int best = -1;
     double best_d = config_.persistence_match_m;
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
@@ -88,6 +104,21 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
       continue;
     }
     done[i] = 1;
+    // Another piece of an object whose change fired in this frame (a vanished box seen through
+    // in two parts): written into the model, no second event.
+    bool part_of_fired = false;
+    for (const auto& f : out) {
+      const auto& side = c.latest.kind == ChangeKind::kAdded ? f.after : f.before;
+      if (!side) continue;
+      Aabb grown = side->box_world;
+      grown.min.array() -= kZoneMargin_m;
+      grown.max.array() += kZoneMargin_m;
+      part_of_fired = part_of_fired || inside(grown, c.latest.centroid_world);
+    }
+    if (part_of_fired) {
+      if (absorbed != nullptr) absorbed->push_back(c.latest);
+      continue;
+    }
     ObjectChange change;
     if (c.latest.kind == ChangeKind::kAdded) {
       change.kind = EventKind::kObjectAdded;
@@ -98,6 +129,17 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
     }
     out.push_back(std::move(change));
   }
+  auto add_zone = [&](const ChangeCluster& c) {
+    Zone z{c.kind, c.box_world};
+    z.box_world.min.array() -= kZoneMargin_m;
+    z.box_world.max.array() += kZoneMargin_m;
+    zones_.push_back(z);
+  };
+  for (const auto& c : out) {
+    if (c.before) add_zone(*c.before);
+    if (c.after) add_zone(*c.after);
+  }
+  if (zones_.size() > kMaxZones) zones_.erase(zones_.begin(), zones_.end() - kMaxZones);
   std::vector<Candidate> rest;
   for (std::size_t i = 0; i < candidates_.size(); ++i) {
     if (done[i]) continue;

@@ -45,6 +45,7 @@ struct DenseGrid {
   int nx = 0, ny = 0, nz = 0;
   std::vector<std::uint8_t> state;  ///< Occupancy per voxel, x fastest
   std::vector<std::uint32_t> rgb;   ///< 0xRRGGBB per voxel (meaningful where occupied)
+  std::vector<std::uint8_t> probability;  ///< occupancy probability per voxel, times 255
   std::size_t size() const { return state.size(); }
   /// Index of the voxel holding p, or -1 outside the grid.
   long index_of(const Eigen::Vector3d& p_world) const {

@@ -46,4 +46,11 @@ std::vector<TrueChange> true_changes_from_labels(const std::vector<Eigen::Vector
                                                  std::uint32_t divisor = 10, std::uint32_t min_label = 10,
                                                  double near_m = 0.01, std::size_t min_points = 100);
 
+/// True when two labelled organized scenes come from one unmoved camera: most pixels both label
+/// as the support (`table_label`) have the same depth (to 0.1 mm; mOSD's sessions share the
+/// table's exact depth).
+bool same_camera_by_labels(const std::vector<Eigen::Vector3f>& before_xyz, const std::vector<std::uint32_t>& before_labels,
+                           const std::vector<Eigen::Vector3f>& after_xyz, const std::vector<std::uint32_t>& after_labels,
+                           std::uint32_t table_label = 1);
+
 }  // namespace scenewatch::change

@@ -21,6 +21,13 @@ struct Config {
   /// noise sigma(z) = 0.0012 + 0.0019 (z - 0.4)^2 m (Nguyen, Izadi & Lovell 2012).
   double sigma_factor = 3.0;
   double min_tolerance_m = 0.01;
+  /// Only voxels the map holds occupied with at least this probability can be claimed removed:
+  /// a surface seen once (a flying pixel at a silhouette) is no evidence of an object. A map
+  /// built from one frame holds prob_hit (0.7); diff() lowers the threshold to it.
+  double min_surface_probability = 0.8;
+  /// Only depths up to this claim anything (Kinect noise beyond is as large as a voxel, and the
+  /// dense grid grows with the cube of the range).
+  double max_range_m = 2.5;
   /// Mismatch points are grouped over a voxel grid of this edge (26-connected cells).
   double cluster_voxel_m = 0.02;
   /// A cluster whose largest box side is below this is noise (border residue, speckle).

@@ -15,11 +15,18 @@ class PersistenceFilter {
 
   /// Feeds one frame's clusters. Returns the changes confirmed by this frame (moves paired).
   /// `pending` receives the clusters of this frame that belong to unconfirmed candidates: their
-  /// pixels should be kept out of the model until confirmed.
-  std::vector<ObjectChange> update(const std::vector<ChangeCluster>& clusters, std::vector<ChangeCluster>* pending);
+  /// pixels should be kept out of the model until confirmed. `absorbed` receives clusters that
+  /// lie where a change of their kind was already confirmed (the other sides of an object that
+  /// was added or taken away, seen from new views): the caller writes them into the model
+  /// without a new event.
+  std::vector<ObjectChange> update(const std::vector<ChangeCluster>& clusters, std::vector<ChangeCluster>* pending,
+                                   std::vector<ChangeCluster>* absorbed = nullptr);
 
   std::size_t candidates() const { return candidates_.size(); }
-  void reset() { candidates_.clear(); }
+  void reset() {
+    candidates_.clear();
+    zones_.clear();
+  }
 
  private:
   struct Candidate {
@@ -28,8 +35,13 @@ class PersistenceFilter {
     int misses = 0;  ///< consecutive frames without a match
     int waited = 0;  ///< frames waited, once confirmed, for a move partner
   };
+  struct Zone {
+    ChangeKind kind;
+    Aabb box_world;  ///< the confirmed change's box, grown by a margin
+  };
   Config config_;
   std::vector<Candidate> candidates_;
+  std::vector<Zone> zones_;  ///< confirmed changes, most recent last (bounded)
 };
 
 }  // namespace scenewatch::change
