@@ -41,5 +41,6 @@ inline double time_ms(const std::function<void()>& f) {
 int run_octomap(const Options& o);
 int run_segmentation(const Options& o);
 int run_latency(const Options& o);
+int run_change(const Options& o);
 
 }  // namespace scenewatch::bench
