@@ -42,5 +42,6 @@ int run_octomap(const Options& o);
 int run_segmentation(const Options& o);
 int run_latency(const Options& o);
 int run_surprise(const Options& o);
+int run_change(const Options& o);
 
 }  // namespace scenewatch::bench

@@ -77,4 +77,14 @@ struct SegmentOptions {
 /// Offline: segments a cloud file and prints planes and objects (no daemon involved).
 int run_segment(const SegmentOptions& options);
 
+struct DiffOptions {
+  std::string before, after;  ///< cloud files or sequence frames (DIR/frame-NNNNNN)
+  bool json = false;
+  std::string config;         ///< YAML config: its change and background sections are used
+  bool force_map = false;     ///< compare through the map even for same-camera pairs
+  double resolution_m = 0;    ///< map voxel edge for the map path (0 = config / default)
+};
+/// Offline: geometric change detection between two observations (no daemon involved).
+int run_diff(const DiffOptions& options);
+
 }  // namespace scenewatch::cli

@@ -11,6 +11,7 @@ namespace {
 
 struct Parsed {
   std::string path;
+  std::string frame_name;  // DIR/frame-NNNNNN: the frame of that name
   bool sequence = false;
   std::size_t first = 0, last = 0;  // inclusive; last = SIZE_MAX: to the end
 };
@@ -26,6 +27,13 @@ Result<Parsed> parse(const std::string& spec) {
   p.path = spec;
   p.last = static_cast<std::size_t>(-1);
   std::error_code ec;
+  const fs::path as_path(spec);
+  if (!fs::exists(spec, ec) && as_path.has_parent_path() && io::is_sequence_dir(as_path.parent_path())) {
+    p.path = as_path.parent_path().string();
+    p.frame_name = as_path.filename().string();
+    p.sequence = true;
+    return p;
+  }
   const auto colon = spec.rfind(':');
   if (!fs::exists(spec, ec) && colon != std::string::npos) {
     p.path = spec.substr(0, colon);
@@ -48,6 +56,18 @@ Result<Parsed> parse(const std::string& spec) {
   return p;
 }
 
+// DIR/frame-NNNNNN: the index of the frame of that name.
+Status resolve_name(Parsed& p, const io::Sequence& seq, const std::string& spec) {
+  if (p.frame_name.empty()) return {};
+  for (std::size_t i = 0; i < seq.frames.size(); ++i) {
+    if (seq.frames[i].name == p.frame_name) {
+      p.first = p.last = i;
+      return {};
+    }
+  }
+  return not_found("'" + spec + "': no frame named '" + p.frame_name + "' in the sequence '" + p.path + "'");
+}
+
 }  // namespace
 
 Result<std::size_t> count_frames(const std::string& spec) {
@@ -56,6 +76,7 @@ Result<std::size_t> count_frames(const std::string& spec) {
   if (!p->sequence) return std::size_t{1};
   auto seq = io::open_sequence(p->path);
   if (!seq) return seq.error();
+  if (auto st = resolve_name(*p, *seq, spec); !st) return st.error();
   const std::size_t n = seq->frames.size();
   if (p->first >= n) return invalid_argument("'" + spec + "': the sequence has " + std::to_string(n) + " frames");
   return std::min(p->last, n - 1) - p->first + 1;
@@ -81,6 +102,7 @@ Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& 
   }
   auto seq = io::open_sequence(p->path);
   if (!seq) return seq.error();
+  if (auto st = resolve_name(*p, *seq, spec); !st) return st.error();
   const std::size_t n = seq->frames.size();
   if (p->first >= n) return invalid_argument("'" + spec + "': the sequence has " + std::to_string(n) + " frames");
   for (std::size_t i = p->first; i <= std::min(p->last, n - 1); ++i) {

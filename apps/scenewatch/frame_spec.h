@@ -4,6 +4,7 @@
 //                           intrinsics recovered from their points unless given
 //   SEQDIR                  every frame of a sequence folder (with its poses and intrinsics)
 //   SEQDIR:N                frame N (0-based) of a sequence
+//   SEQDIR/frame-NNNNNN     the frame of that name
 //   SEQDIR:A-B              frames A to B inclusive
 #include <functional>
 #include <optional>

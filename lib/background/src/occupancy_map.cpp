@@ -342,6 +342,73 @@ std::size_t OccupancyMap::clear_box(const Aabb& box) {
   return changed + keys.size();
 }
 
+Result<DenseGrid> OccupancyMap::dense_grid(const Aabb& box, std::size_t max_voxels) const {
+  const auto& tree = impl_->tree;
+  OcTreeKey lo, hi;
+  if (!box.valid()) return invalid_argument("dense grid: the box is empty or not finite");
+  if (!key_range(tree, box, lo, hi)) return invalid_argument("dense grid: the box leaves the map's extent");
+  DenseGrid grid;
+  grid.resolution = tree.getResolution();
+  grid.nx = hi[0] - lo[0] + 1;
+  grid.ny = hi[1] - lo[1] + 1;
+  grid.nz = hi[2] - lo[2] + 1;
+  const std::size_t n = static_cast<std::size_t>(grid.nx) * grid.ny * grid.nz;
+  if (n > max_voxels) {
+    return invalid_argument("dense grid: the box holds " + std::to_string(n) + " voxels, more than " +
+                            std::to_string(max_voxels));
+  }
+  const double res = grid.resolution;
+  grid.origin = Eigen::Vector3d(tree.keyToCoord(lo[0]), tree.keyToCoord(lo[1]), tree.keyToCoord(lo[2])) -
+                Eigen::Vector3d::Constant(res / 2);
+  grid.state.assign(n, static_cast<std::uint8_t>(Occupancy::kUnknown));
+  grid.rgb.assign(n, 0);
+  grid.probability.assign(n, 128);
+  for (auto it = tree.begin_leafs_bbx(lo, hi), end = tree.end_leafs_bbx(); it != end; ++it) {
+    const octomap::point3d c = it.getCoordinate();
+    const double size = it.getSize();
+    long first[3], last[3];
+    for (int i = 0; i < 3; ++i) {
+      first[i] = std::max<long>(tree.coordToKey(c(i) - size / 2 + res / 2), lo[i]) - lo[i];
+      last[i] = std::min<long>(tree.coordToKey(c(i) + size / 2 - res / 2), hi[i]) - lo[i];
+    }
+    const auto s = static_cast<std::uint8_t>(tree.isNodeOccupied(*it) ? Occupancy::kOccupied : Occupancy::kFree);
+    const octomap::ColorOcTreeNode::Color col = it->getColor();
+    const std::uint32_t rgb = (std::uint32_t{col.r} << 16) | (std::uint32_t{col.g} << 8) | col.b;
+    const auto prob = static_cast<std::uint8_t>(std::lround(255.0 * it->getOccupancy()));
+    for (long z = first[2]; z <= last[2]; ++z)
+      for (long y = first[1]; y <= last[1]; ++y)
+        for (long x = first[0]; x <= last[0]; ++x) {
+          const std::size_t idx = (static_cast<std::size_t>(z) * grid.ny + y) * grid.nx + x;
+          grid.state[idx] = s;
+          grid.rgb[idx] = rgb;
+          grid.probability[idx] = prob;
+        }
+  }
+  return grid;
+}
+
+std::size_t OccupancyMap::set_voxels(const std::vector<Eigen::Vector3d>& points, Occupancy state) {
+  auto& tree = impl_->tree;
+  std::vector<std::uint64_t> keys;
+  keys.reserve(points.size());
+  OcTreeKey key;
+  for (const auto& p : points) {
+    if (p.allFinite() && tree.coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) keys.push_back(pack(key));
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  const float log_odds = state == Occupancy::kOccupied ? tree.getClampingThresMaxLog() : tree.getClampingThresMinLog();
+  for (std::uint64_t k : keys) {
+    if (state == Occupancy::kUnknown) {
+      tree.deleteNode(unpack(k));
+    } else {
+      tree.setNodeValue(unpack(k), log_odds, /*lazy_eval=*/true);
+    }
+  }
+  if (state != Occupancy::kUnknown) refresh_inner(tree);
+  return keys.size();
+}
+
 void OccupancyMap::reset() {
   impl_->tree.clear();
   impl_->rays.clear();

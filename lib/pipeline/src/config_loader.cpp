@@ -22,7 +22,7 @@ Status YamlSection::finish() const {
 }
 
 const std::vector<std::string>& pipeline_sections() {
-  static const std::vector<std::string> kSections = {"background", "segmentation", "tracking",
+  static const std::vector<std::string> kSections = {"background", "segmentation", "tracking", "change",
                                                      "appearance", "surprise", "events"};
   return kSections;
 }
@@ -81,6 +81,28 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
     if (auto st = s.check_is_map(); !st) return st;
     if (auto st = read_all([&] { return s.read("match_distance_m", c.tracking.match_distance_m); },
                            [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); });
+        !st)
+      return st;
+    if (auto st = s.finish(); !st) return st;
+  }
+  {
+    YamlSection s(root["change"], "change");
+    auto& g = c.change;
+    if (auto st = s.check_is_map(); !st) return st;
+    if (auto st = read_all([&] { return s.read("enabled", c.change_enabled); },
+                           [&] { return s.read("persistence_frames", g.persistence_frames); },
+                           [&] { return s.read("persistence_match_m", g.persistence_match_m); },
+                           [&] { return s.read("sigma_factor", g.sigma_factor); },
+                           [&] { return s.read("max_range_m", g.max_range_m); },
+                           [&] { return s.read("min_surface_probability", g.min_surface_probability); },
+                           [&] { return s.read("min_tolerance_m", g.min_tolerance_m); },
+                           [&] { return s.read("cluster_voxel_m", g.cluster_voxel_m); },
+                           [&] { return s.read("min_object_size_m", g.min_object_size_m); },
+                           [&] { return s.read("min_object_area_m2", g.min_object_area_m2); },
+                           [&] { return s.read("min_cluster_points", g.min_cluster_points); },
+                           [&] { return s.read("move_max_size_ratio", g.move_max_size_ratio); },
+                           [&] { return s.read("move_max_color_distance", g.move_max_color_distance); },
+                           [&] { return s.read("move_min_distance_m", g.move_min_distance_m); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

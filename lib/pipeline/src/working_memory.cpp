@@ -7,10 +7,14 @@
 #include <cmath>
 #include <deque>
 #include <fstream>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 #include "appearance_stage.h"
 #include "model_store.h"
+#include "scenewatch/change/objects.h"
+#include "scenewatch/change/persistence.h"
 
 namespace scenewatch::pipeline {
 namespace fs = std::filesystem;
@@ -65,11 +69,41 @@ bool inside(const OrientedBox& box, const Eigen::Vector3d& p, double margin) {
 
 constexpr std::size_t kSamplesPerObject = 200;
 
+// The frame without the points of unconfirmed change candidates: an added candidate's own points,
+// and every pixel in the region where a removed candidate was seen through (a few pixels wider).
+// Without this the insertion would erode a removed object's voxels frame by frame, and the
+// candidate would change shape (and lose its move partner) before it is confirmed.
+CloudConstPtr without_pending(const Cloud& cloud, const std::vector<change::ChangeCluster>& pending,
+                              const Intrinsics& K) {
+  auto masked = std::make_shared<Cloud>(cloud);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto blank = [&](std::size_t i) { masked->points[i].x = masked->points[i].y = masked->points[i].z = nan; };
+  constexpr int kMarginPx = 3;
+  for (const auto& c : pending) {
+    if (c.kind == change::ChangeKind::kAdded) {
+      for (int i : c.indices) blank(static_cast<std::size_t>(i));
+      continue;
+    }
+    const int u0 = c.region.x - kMarginPx, v0 = c.region.y - kMarginPx;
+    const int u1 = c.region.x + c.region.width + kMarginPx, v1 = c.region.y + c.region.height + kMarginPx;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const PointT& p = cloud.points[i];
+      if (!is_valid(p) || p.z <= 0) continue;
+      const bool organized = cloud.height > 1;
+      const int u = organized ? static_cast<int>(i % cloud.width) : static_cast<int>(std::lround(K.fx * p.x / p.z + K.cx));
+      const int v = organized ? static_cast<int>(i / cloud.width) : static_cast<int>(std::lround(K.fy * p.y / p.z + K.cy));
+      if (u >= u0 && u <= u1 && v >= v0 && v <= v1) blank(i);
+    }
+  }
+  return masked;
+}
+
 }  // namespace
 
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
-      : map(c.background), appearance(c.appearance, c.surprise), snapshot(std::make_shared<SceneSnapshot>()) {}
+      : map(c.background), appearance(c.appearance, c.surprise), changes(c.change),
+        snapshot(std::make_shared<SceneSnapshot>()) {}
 
   // process() and the other writers hold this for their whole duration.
   mutable std::mutex writer;
@@ -79,6 +113,7 @@ struct WorkingMemory::Impl {
   AppearanceStage appearance;  // keyframes, mesh and image surprise; locks itself for readers
 
   // Owned by the writer.
+  change::PersistenceFilter changes;
   std::vector<TrackedObject> objects;
   std::map<std::uint64_t, std::vector<Eigen::Vector3d>> object_samples;  // world points per object
   std::vector<Plane> planes;
@@ -130,6 +165,7 @@ Status validate(const Config& c) {
   if (c.max_event_log < 1) return invalid_argument("events.max_log: must be >= 1");
   if (auto st = background::validate(c.appearance); !st) return st;
   if (auto st = surprise::validate(c.surprise); !st) return st;
+  if (auto st = change::validate(c.change); !st) return st;
   return {};
 }
 
@@ -203,13 +239,56 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   result.surprise_ms = ms_since(t_surprise);
   if (result.surprise) events.insert(events.end(), result.surprise->events.begin(), result.surprise->events.end());
 
-  // Update the background.
+
+  // Geometric change detection against the map as it stands before this frame. Candidates stay
+  // out of the map until the persistence filter confirms them, so the comparison keeps being made
+  // against the model that predates them (OctoMap's log-odds would absorb a new object, or erode
+  // a removed one, within a few frames). The tracker's OBJECT_GONE follows a confirmed removal.
+  std::vector<change::ChangeCluster> pending, absorbed;
+  std::vector<change::ObjectChange> confirmed;
+  Intrinsics K_change;
+  if (config_.change_enabled && m.frames > 0) {
+    const auto t_change = Clock::now();
+    auto K = change::observation_camera(*frame.cloud, frame.intrinsics);
+    if (K) {
+      K_change = *K;
+      std::shared_lock<std::shared_mutex> read(m.map_mutex);
+      // A frame whose region is too large for a dense grid is left without change detection.
+      auto mismatch = change::mismatch_against_map(m.map, *frame.cloud, T, *K, config_.change);
+      if (mismatch) {
+        change::ClusterInput input;
+        input.after_camera = frame.cloud.get();
+        input.T_world_after = T;
+        input.K_after = *K;
+        confirmed = m.changes.update(change::cluster_mismatch(*mismatch, input, config_.change), &pending, &absorbed);
+      }
+    }
+    result.change_ms = ms_since(t_change);
+    result.change_candidates = m.changes.candidates();
+  }
+  CloudConstPtr to_insert = frame.cloud;
+  if (!pending.empty()) to_insert = without_pending(*frame.cloud, pending, K_change);
+
+  // Update the background; confirmed changes are written into it at once.
   const auto t_ins = Clock::now();
   {
     std::unique_lock<std::shared_mutex> write(m.map_mutex);
-    result.insert_stats = m.map.insert(*frame.cloud, T);
+    result.insert_stats = m.map.insert(*to_insert, T);
+    for (const auto& c : confirmed) {
+      if (c.before) m.map.set_voxels(c.before->points_world, background::Occupancy::kFree);
+      if (c.after) m.map.set_voxels(c.after->points_world, background::Occupancy::kOccupied);
+    }
+    for (const auto& c : absorbed) {
+      m.map.set_voxels(c.points_world, c.kind == change::ChangeKind::kAdded ? background::Occupancy::kOccupied
+                                                                            : background::Occupancy::kFree);
+    }
   }
   result.insert_ms = ms_since(t_ins);
+  for (const auto& c : confirmed) {
+    Event e = change::to_event(c);
+    e.stamp_s = frame.stamp_s;
+    events.push_back(std::move(e));
+  }
 
   for (std::size_t c = 0; c < result.objects.size(); ++c) {
     ObjectCluster cluster = result.objects[c];
@@ -344,6 +423,7 @@ void WorkingMemory::reset() {
   impl_->appearance.reset();
   impl_->objects.clear();
   impl_->object_samples.clear();
+  impl_->changes.reset();
   impl_->planes.clear();
   impl_->frames = impl_->points = 0;
   impl_->total_ms = impl_->last_ms = 0;
@@ -451,6 +531,7 @@ Status WorkingMemory::load(const fs::path& model_dir) {
   config_.background.resolution_m = m.map.resolution();
   m.objects = std::move(objects);
   m.object_samples = std::move(samples);
+  m.changes.reset();
   m.planes = std::move(planes);
   m.frames = frames;
   m.points = points;

@@ -2,7 +2,10 @@
 /// The background: an OctoMap ColorOcTree with free space from ray casting. OctoMap stays inside
 /// this module; callers see points, boxes and states.
 #include <filesystem>
+#include <cmath>
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/geometry.h"
@@ -34,6 +37,31 @@ struct BoxOccupancy {
   std::size_t occupied_voxels = 0, free_voxels = 0, unknown_voxels = 0;  ///< at map resolution
 };
 
+/// A dense copy of part of the map at its finest resolution, aligned to its voxels: for
+/// per-pixel and per-point lookups without octree searches (change detection).
+struct DenseGrid {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< min corner of voxel (0, 0, 0), world
+  double resolution = 0.0;
+  int nx = 0, ny = 0, nz = 0;
+  std::vector<std::uint8_t> state;  ///< Occupancy per voxel, x fastest
+  std::vector<std::uint32_t> rgb;   ///< 0xRRGGBB per voxel (meaningful where occupied)
+  std::vector<std::uint8_t> probability;  ///< occupancy probability per voxel, times 255
+  std::size_t size() const { return state.size(); }
+  /// Index of the voxel holding p, or -1 outside the grid.
+  long index_of(const Eigen::Vector3d& p_world) const {
+    const Eigen::Vector3d q = (p_world - origin) / resolution;
+    const long i = static_cast<long>(std::floor(q.x())), j = static_cast<long>(std::floor(q.y())),
+               k = static_cast<long>(std::floor(q.z()));
+    if (i < 0 || j < 0 || k < 0 || i >= nx || j >= ny || k >= nz) return -1;
+    return (k * ny + j) * nx + i;
+  }
+  Occupancy at(long index) const { return index < 0 ? Occupancy::kUnknown : static_cast<Occupancy>(state[index]); }
+  Eigen::Vector3d center(long index) const {
+    const long i = index % nx, j = (index / nx) % ny, k = index / (static_cast<long>(nx) * ny);
+    return origin + resolution * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
+  }
+};
+
 struct InsertStats {
   std::size_t points = 0;          ///< valid points in the frame
   std::size_t occupied_updates = 0;
@@ -61,6 +89,14 @@ class OccupancyMap {
   /// unknown voxels stay unknown. Returns the number of voxels changed.
   std::size_t clear_box(const Aabb& box_world);
   void reset();
+
+  /// The voxels overlapping a box as a dense grid. Error when the box is invalid, outside the
+  /// map's extent, or holds more than max_voxels voxels.
+  Result<DenseGrid> dense_grid(const Aabb& box_world, std::size_t max_voxels = std::size_t{1} << 26) const;
+  /// Sets the voxels holding the given points to the clamped free or occupied belief (a confirmed
+  /// change written into the model at once instead of over several frames). kUnknown deletes
+  /// them. Returns the number of distinct voxels set.
+  std::size_t set_voxels(const std::vector<Eigen::Vector3d>& points_world, Occupancy state);
 
   /// .ot keeps colour; .bt keeps occupancy only. Written to a temporary file then renamed.
   Status save(const std::filesystem::path& path) const;

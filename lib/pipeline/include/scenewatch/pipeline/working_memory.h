@@ -1,6 +1,7 @@
 #pragma once
 /// The facade: WorkingMemory::process(frame) validates the frame, segments it, tracks objects at
-/// cluster level, emits events and updates the background. It owns the modules; the service
+/// cluster level, detects geometric changes against the background, emits events and updates
+/// the background. It owns the modules; the service
 /// talks to it and knows nothing of their insides.
 #include <atomic>
 #include <cstdint>
@@ -14,6 +15,7 @@
 
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/change/mismatch.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
@@ -35,6 +37,10 @@ struct Config {
   background::Config background;
   segmentation::Config segmentation;
   TrackingConfig tracking;
+  /// Geometric change detection (OBJECT_ADDED / OBJECT_REMOVED / OBJECT_MOVED) against the map
+  /// as it stood before each frame, with a persistence filter.
+  bool change_enabled = true;
+  change::Config change;
   background::AppearanceConfig appearance;  ///< keyframes and mesh (posed RGB-D frames only)
   surprise::SurpriseConfig surprise;        ///< image-based Bayesian surprise
   std::size_t max_event_log = 10000;  ///< events kept in memory for GetEvents
@@ -61,7 +67,8 @@ struct FrameResult {
   std::vector<Event> events;
   background::InsertStats insert_stats;
   std::shared_ptr<const SurpriseResult> surprise;  ///< null: the frame had no pose or no keyframes existed yet
-  double segment_ms = 0, insert_ms = 0, surprise_ms = 0, total_ms = 0;
+  double segment_ms = 0, insert_ms = 0, surprise_ms = 0, change_ms = 0, total_ms = 0;
+  std::size_t change_candidates = 0;  ///< changes seen but not yet confirmed
 };
 
 /// An immutable view of the scene, swapped atomically after each frame: readers never wait for

@@ -1,0 +1,56 @@
+#pragma once
+/// Object-level scoring of change events against ground truth, in the manner of Dynablox
+/// (Schmid et al. 2023): precision is the share of events most of whose points belong to truly
+/// changed objects; recall is the share of true changes that some event covers at point
+/// IoU >= a threshold; IoU is the best event's, averaged over the covered changes.
+#include <cstdint>
+#include <vector>
+
+#include "scenewatch/core/event.h"
+
+namespace scenewatch::change {
+
+/// A true change: its points in BEFORE (removed, moved) and/or AFTER (added, moved).
+struct TrueChange {
+  std::uint32_t object_id = 0;
+  std::vector<int> indices_before, indices_after;
+};
+
+struct ChangeScore {
+  std::size_t events = 0, true_changes = 0;
+  std::size_t matched_events = 0, matched_changes = 0;
+  double iou_sum = 0.0;  ///< over matched true changes (best IoU)
+  double precision() const { return events ? static_cast<double>(matched_events) / events : 1.0; }
+  double recall() const { return true_changes ? static_cast<double>(matched_changes) / true_changes : 1.0; }
+  double mean_iou() const { return matched_changes ? iou_sum / matched_changes : 0.0; }
+  ChangeScore& operator+=(const ChangeScore& o);
+};
+
+/// Point IoU of an event with a true change: the union of its BEFORE and AFTER points against the
+/// change's, each side in its own index space.
+double change_iou(const Event& event, const TrueChange& truth);
+
+/// Scores events against true changes (see above).
+ChangeScore score_changes(const std::vector<Event>& events, const std::vector<TrueChange>& truth,
+                          double iou_threshold = 0.3);
+
+/// True changes of a same-camera pair from per-point object labels (mOSD: id = label / 10,
+/// labels below `min_label` are background). An object of AFTER is added when fewer than half of
+/// its points lie within `near_m` of any labelled object point of BEFORE; removed likewise the
+/// other way, unless most of its pixels are occluded in AFTER (valid AFTER depth in front of it).
+/// Objects with fewer than min_points labelled points are left out.
+std::vector<TrueChange> true_changes_from_labels(const std::vector<Eigen::Vector3f>& before_xyz,
+                                                 const std::vector<std::uint32_t>& before_labels,
+                                                 const std::vector<Eigen::Vector3f>& after_xyz,
+                                                 const std::vector<std::uint32_t>& after_labels,
+                                                 std::uint32_t divisor = 10, std::uint32_t min_label = 10,
+                                                 double near_m = 0.01, std::size_t min_points = 100);
+
+/// True when two labelled organized scenes come from one unmoved camera: most pixels both label
+/// as the support (`table_label`) have the same depth (to 0.1 mm; mOSD's sessions share the
+/// table's exact depth).
+bool same_camera_by_labels(const std::vector<Eigen::Vector3f>& before_xyz, const std::vector<std::uint32_t>& before_labels,
+                           const std::vector<Eigen::Vector3f>& after_xyz, const std::vector<std::uint32_t>& after_labels,
+                           std::uint32_t table_label = 1);
+
+}  // namespace scenewatch::change

@@ -1,0 +1,113 @@
+#pragma once
+/// Per-pixel geometric mismatch between a model and a new observation at a known pose (issue 5).
+///
+/// "Added": an observed point lies where the model knows space to be free, farther than a
+/// depth-dependent tolerance from any surface of the model. "Removed": a model surface lies in
+/// front of the observed depth at its pixel by more than the tolerance, so this frame's ray passed
+/// through it. Unknown space, occluded surfaces and pixels without depth claim nothing.
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/core/cloud.h"
+#include "scenewatch/core/geometry.h"
+#include "scenewatch/core/result.h"
+
+namespace scenewatch::change {
+
+struct Config {
+  /// Tolerance at depth z: max(min_tolerance_m, sigma_factor * sigma(z)), with the Kinect's axial
+  /// noise sigma(z) = 0.0012 + 0.0019 (z - 0.4)^2 m (Nguyen, Izadi & Lovell 2012).
+  double sigma_factor = 3.0;
+  double min_tolerance_m = 0.01;
+  /// Only voxels the map holds occupied with at least this probability can be claimed removed:
+  /// a surface seen once (a flying pixel at a silhouette) is no evidence of an object. A map
+  /// built from one frame holds prob_hit (0.7); diff() lowers the threshold to it.
+  double min_surface_probability = 0.8;
+  /// Only depths up to this claim anything (Kinect noise beyond is as large as a voxel, and the
+  /// dense grid grows with the cube of the range).
+  double max_range_m = 2.5;
+  /// Mismatch points are grouped over a voxel grid of this edge (26-connected cells).
+  double cluster_voxel_m = 0.02;
+  /// A cluster whose largest box side is below this is noise (border residue, speckle).
+  double min_object_size_m = 0.025;
+  std::size_t min_cluster_points = 15;  ///< and so is one with fewer points (or voxels, for removed)
+  /// ... and one whose evidence covers less surface than this (pixels weighted by their metric
+  /// footprint (z/f)^2, voxels by their face): a 3 cm object shows at least about 2 x 2 cm.
+  double min_object_area_m2 = 0.0004;
+  /// Same-camera pairs: a changed pixel counts only when this many of its 8 neighbours changed
+  /// too (removes one-pixel slivers along depth edges).
+  int min_changed_neighbours = 5;
+  /// Pairing a vanished cluster with an appeared one as a move: sorted box sides within this
+  /// ratio, mean colours within this RGB distance, and a centroid displacement of at least
+  /// min_move_m (below it the two are one object's border residue).
+  double move_max_size_ratio = 2.0;
+  double move_max_color_distance = 80.0;
+  double move_min_distance_m = 0.03;
+  /// Sequences: a change fires after this many consistent frames (1 = at once).
+  int persistence_frames = 3;
+  /// A candidate is re-observed when a cluster of its kind lies within this distance.
+  double persistence_match_m = 0.06;
+  /// Largest dense grid built from the map for one frame (voxels).
+  std::size_t max_grid_voxels = std::size_t{1} << 25;
+};
+
+/// Validates ranges; the message names the key ("change.persistence_frames: ...").
+Status validate(const Config& config);
+
+/// The tolerance at depth z (metres).
+double tolerance_m(const Config& config, double z);
+
+/// A depth image in some camera: z per pixel (NaN where none), plus that camera.
+struct DepthView {
+  Intrinsics K;
+  std::vector<float> z;  ///< row-major, K.width * K.height
+  float at(int u, int v) const { return z[static_cast<std::size_t>(v) * K.width + u]; }
+};
+
+/// Intrinsics of an organized cloud fitted from its own points (u = fx x/z + cx, v = fy y/z + cy),
+/// by least squares. Error when the cloud is not organized or the fit leaves residuals above
+/// half a pixel (the cloud does not come from one pinhole camera).
+Result<Intrinsics> estimate_intrinsics(const Cloud& organized_camera);
+
+/// The camera an observation is seen with: the given intrinsics, else those fitted to an
+/// organized cloud, else a virtual pinhole covering the points of an unorganized cloud.
+Result<Intrinsics> observation_camera(const Cloud& points_camera, const std::optional<Intrinsics>& K);
+
+/// The depth image of a cloud seen from its own camera (an organized cloud: its z; otherwise a
+/// z-buffer of the projected points, nearest wins).
+DepthView depth_view(const Cloud& points_camera, const Intrinsics& K);
+
+/// A model voxel this observation saw through.
+struct MissingVoxel {
+  Eigen::Vector3d center_world = Eigen::Vector3d::Zero();
+  std::uint32_t rgb = 0;  ///< the model's colour there, 0xRRGGBB
+  int u = 0, v = 0;       ///< pixel of its centre
+  float depth_gap_m = 0;  ///< observed depth minus the voxel's
+};
+
+/// Raw mismatch of one observation.
+struct Mismatch {
+  std::vector<int> added;             ///< indices of observed points in space the model holds free
+  std::vector<float> added_gap_m;     ///< per added point: distance to the nearest model surface (capped)
+  std::vector<MissingVoxel> missing;  ///< model voxels the rays passed through
+  double voxel_m = 0.0;               ///< the map's voxel edge (map path)
+  /// Removed side given as points of an earlier organized observation (same-camera pairs); its
+  /// indices index that observation. Empty for the map path.
+  std::vector<int> removed_points;
+  double grid_ms = 0, added_ms = 0, missing_ms = 0;  ///< where the time went
+};
+
+/// Compares an observation (points in the camera frame, placed with T_world_camera) with the
+/// map. Error when the region is too large for a dense grid or the camera is invalid.
+Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& points_camera,
+                                      const Pose& T_world_camera, const Intrinsics& K, const Config& config);
+
+/// Same-camera pair of organized clouds of equal size (the camera did not move): exact per-pixel
+/// reasoning. A pixel whose AFTER depth is in front of BEFORE by more than the tolerance is added
+/// (BEFORE saw through that space); BEFORE in front of AFTER is removed (AFTER saw through it).
+/// Error when the sizes differ or the clouds are not organized.
+Result<Mismatch> mismatch_same_camera(const Cloud& before_camera, const Cloud& after_camera, const Config& config);
+
+}  // namespace scenewatch::change

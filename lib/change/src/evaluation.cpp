@@ -1,0 +1,149 @@
+// Object-level scoring of change events against true changes.
+#include "scenewatch/change/evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <unordered_set>
+
+namespace scenewatch::change {
+namespace {
+
+// |A n B| for two sorted index lists.
+std::size_t intersection(std::vector<int> a, std::vector<int> b) {
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  std::size_t n = 0;
+  for (std::size_t i = 0, j = 0; i < a.size() && j < b.size();) {
+    if (a[i] < b[j]) {
+      ++i;
+    } else if (b[j] < a[i]) {
+      ++j;
+    } else {
+      ++n;
+      ++i;
+      ++j;
+    }
+  }
+  return n;
+}
+
+}  // namespace
+
+ChangeScore& ChangeScore::operator+=(const ChangeScore& o) {
+  events += o.events;
+  true_changes += o.true_changes;
+  matched_events += o.matched_events;
+  matched_changes += o.matched_changes;
+  iou_sum += o.iou_sum;
+  return *this;
+}
+
+double change_iou(const Event& e, const TrueChange& t) {
+  // Only the sides the truth has: a move found where the truth lists a removal (or an addition)
+  // is scored on its vanished (or appeared) side.
+  const bool use_before = !t.indices_before.empty(), use_after = !t.indices_after.empty();
+  const std::size_t inter = (use_before ? intersection(e.indices_before, t.indices_before) : 0) +
+                            (use_after ? intersection(e.indices_after, t.indices_after) : 0);
+  const std::size_t uni = (use_before ? e.indices_before.size() + t.indices_before.size() : 0) +
+                          (use_after ? e.indices_after.size() + t.indices_after.size() : 0) - inter;
+  return uni ? static_cast<double>(inter) / uni : 0.0;
+}
+
+ChangeScore score_changes(const std::vector<Event>& events, const std::vector<TrueChange>& truth, double iou_threshold) {
+  ChangeScore s;
+  s.events = events.size();
+  s.true_changes = truth.size();
+  for (const auto& t : truth) {
+    double best = 0;
+    for (const auto& e : events) best = std::max(best, change_iou(e, t));
+    if (best >= iou_threshold) {
+      ++s.matched_changes;
+      s.iou_sum += best;
+    }
+  }
+  // An event is right when most of its points belong to truly changed objects (on the side it
+  // claims: BEFORE for what vanished, AFTER for what appeared).
+  std::vector<int> changed_before, changed_after;
+  for (const auto& t : truth) {
+    changed_before.insert(changed_before.end(), t.indices_before.begin(), t.indices_before.end());
+    changed_after.insert(changed_after.end(), t.indices_after.begin(), t.indices_after.end());
+  }
+  for (const auto& e : events) {
+    const std::size_t in = intersection(e.indices_before, changed_before) + intersection(e.indices_after, changed_after);
+    const std::size_t n = e.indices_before.size() + e.indices_after.size();
+    s.matched_events += n > 0 && 2 * in >= n ? 1 : 0;
+  }
+  return s;
+}
+
+std::vector<TrueChange> true_changes_from_labels(const std::vector<Eigen::Vector3f>& bx,
+                                                 const std::vector<std::uint32_t>& bl,
+                                                 const std::vector<Eigen::Vector3f>& ax,
+                                                 const std::vector<std::uint32_t>& al, std::uint32_t divisor,
+                                                 std::uint32_t min_label, double near_m, std::size_t min_points) {
+  // Labelled object points of one side on a hash grid of near_m cells, for "within near_m" tests.
+  auto key = [near_m](const Eigen::Vector3f& p) {
+    auto c = [&](float x) { return static_cast<std::int64_t>(std::floor(x / near_m)) & 0x1fffff; };
+    return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
+  };
+  auto object_cells = [&](const std::vector<Eigen::Vector3f>& xyz, const std::vector<std::uint32_t>& labels) {
+    std::unordered_set<std::int64_t> cells;
+    for (std::size_t i = 0; i < xyz.size(); ++i)
+      if (labels[i] >= min_label && xyz[i].allFinite()) cells.insert(key(xyz[i]));
+    return cells;
+  };
+  auto near = [&](const std::unordered_set<std::int64_t>& cells, const Eigen::Vector3f& p) {
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz)
+          if (cells.count(key(p + Eigen::Vector3f(dx, dy, dz) * static_cast<float>(near_m)))) return true;
+    return false;
+  };
+  auto objects = [&](const std::vector<Eigen::Vector3f>& xyz, const std::vector<std::uint32_t>& labels) {
+    std::map<std::uint32_t, std::vector<int>> out;
+    for (std::size_t i = 0; i < xyz.size(); ++i)
+      if (labels[i] >= min_label && xyz[i].allFinite()) out[labels[i] / divisor].push_back(static_cast<int>(i));
+    return out;
+  };
+  const auto before_cells = object_cells(bx, bl), after_cells = object_cells(ax, al);
+  std::vector<TrueChange> out;
+  for (const auto& [id, idx] : objects(ax, al)) {
+    if (idx.size() < min_points) continue;
+    std::size_t there = 0;
+    for (int i : idx) there += near(before_cells, ax[i]) ? 1 : 0;
+    if (2 * there >= idx.size()) continue;
+    TrueChange t;
+    t.object_id = id;
+    t.indices_after = idx;
+    out.push_back(std::move(t));
+  }
+  for (const auto& [id, idx] : objects(bx, bl)) {
+    if (idx.size() < min_points) continue;
+    std::size_t there = 0, occluded = 0;
+    for (int i : idx) {
+      there += near(after_cells, bx[i]) ? 1 : 0;
+      occluded += ax[i].allFinite() && ax[i].z() < bx[i].z() - 0.01f ? 1 : 0;
+    }
+    if (2 * there >= idx.size() || 2 * occluded >= idx.size()) continue;
+    TrueChange t;
+    t.object_id = id;
+    t.indices_before = idx;
+    out.push_back(std::move(t));
+  }
+  return out;
+}
+
+bool same_camera_by_labels(const std::vector<Eigen::Vector3f>& bx, const std::vector<std::uint32_t>& bl,
+                           const std::vector<Eigen::Vector3f>& ax, const std::vector<std::uint32_t>& al,
+                           std::uint32_t table_label) {
+  std::size_t n = 0, same = 0;
+  for (std::size_t i = 0; i < bx.size() && i < ax.size(); ++i) {
+    if (bl[i] != table_label || al[i] != table_label || !bx[i].allFinite() || !ax[i].allFinite()) continue;
+    ++n;
+    same += std::abs(bx[i].z() - ax[i].z()) < 1e-4f ? 1 : 0;
+  }
+  return n > 1000 && 2 * same > n;
+}
+
+}  // namespace scenewatch::change

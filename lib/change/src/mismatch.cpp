@@ -1,0 +1,308 @@
+// Per-pixel geometric mismatch against the occupancy map, and per-pixel depth reasoning for
+// same-camera pairs.
+#include "scenewatch/change/mismatch.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+namespace scenewatch::change {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+// Half the diagonal of a unit cube: a surface inside a voxel lies within this many voxel edges
+// of its centre.
+constexpr double kHalfDiagonal = 0.8660254;
+
+}  // namespace
+
+Status validate(const Config& c) {
+  auto bad = [](const std::string& key, const std::string& why) { return invalid_argument("change." + key + ": " + why); };
+  if (!(c.sigma_factor > 0 && c.sigma_factor <= 20)) return bad("sigma_factor", "must be in (0, 20]");
+  if (!(c.min_tolerance_m >= 0 && c.min_tolerance_m <= 0.5)) return bad("min_tolerance_m", "must be in [0, 0.5] m");
+  if (!(c.cluster_voxel_m >= 0.002 && c.cluster_voxel_m <= 0.2)) return bad("cluster_voxel_m", "must be in [0.002, 0.2] m");
+  if (!(c.min_object_size_m >= 0 && c.min_object_size_m <= 2)) return bad("min_object_size_m", "must be in [0, 2] m");
+  if (!(c.min_object_area_m2 >= 0 && c.min_object_area_m2 <= 1)) return bad("min_object_area_m2", "must be in [0, 1] m2");
+  if (!(c.min_surface_probability >= 0.5 && c.min_surface_probability < 1)) return bad("min_surface_probability", "must be in [0.5, 1)");
+  if (!(c.max_range_m > 0.1 && c.max_range_m <= 20)) return bad("max_range_m", "must be in (0.1, 20] m");
+  if (c.min_cluster_points < 1) return bad("min_cluster_points", "must be >= 1");
+  if (c.min_changed_neighbours < 0 || c.min_changed_neighbours > 8) return bad("min_changed_neighbours", "must be in [0, 8]");
+  if (!(c.move_max_size_ratio >= 1)) return bad("move_max_size_ratio", "must be >= 1");
+  if (!(c.move_max_color_distance >= 0)) return bad("move_max_color_distance", "must be >= 0");
+  if (!(c.move_min_distance_m >= 0)) return bad("move_min_distance_m", "must be >= 0 m");
+  if (c.persistence_frames < 1 || c.persistence_frames > 100) {
+    return bad("persistence_frames", "must be in [1, 100], got " + std::to_string(c.persistence_frames));
+  }
+  if (!(c.persistence_match_m > 0 && c.persistence_match_m <= 1)) return bad("persistence_match_m", "must be in (0, 1] m");
+  if (c.max_grid_voxels < 1000) return bad("max_grid_voxels", "must be >= 1000");
+  return {};
+}
+
+double tolerance_m(const Config& c, double z) {
+  const double d = z - 0.4;
+  const double sigma = 0.0012 + 0.0019 * d * d;  // Nguyen, Izadi & Lovell 2012, eq. (2), z in m
+  return std::max(c.min_tolerance_m, c.sigma_factor * sigma);
+}
+
+Result<Intrinsics> estimate_intrinsics(const Cloud& cloud) {
+  if (cloud.height <= 1) return invalid_argument("intrinsics: the cloud is not organized");
+  // Independent fits u = fx (x/z) + cx and v = fy (y/z) + cy.
+  double sa[2] = {0, 0}, saa[2] = {0, 0}, sb[2] = {0, 0}, sab[2] = {0, 0};
+  std::size_t n = 0;
+  for (std::uint32_t v = 0; v < cloud.height; v += 2)
+    for (std::uint32_t u = 0; u < cloud.width; u += 2) {
+      const PointT& p = cloud.at(u, v);
+      if (!is_valid(p) || p.z <= 0) continue;
+      const double a[2] = {p.x / p.z, p.y / p.z}, b[2] = {static_cast<double>(u), static_cast<double>(v)};
+      for (int i = 0; i < 2; ++i) {
+        sa[i] += a[i];
+        saa[i] += a[i] * a[i];
+        sb[i] += b[i];
+        sab[i] += a[i] * b[i];
+      }
+      ++n;
+    }
+  if (n < 100) return invalid_argument("intrinsics: too few valid points to fit a camera");
+  double f[2], c[2];
+  for (int i = 0; i < 2; ++i) {
+    const double den = n * saa[i] - sa[i] * sa[i];
+    if (!(std::abs(den) > 1e-12)) return invalid_argument("intrinsics: degenerate cloud, cannot fit a camera");
+    f[i] = (n * sab[i] - sa[i] * sb[i]) / den;
+    c[i] = (sb[i] - f[i] * sa[i]) / n;
+  }
+  Intrinsics K;
+  K.fx = f[0];
+  K.fy = f[1];
+  K.cx = c[0];
+  K.cy = c[1];
+  K.width = static_cast<int>(cloud.width);
+  K.height = static_cast<int>(cloud.height);
+  if (!K.valid()) return invalid_argument("intrinsics: the fitted focal length is not positive");
+  double worst = 0;
+  for (std::uint32_t v = 0; v < cloud.height; v += 7)
+    for (std::uint32_t u = 0; u < cloud.width; u += 7) {
+      const PointT& p = cloud.at(u, v);
+      if (!is_valid(p) || p.z <= 0) continue;
+      worst = std::max({worst, std::abs(K.fx * p.x / p.z + K.cx - u), std::abs(K.fy * p.y / p.z + K.cy - v)});
+    }
+  if (worst > 0.5) {
+    return invalid_argument("intrinsics: the organized cloud does not fit one pinhole camera (residual " +
+                            std::to_string(worst) + " px)");
+  }
+  return K;
+}
+
+Result<Intrinsics> observation_camera(const Cloud& cloud, const std::optional<Intrinsics>& K) {
+  if (K) {
+    if (!K->valid()) return invalid_argument("intrinsics are invalid");
+    return *K;
+  }
+  if (cloud.height > 1) return estimate_intrinsics(cloud);
+  // A virtual pinhole, 640 pixels wide, whose field of view covers every point in front.
+  double tx = 0, ty = 0;
+  std::size_t n = 0;
+  for (const auto& p : cloud.points) {
+    if (!is_valid(p) || p.z <= 0) continue;
+    tx = std::max(tx, std::abs(static_cast<double>(p.x / p.z)));
+    ty = std::max(ty, std::abs(static_cast<double>(p.y / p.z)));
+    ++n;
+  }
+  if (n == 0) return invalid_argument("no point lies in front of the camera (z > 0)");
+  Intrinsics V;
+  V.width = 640;
+  const double t = std::max({tx, ty, 1e-3});
+  V.fx = V.fy = (V.width / 2.0 - 1) / t;
+  V.height = std::max(2, 2 * static_cast<int>(std::ceil(ty * V.fy + 1)));
+  V.cx = V.width / 2.0 - 0.5;
+  V.cy = V.height / 2.0 - 0.5;
+  return V;
+}
+
+DepthView depth_view(const Cloud& cloud, const Intrinsics& K) {
+  DepthView view;
+  view.K = K;
+  view.z.assign(static_cast<std::size_t>(K.width) * K.height, kNaN);
+  if (cloud.height > 1 && static_cast<int>(cloud.width) == K.width && static_cast<int>(cloud.height) == K.height) {
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const PointT& p = cloud.points[i];
+      if (is_valid(p) && p.z > 0) view.z[i] = p.z;
+    }
+    return view;
+  }
+  for (const auto& p : cloud.points) {
+    if (!is_valid(p) || p.z <= 0) continue;
+    const long u = std::lround(K.fx * p.x / p.z + K.cx), v = std::lround(K.fy * p.y / p.z + K.cy);
+    if (u < 0 || v < 0 || u >= K.width || v >= K.height) continue;
+    float& z = view.z[static_cast<std::size_t>(v) * K.width + u];
+    if (!(z <= p.z)) z = p.z;  // NaN or farther: the nearer point wins
+  }
+  return view;
+}
+
+Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& cloud, const Pose& T,
+                                      const Intrinsics& K, const Config& config) {
+  if (!K.valid()) return invalid_argument("mismatch: intrinsics are invalid");
+  Mismatch out;
+  out.voxel_m = map.resolution();
+  const auto t0 = Clock::now();
+  // 1. A dense copy of the map over the frame's rays: the camera and every valid point.
+  const Eigen::Isometry3f Tf = T.cast<float>();
+  Aabb box;
+  box.min = box.max = T.translation();
+  std::size_t valid = 0;
+  for (const auto& p : cloud.points) {
+    if (!is_valid(p) || p.z > config.max_range_m) continue;
+    const Eigen::Vector3d w = (Tf * p.getVector3fMap()).cast<double>();
+    box.min = box.min.cwiseMin(w);
+    box.max = box.max.cwiseMax(w);
+    ++valid;
+  }
+  if (valid == 0) return Mismatch{};  // nothing within range: nothing to claim
+  const double res = map.resolution();
+  box.min.array() -= 2 * res;
+  box.max.array() += 2 * res;
+  auto grid_or = map.dense_grid(box, config.max_grid_voxels);
+  if (!grid_or) return grid_or.error();
+  const background::DenseGrid& grid = *grid_or;
+  out.grid_ms = ms_since(t0);
+
+  // 2. Added: points whose voxel the model holds free and whose distance to every occupied voxel
+  //    centre exceeds half a voxel diagonal plus the tolerance at their depth (a surface inside an
+  //    occupied voxel may lie anywhere in it). Only points in free voxels pay for the search.
+  const auto t1 = Clock::now();
+  using background::Occupancy;
+  const long sx = 1, sy = grid.nx, sz = static_cast<long>(grid.nx) * grid.ny;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const PointT& p = cloud.points[i];
+    if (!is_valid(p) || p.z > config.max_range_m) continue;
+    const Eigen::Vector3d w = (Tf * p.getVector3fMap()).cast<double>();
+    const long idx = grid.index_of(w);
+    if (grid.at(idx) != Occupancy::kFree) continue;
+    const double reach = kHalfDiagonal * res + tolerance_m(config, p.z);
+    const int ring = std::min(3, static_cast<int>(std::ceil(reach / res - 0.5)));
+    const long i0 = idx % grid.nx, j0 = (idx / grid.nx) % grid.ny, k0 = idx / sz;
+    double nearest2 = reach * reach;
+    bool near_surface = false;
+    for (int dk = -ring; dk <= ring && !near_surface; ++dk) {
+      const long k = k0 + dk;
+      if (k < 0 || k >= grid.nz) continue;
+      for (int dj = -ring; dj <= ring && !near_surface; ++dj) {
+        const long j = j0 + dj;
+        if (j < 0 || j >= grid.ny) continue;
+        for (int di = -ring; di <= ring; ++di) {
+          const long ii = i0 + di;
+          if (ii < 0 || ii >= grid.nx) continue;
+          const long n = k * sz + j * sy + ii * sx;
+          // Near a surface, or near space never seen (the far side of a thin leg whose
+          // silhouette rays grazed this voxel): no claim.
+          if (grid.state[n] == static_cast<std::uint8_t>(Occupancy::kFree)) continue;
+          const double d2 = (grid.center(n) - w).squaredNorm();
+          if (d2 < nearest2) {
+            near_surface = true;
+            break;
+          }
+        }
+      }
+    }
+    if (near_surface) continue;
+    out.added.push_back(static_cast<int>(i));
+    out.added_gap_m.push_back(static_cast<float>(reach));
+  }
+  out.added_ms = ms_since(t1);
+
+  // 3. Removed: occupied voxels whose whole projected footprint shows depth behind them by more
+  //    than the tolerance. A footprint pixel at or in front of the voxel (the surface is still
+  //    there, or something occludes it) vetoes; so does one without depth (a hole at a grazing
+  //    edge may be the surface itself).
+  const auto t2 = Clock::now();
+  const DepthView depth = depth_view(cloud, K);
+  const Eigen::Isometry3d T_camera_world = T.inverse();
+  const auto min_probability = static_cast<std::uint8_t>(std::floor(255.0 * config.min_surface_probability));
+  for (std::size_t n = 0; n < grid.size(); ++n) {
+    if (grid.state[n] != static_cast<std::uint8_t>(Occupancy::kOccupied) || grid.probability[n] < min_probability) continue;
+    const Eigen::Vector3d c = grid.center(static_cast<long>(n));
+    const Eigen::Vector3d q = T_camera_world * c;
+    if (q.z() <= res || q.z() > config.max_range_m) continue;
+    const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
+    const double half_px = K.fx * kHalfDiagonal * res / q.z();
+    if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) continue;
+    const double limit = q.z() + kHalfDiagonal * res + tolerance_m(config, q.z());
+    constexpr int kSteps = 3;  // (2 kSteps + 1)^2 samples over the footprint
+    int with_depth = 0, total = 0;
+    float nearest = std::numeric_limits<float>::infinity();
+    bool veto = false;
+    for (int a = -kSteps; a <= kSteps && !veto; ++a)
+      for (int b = -kSteps; b <= kSteps; ++b) {
+        const int u = static_cast<int>(std::lround(uc + half_px * a / kSteps));
+        const int v = static_cast<int>(std::lround(vc + half_px * b / kSteps));
+        ++total;
+        const float z = depth.at(u, v);
+        if (!(z > 0)) continue;
+        ++with_depth;
+        if (z <= limit) {
+          veto = true;
+          break;
+        }
+        nearest = std::min(nearest, z);
+      }
+    if (veto || with_depth < total) continue;
+    MissingVoxel m;
+    m.center_world = c;
+    m.rgb = grid.rgb[n];
+    m.u = static_cast<int>(std::lround(uc));
+    m.v = static_cast<int>(std::lround(vc));
+    m.depth_gap_m = static_cast<float>(nearest - q.z());
+    out.missing.push_back(m);
+  }
+  out.missing_ms = ms_since(t2);
+  return out;
+}
+
+Result<Mismatch> mismatch_same_camera(const Cloud& before, const Cloud& after, const Config& config) {
+  if (before.height <= 1 || after.height <= 1) return invalid_argument("same-camera diff: both clouds must be organized");
+  if (before.width != after.width || before.height != after.height) {
+    return invalid_argument("same-camera diff: BEFORE is " + std::to_string(before.width) + "x" + std::to_string(before.height) +
+                            ", AFTER is " + std::to_string(after.width) + "x" + std::to_string(after.height));
+  }
+  const int w = static_cast<int>(after.width), h = static_cast<int>(after.height);
+  // +1 added, -1 removed, 0 nothing; pixels without depth on either side claim nothing.
+  std::vector<std::int8_t> change(static_cast<std::size_t>(w) * h, 0);
+  std::vector<float> gap(change.size(), 0.f);
+  for (std::size_t i = 0; i < change.size(); ++i) {
+    const PointT &b = before.points[i], &a = after.points[i];
+    if (!is_valid(a) || !is_valid(b) || a.z <= 0 || b.z <= 0) continue;
+    if (a.z < b.z - tolerance_m(config, a.z)) {
+      change[i] = 1;
+      gap[i] = b.z - a.z;
+    } else if (b.z < a.z - tolerance_m(config, b.z)) {
+      change[i] = -1;
+      gap[i] = a.z - b.z;
+    }
+  }
+  Mismatch out;
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      if (change[i] == 0) continue;
+      int same = 0;
+      for (int dv = -1; dv <= 1; ++dv)
+        for (int du = -1; du <= 1; ++du) {
+          if ((du == 0 && dv == 0) || u + du < 0 || v + dv < 0 || u + du >= w || v + dv >= h) continue;
+          same += change[static_cast<std::size_t>(v + dv) * w + (u + du)] == change[i] ? 1 : 0;
+        }
+      if (same < config.min_changed_neighbours) continue;
+      if (change[i] > 0) {
+        out.added.push_back(static_cast<int>(i));
+        out.added_gap_m.push_back(gap[i]);
+      } else {
+        out.removed_points.push_back(static_cast<int>(i));
+      }
+    }
+  return out;
+}
+
+}  // namespace scenewatch::change

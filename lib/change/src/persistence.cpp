@@ -1,0 +1,153 @@
+// Persistence filter: candidates are matched frame to frame by kind and centroid; a candidate
+// fires after persistence_frames hits, paired into a move when its opposite is ready too.
+#include "scenewatch/change/persistence.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace scenewatch::change {
+
+namespace {
+constexpr double kZoneMargin_m = 0.05;
+constexpr std::size_t kMaxZones = 256;
+
+bool inside(const Aabb& box, const Eigen::Vector3d& p) {
+  return (p.array() >= box.min.array()).all() && (p.array() <= box.max.array()).all();
+}
+}  // namespace
+
+std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeCluster>& clusters,
+                                                    std::vector<ChangeCluster>* pending,
+                                                    std::vector<ChangeCluster>* absorbed) {
+  const int k = config_.persistence_frames;
+  std::vector<char> matched(candidates_.size(), 0);
+  for (const auto& c : clusters) {
+    bool in_zone = false;
+    for (const auto& z : zones_) in_zone = in_zone || (z.kind == c.kind && inside(z.box_world, c.centroid_world));
+    if (in_zone) {
+      if (absorbed != nullptr) absorbed->push_back(c);
+      continue;
+    }
+    int best = -1;
+    double best_d = config_.persistence_match_m;
+    for (std::size_t i = 0; i < candidates_.size(); ++i) {
+      if (matched[i] || candidates_[i].latest.kind != c.kind) continue;
+      const double d = (candidates_[i].latest.centroid_world - c.centroid_world).norm();
+      if (d <= best_d) {
+        best_d = d;
+        best = static_cast<int>(i);
+      }
+    }
+    if (best < 0) {
+      candidates_.push_back(Candidate{c, 1, 0, 0});
+      matched.push_back(1);
+      continue;
+    }
+    Candidate& cand = candidates_[best];
+    cand.latest = c;
+    ++cand.hits;
+    cand.misses = 0;
+    matched[best] = 1;
+  }
+  for (std::size_t i = 0; i < candidates_.size(); ++i) {
+    if (!matched[i]) ++candidates_[i].misses;
+  }
+  // A candidate not seen for k frames in a row was noise (or left the view before it could be
+  // confirmed).
+  std::vector<Candidate> kept;
+  std::vector<char> kept_matched;
+  for (std::size_t i = 0; i < candidates_.size(); ++i) {
+    if (candidates_[i].misses >= k) continue;
+    kept.push_back(std::move(candidates_[i]));
+    kept_matched.push_back(matched[i]);
+  }
+  candidates_.swap(kept);
+  matched.swap(kept_matched);
+
+  auto ready = [&](const Candidate& c) { return c.hits >= k; };
+  std::vector<char> done(candidates_.size(), 0);
+  std::vector<ObjectChange> out;
+  // Moves: a ready removed candidate with the most similar ready added one.
+  std::vector<std::tuple<double, int, int>> pairs;
+  for (std::size_t r = 0; r < candidates_.size(); ++r) {
+    if (!ready(candidates_[r]) || candidates_[r].latest.kind != ChangeKind::kRemoved) continue;
+    for (std::size_t a = 0; a < candidates_.size(); ++a) {
+      if (!ready(candidates_[a]) || candidates_[a].latest.kind != ChangeKind::kAdded) continue;
+      const double s = move_similarity(candidates_[r].latest, candidates_[a].latest, config_);
+      if (s > 0) pairs.emplace_back(-s, static_cast<int>(r), static_cast<int>(a));
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
+  for (const auto& [neg, r, a] : pairs) {
+    if (done[r] || done[a]) continue;
+    done[r] = done[a] = 1;
+    ObjectChange c;
+    c.kind = EventKind::kObjectMoved;
+    c.before = candidates_[r].latest;
+    c.after = candidates_[a].latest;
+    c.similarity = -neg;
+    out.push_back(std::move(c));
+  }
+  // Singles; one that may still become half of a move waits up to k frames for its partner.
+  for (std::size_t i = 0; i < candidates_.size(); ++i) {
+    Candidate& c = candidates_[i];
+    if (done[i] || !ready(c)) continue;
+    bool partner_coming = false;
+    for (std::size_t j = 0; j < candidates_.size() && !partner_coming; ++j) {
+      if (j == i || done[j] || ready(candidates_[j]) || candidates_[j].latest.kind == c.latest.kind) continue;
+      const auto& removed = c.latest.kind == ChangeKind::kRemoved ? c.latest : candidates_[j].latest;
+      const auto& added = c.latest.kind == ChangeKind::kAdded ? c.latest : candidates_[j].latest;
+      partner_coming = move_similarity(removed, added, config_) > 0;
+    }
+    if (partner_coming && c.waited < k) {
+      ++c.waited;
+      continue;
+    }
+    done[i] = 1;
+    // Another piece of an object whose change fired in this frame (a vanished box seen through
+    // in two parts): written into the model, no second event.
+    bool part_of_fired = false;
+    for (const auto& f : out) {
+      const auto& side = c.latest.kind == ChangeKind::kAdded ? f.after : f.before;
+      if (!side) continue;
+      Aabb grown = side->box_world;
+      grown.min.array() -= kZoneMargin_m;
+      grown.max.array() += kZoneMargin_m;
+      part_of_fired = part_of_fired || inside(grown, c.latest.centroid_world);
+    }
+    if (part_of_fired) {
+      if (absorbed != nullptr) absorbed->push_back(c.latest);
+      continue;
+    }
+    ObjectChange change;
+    if (c.latest.kind == ChangeKind::kAdded) {
+      change.kind = EventKind::kObjectAdded;
+      change.after = c.latest;
+    } else {
+      change.kind = EventKind::kObjectRemoved;
+      change.before = c.latest;
+    }
+    out.push_back(std::move(change));
+  }
+  auto add_zone = [&](const ChangeCluster& c) {
+    Zone z{c.kind, c.box_world};
+    z.box_world.min.array() -= kZoneMargin_m;
+    z.box_world.max.array() += kZoneMargin_m;
+    zones_.push_back(z);
+  };
+  for (const auto& c : out) {
+    if (c.before) add_zone(*c.before);
+    if (c.after) add_zone(*c.after);
+  }
+  if (zones_.size() > kMaxZones) zones_.erase(zones_.begin(), zones_.end() - kMaxZones);
+  std::vector<Candidate> rest;
+  for (std::size_t i = 0; i < candidates_.size(); ++i) {
+    if (done[i]) continue;
+    if (pending != nullptr && matched[i]) pending->push_back(candidates_[i].latest);
+    rest.push_back(std::move(candidates_[i]));
+  }
+  candidates_.swap(rest);
+  return out;
+}
+
+}  // namespace scenewatch::change
