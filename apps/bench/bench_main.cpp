@@ -2,8 +2,10 @@
 #include <CLI/CLI.hpp>
 
 #include "bench.h"
+#include "scenewatch/core/memory.h"
 
 int main(int argc, char** argv) {
+  scenewatch::keep_frame_buffers_in_heap();  // as the daemon runs
   CLI::App app{"scenewatch-bench: time scenewatch against its baselines on real frames (prints tables; not a test)"};
   scenewatch::bench::Options o;
   o.data_dir = SCENEWATCH_DEFAULT_DATA_DIR;

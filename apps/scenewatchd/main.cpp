@@ -14,6 +14,7 @@
 #include "scenewatch/service/daemon_config.h"
 #include "scenewatch/service/log.h"
 #include "scenewatch/service/server.h"
+#include "scenewatch/core/memory.h"
 
 namespace {
 
@@ -48,6 +49,7 @@ class StderrLog {
 }  // namespace
 
 int main(int argc, char** argv) {
+  scenewatch::keep_frame_buffers_in_heap();
   CLI::App app{"scenewatchd - the scenewatch perception service.\n"
                "Serves the scenewatch protocol (4-byte big-endian length + protobuf) over TCP, keeps the\n"
                "working memory of the scene and saves it to the model directory on SaveModel and on\n"

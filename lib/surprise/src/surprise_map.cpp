@@ -30,26 +30,32 @@ Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage&
   SurpriseMap map;
   map.width = view.width;
   map.height = view.height;
-  std::array<std::vector<float>, kChannels> obs;
-  for (auto& o : obs) o.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    float opp[kChannels];
-    to_opponent(observed.rgb[3 * i], observed.rgb[3 * i + 1], observed.rgb[3 * i + 2], opp);
-    for (int c = 0; c < kChannels; ++c) obs[c][i] = opp[c];
-  }
   map.total.resize(n);
-  const float* means[kChannels];
-  const float* ssds[kChannels];
-  const float* observed_ch[kChannels];
-  float* outs[kChannels];
-  for (int c = 0; c < kChannels; ++c) {
-    map.channel[c].resize(n);
-    means[c] = view.mean[c].data();
-    ssds[c] = view.ssd[c].data();
-    observed_ch[c] = obs[c].data();
-    outs[c] = map.channel[c].data();
+  for (auto& channel : map.channel) channel.resize(n);
+  // In blocks, so that the observed opponent signals live in a small buffer rather than in three
+  // more frame-sized arrays (fresh pages cost more than the arithmetic here).
+  constexpr std::size_t kBlock = 4096;
+  std::array<std::array<float, kBlock>, kChannels> obs;
+  for (std::size_t start = 0; start < n; start += kBlock) {
+    const std::size_t len = std::min(kBlock, n - start);
+    for (std::size_t i = 0; i < len; ++i) {
+      const std::uint8_t* px = &observed.rgb[3 * (start + i)];
+      float opp[kChannels];
+      to_opponent(px[0], px[1], px[2], opp);
+      for (int c = 0; c < kChannels; ++c) obs[c][i] = opp[c];
+    }
+    const float* means[kChannels];
+    const float* ssds[kChannels];
+    const float* observed_ch[kChannels];
+    float* outs[kChannels];
+    for (int c = 0; c < kChannels; ++c) {
+      means[c] = view.mean[c].data() + start;
+      ssds[c] = view.ssd[c].data() + start;
+      observed_ch[c] = obs[c].data();
+      outs[c] = map.channel[c].data() + start;
+    }
+    kernel.run_channels(kChannels, view.count.data() + start, means, ssds, observed_ch, outs, map.total.data() + start, len);
   }
-  kernel.run_channels(kChannels, view.count.data(), means, ssds, observed_ch, outs, map.total.data(), n);
   for (std::size_t i = 0; i < n; ++i) map.known_pixels += std::isnan(map.total[i]) ? 0 : 1;
   return map;
 }

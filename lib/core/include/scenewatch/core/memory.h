@@ -1,0 +1,13 @@
+#pragma once
+/// Process-wide allocator settings for long-running frame processing.
+
+namespace scenewatch {
+
+/// Keeps freed frame-sized buffers (images, maps: megabytes each) in the heap for reuse instead of
+/// returning them to the kernel (glibc's mmap threshold and trim threshold raised). Every frame
+/// allocates such buffers anew; unmapped, each of their pages faults again on first touch, which
+/// costs more than the per-pixel arithmetic (about 5 ms per VGA surprise map measured in a VM).
+/// The price: the process keeps its peak heap. Call once at start-up; no-op outside glibc.
+void keep_frame_buffers_in_heap();
+
+}  // namespace scenewatch
