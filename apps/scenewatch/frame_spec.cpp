@@ -94,9 +94,8 @@ Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& 
       frame->intrinsics->width = static_cast<int>(frame->cloud->width);
       frame->intrinsics->height = static_cast<int>(frame->cloud->height);
     } else if (!frame->intrinsics && frame->cloud->height > 1) {
-      auto K = io::estimate_intrinsics(*frame->cloud);
-      if (!K) return Error{K.error().code, "'" + p->path + "': " + K.error().message};
-      frame->intrinsics = *K;
+      // Left unset when the cloud is not a pinhole image (commands that need intrinsics say so).
+      if (auto K = io::estimate_intrinsics(*frame->cloud)) frame->intrinsics = *K;
     }
     return each(std::move(*frame));
   }

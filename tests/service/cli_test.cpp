@@ -225,6 +225,45 @@ TEST_F(CliTest, SurpriseOfflineOnAnMosdPair) {
   EXPECT_NE(bad.err.find(":999"), std::string::npos) << bad.err;
 }
 
+TEST_F(CliTest, DiffOfAnMosdPairAndBadInput) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn12.pcd");
+  const fs::path learn = data_dir() / "mosd/learn";
+  // learn12 -> learn13: same camera; an object is added (and others moved).
+  auto result = cli({"diff", (learn / "learn12.pcd").string(), (learn / "learn13.pcd").string(), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json j = parse(result.out);
+  EXPECT_EQ(j.at("method"), "same-camera");
+  std::size_t added = 0;
+  for (const auto& e : j.at("events")) {
+    EXPECT_TRUE(e.contains("box_world"));
+    for (const char* key : {"indices_before", "indices_after"}) {
+      if (!e.contains(key)) continue;
+      for (const auto& i : e.at(key)) ASSERT_LT(i.get<int>(), 640 * 480);
+    }
+    if (e.at("kind") == "OBJECT_ADDED") {
+      ++added;
+      EXPECT_TRUE(!e.contains("indices_before") || e.at("indices_before").empty());
+      EXPECT_GT(e.at("indices_after").size(), 100u);
+    }
+  }
+  EXPECT_GE(added, 1u);
+  // The same frame twice: nothing changed.
+  const std::string frame = (source_dir() / "sample_clouds/tabletop").string() + ":0";
+  result = cli({"diff", frame, frame, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(parse(result.out).at("events").size(), 0u);
+  // Bad input is named.
+  result = cli({"diff", (learn / "learn12.pcd").string(), (tmp_ / "absent.pcd").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("absent.pcd"), std::string::npos) << result.err;
+  // The mug's PCD VIEWPOINT turns its points behind the camera: no camera can be fitted, and the
+  // message says which observation and why.
+  result = cli({"diff", (learn / "learn12.pcd").string(), (data_dir() / kMug).string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("AFTER"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find("intrinsics"), std::string::npos) << result.err;
+}
+
 TEST_F(CliTest, SurpriseFromTheDaemon) {
   ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, ""));
   const std::string sequence = (source_dir() / "sample_clouds/tabletop").string();
