@@ -1,6 +1,7 @@
 // The appearance path inside the working memory: posed RGB-D frames of the simulator's cup_added
 // build keyframes; after the cup is put on the table, APPEARANCE_CHANGE events arise where it
-// stands, and not while nothing changed. The keyframes survive save and load.
+// stands, and not while nothing changed; after a few frames the change is adopted into the
+// memory and no longer reported. The keyframes survive save and load.
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -39,6 +40,7 @@ TEST(AppearancePipeline, CupAddedRaisesAppearanceChangeWhereTheCupStands) {
   config.segmentation.up = Eigen::Vector3d::UnitZ();
   WorkingMemory memory(config);
   std::vector<Event> appearance[2];
+  std::vector<int> frames_with_events;
   double stamp = 0;
   Frame last;
   for (std::size_t phase = 0; phase < 2; ++phase) {
@@ -53,6 +55,7 @@ TEST(AppearancePipeline, CupAddedRaisesAppearanceChangeWhereTheCupStands) {
       for (const auto& e : result->events) {
         if (e.kind != EventKind::kAppearanceChange) continue;
         appearance[phase].push_back(e);
+        if (phase == 1) frames_with_events.push_back(f);
         std::printf("phase %zu frame %d: %s\n", phase, f, e.detail.c_str());
       }
       last = frame;
@@ -69,6 +72,11 @@ TEST(AppearancePipeline, CupAddedRaisesAppearanceChangeWhereTheCupStands) {
   }
   EXPECT_GE(at_cup, appearance[1].size() * 8 / 10) << "events away from the cup";
   EXPECT_GE(memory.stats().keyframes, 1u);
+  // After adopt_after_frames (5) frames of the same change, the memory holds the cup and the
+  // change is no longer reported.
+  ASSERT_EQ(config.surprise.adopt_after_frames, 5);
+  EXPECT_EQ(frames_with_events.front(), 0);
+  EXPECT_LE(frames_with_events.back(), 5) << "the change was not adopted";
 
   // The keyframes and the mesh are saved with the model and come back.
   test::TempDir dir("appearance-model");

@@ -282,6 +282,24 @@ Result<bool> AppearanceMemory::consider(Keyframe keyframe) {
   return true;
 }
 
+Result<std::uint64_t> AppearanceMemory::replace_nearest(Keyframe keyframe) {
+  if (auto st = check_keyframe(keyframe); !st) return st.error();
+  if (!impl_->entries.empty()) {
+    std::size_t best = 0;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < impl_->entries.size(); ++i) {
+      const double d = impl_->normalized(config_, impl_->entries[i].keyframe->T_world_camera, keyframe.T_world_camera);
+      if (d < best_d) {
+        best_d = d;
+        best = i;
+      }
+    }
+    impl_->bytes -= impl_->entries[best].bytes();
+    impl_->entries.erase(impl_->entries.begin() + static_cast<std::ptrdiff_t>(best));
+  }
+  return add(std::move(keyframe));
+}
+
 std::vector<std::shared_ptr<const Keyframe>> AppearanceMemory::nearest(const Pose& T_world_camera, std::size_t n) const {
   std::vector<std::pair<double, std::size_t>> ranked;
   const Eigen::Vector3d axis = T_world_camera.linear().col(2);

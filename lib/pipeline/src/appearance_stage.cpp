@@ -62,7 +62,16 @@ std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& fram
   }
   std::unique_lock<std::shared_mutex> write(mutex_);
   if (result) last_ = result;
-  if (appearance_config_.enabled) (void)memory_.consider(std::move(*observed));
+  changed_streak_ = (result && !result->events.empty()) ? changed_streak_ + 1 : 0;
+  if (!appearance_config_.enabled) return result;
+  if (config_.adopt_after_frames > 0 && changed_streak_ >= config_.adopt_after_frames &&
+      !memory_.is_new_view(observed->T_world_camera)) {
+    // The change held for long enough from a view the memory holds: remember it.
+    (void)memory_.replace_nearest(std::move(*observed));
+    changed_streak_ = 0;
+  } else {
+    (void)memory_.consider(std::move(*observed));
+  }
   return result;
 }
 
@@ -113,6 +122,7 @@ void AppearanceStage::reset() {
   std::unique_lock<std::shared_mutex> write(mutex_);
   memory_.clear();
   last_.reset();
+  changed_streak_ = 0;
 }
 
 std::size_t AppearanceStage::keyframes() const {

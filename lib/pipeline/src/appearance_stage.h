@@ -44,6 +44,7 @@ class AppearanceStage {
   mutable std::shared_mutex mutex_;
   background::AppearanceMemory memory_;
   std::shared_ptr<const SurpriseResult> last_;
+  int changed_streak_ = 0;  ///< consecutive frames with regions (writer only)
 };
 
 }  // namespace scenewatch::pipeline

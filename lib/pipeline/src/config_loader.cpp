@@ -139,7 +139,8 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("threshold_low", u.regions.threshold_low); },
                            [&] { return s.read("open_radius_px", u.regions.open_radius_px); },
                            [&] { return s.read("min_area_px", u.regions.min_area_px); },
-                           [&] { return s.read("min_extent_px", u.regions.min_extent_px); });
+                           [&] { return s.read("min_extent_px", u.regions.min_extent_px); },
+                           [&] { return s.read("adopt_after_frames", u.adopt_after_frames); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

@@ -74,6 +74,8 @@ Status validate(const SurpriseConfig& c) {
   if (auto st = validate(c.regions); !st) return st;
   if (!(c.prior.a0 > 0)) return invalid_argument("surprise.a0 must be > 0");
   if (!(c.prior.b0 > 0)) return invalid_argument("surprise.b0 must be > 0");
+  if (c.adopt_after_frames < 0 || c.adopt_after_frames > 1000)
+    return invalid_argument("surprise.adopt_after_frames must be in [0, 1000]");
   if (c.min_samples < 1 || c.min_samples > kMaxSamples)
     return invalid_argument("surprise.min_samples must be in [1, " + std::to_string(kMaxSamples) + "]");
   return {};

@@ -86,6 +86,9 @@ class AppearanceMemory {
   Result<std::uint64_t> add(Keyframe keyframe);
   /// Adds the keyframe when its view is new; returns whether it was added.
   Result<bool> consider(Keyframe keyframe);
+  /// Replaces the keyframe nearest to this one's view (the scene there changed and the change is
+  /// to be remembered); adds it when the memory is empty.
+  Result<std::uint64_t> replace_nearest(Keyframe keyframe);
 
   /// Up to n keyframes that see towards the given view, nearest first (by translation plus
   /// rotation, each in units of its keyframe threshold). Keyframes looking away (optical axes

@@ -62,6 +62,10 @@ struct SurpriseConfig {
   /// with the prior alone setting the colour noise.
   int min_samples = 1;
   RegionConfig regions;
+  /// After this many consecutive frames with APPEARANCE_CHANGE regions from a view the memory
+  /// already holds, the frame replaces the nearest keyframe: the change is remembered and stops
+  /// being reported. 0: never (the memory keeps the first sight of every place).
+  int adopt_after_frames = 5;
 };
 Status validate(const SurpriseConfig& config);
 
