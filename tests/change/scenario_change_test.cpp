@@ -106,10 +106,13 @@ TEST(ScenarioChange, CupAddedAndObjectMoved) {
   }
 }
 
-TEST(ScenarioChange, GlassesRemoved) {
+// The two removed glasses are transparent: they have no depth in either observation, so geometry
+// cannot see them (the image surprise does, see surprise_test). What geometry must do here is
+// report nothing else: the plates, bottle, bowl, mug and box stayed.
+TEST(ScenarioChange, GlassesRemovedIsInvisibleToGeometryAndNothingElseIsReported) {
   const PairFigures f = run_pair("glasses_removed", 0, -1, 1, 0, 640, 480);
-  EXPECT_GE(f.score.precision(), 0.95) << "nothing else may be reported";
-  EXPECT_GE(f.score.recall(), 0.95);
+  EXPECT_EQ(f.left_out, 2u) << "both glasses are without depth";
+  EXPECT_EQ(f.score.events, 0u) << "nothing else changed";
 }
 
 TEST(ScenarioChange, ClutterStaticPairsGiveNoEvent) {

@@ -239,7 +239,6 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   result.surprise_ms = ms_since(t_surprise);
   if (result.surprise) events.insert(events.end(), result.surprise->events.begin(), result.surprise->events.end());
 
-
   // Geometric change detection against the map as it stands before this frame. Candidates stay
   // out of the map until the persistence filter confirms them, so the comparison keeps being made
   // against the model that predates them (OctoMap's log-odds would absorb a new object, or erode
