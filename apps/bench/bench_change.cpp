@@ -12,6 +12,7 @@
 #include "scenewatch/change/diff.h"
 #include "scenewatch/change/evaluation.h"
 #include "scenewatch/io/cloud_io.h"
+#include "scenewatch/io/rgbd.h"
 
 namespace scenewatch::bench {
 namespace {
@@ -127,7 +128,7 @@ int run_change(const Options& o) {
     change::ClusterInput input;
     input.after_camera = &a;
     input.before_camera = &b;
-    input.K_after = *change::estimate_intrinsics(a);
+    input.K_after = *io::estimate_intrinsics(a);
     auto events_of = [&](const change::Mismatch& mm) {
       std::vector<Event> events;
       for (const auto& c : change::pair_changes(change::cluster_mismatch(mm, input, config), config)) events.push_back(change::to_event(c));

@@ -4,6 +4,7 @@
 
 #include "scenewatch/change/diff.h"
 #include "scenewatch/change/persistence.h"
+#include "scenewatch/io/rgbd.h"
 #include "test_data.h"
 
 namespace scenewatch::change {
@@ -50,14 +51,14 @@ TEST(Change, ToleranceGrowsWithDepthLikeKinectNoise) {
 
 TEST(Change, IntrinsicsAreFittedFromAnOrganizedCloud) {
   const Intrinsics K = small_camera();
-  auto fitted = estimate_intrinsics(*plane_view(K, 1.0f, 0.6f, 0.2f));
+  auto fitted = io::estimate_intrinsics(*plane_view(K, 1.0f, 0.6f, 0.2f));
   ASSERT_TRUE(fitted.ok()) << fitted.error().message;
   EXPECT_NEAR(fitted->fx, K.fx, 1e-2);
   EXPECT_NEAR(fitted->cy, K.cy, 1e-2);
   Cloud flat = *plane_view(K, 1.0f);
   flat.width = static_cast<std::uint32_t>(flat.size());
   flat.height = 1;
-  EXPECT_FALSE(estimate_intrinsics(flat).ok());
+  EXPECT_FALSE(io::estimate_intrinsics(flat).ok());
 }
 
 TEST(Change, SameCameraBoxAddedThenRemoved) {

@@ -2,6 +2,8 @@
 // same-camera pairs.
 #include "scenewatch/change/mismatch.h"
 
+#include "scenewatch/io/rgbd.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -48,60 +50,12 @@ double tolerance_m(const Config& c, double z) {
   return std::max(c.min_tolerance_m, c.sigma_factor * sigma);
 }
 
-Result<Intrinsics> estimate_intrinsics(const Cloud& cloud) {
-  if (cloud.height <= 1) return invalid_argument("intrinsics: the cloud is not organized");
-  // Independent fits u = fx (x/z) + cx and v = fy (y/z) + cy.
-  double sa[2] = {0, 0}, saa[2] = {0, 0}, sb[2] = {0, 0}, sab[2] = {0, 0};
-  std::size_t n = 0;
-  for (std::uint32_t v = 0; v < cloud.height; v += 2)
-    for (std::uint32_t u = 0; u < cloud.width; u += 2) {
-      const PointT& p = cloud.at(u, v);
-      if (!is_valid(p) || p.z <= 0) continue;
-      const double a[2] = {p.x / p.z, p.y / p.z}, b[2] = {static_cast<double>(u), static_cast<double>(v)};
-      for (int i = 0; i < 2; ++i) {
-        sa[i] += a[i];
-        saa[i] += a[i] * a[i];
-        sb[i] += b[i];
-        sab[i] += a[i] * b[i];
-      }
-      ++n;
-    }
-  if (n < 100) return invalid_argument("intrinsics: too few valid points to fit a camera");
-  double f[2], c[2];
-  for (int i = 0; i < 2; ++i) {
-    const double den = n * saa[i] - sa[i] * sa[i];
-    if (!(std::abs(den) > 1e-12)) return invalid_argument("intrinsics: degenerate cloud, cannot fit a camera");
-    f[i] = (n * sab[i] - sa[i] * sb[i]) / den;
-    c[i] = (sb[i] - f[i] * sa[i]) / n;
-  }
-  Intrinsics K;
-  K.fx = f[0];
-  K.fy = f[1];
-  K.cx = c[0];
-  K.cy = c[1];
-  K.width = static_cast<int>(cloud.width);
-  K.height = static_cast<int>(cloud.height);
-  if (!K.valid()) return invalid_argument("intrinsics: the fitted focal length is not positive");
-  double worst = 0;
-  for (std::uint32_t v = 0; v < cloud.height; v += 7)
-    for (std::uint32_t u = 0; u < cloud.width; u += 7) {
-      const PointT& p = cloud.at(u, v);
-      if (!is_valid(p) || p.z <= 0) continue;
-      worst = std::max({worst, std::abs(K.fx * p.x / p.z + K.cx - u), std::abs(K.fy * p.y / p.z + K.cy - v)});
-    }
-  if (worst > 0.5) {
-    return invalid_argument("intrinsics: the organized cloud does not fit one pinhole camera (residual " +
-                            std::to_string(worst) + " px)");
-  }
-  return K;
-}
-
 Result<Intrinsics> observation_camera(const Cloud& cloud, const std::optional<Intrinsics>& K) {
   if (K) {
     if (!K->valid()) return invalid_argument("intrinsics are invalid");
     return *K;
   }
-  if (cloud.height > 1) return estimate_intrinsics(cloud);
+  if (cloud.height > 1) return io::estimate_intrinsics(cloud);
   // A virtual pinhole, 640 pixels wide, whose field of view covers every point in front.
   double tx = 0, ty = 0;
   std::size_t n = 0;

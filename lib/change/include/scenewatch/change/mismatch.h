@@ -66,13 +66,8 @@ struct DepthView {
   float at(int u, int v) const { return z[static_cast<std::size_t>(v) * K.width + u]; }
 };
 
-/// Intrinsics of an organized cloud fitted from its own points (u = fx x/z + cx, v = fy y/z + cy),
-/// by least squares. Error when the cloud is not organized or the fit leaves residuals above
-/// half a pixel (the cloud does not come from one pinhole camera).
-Result<Intrinsics> estimate_intrinsics(const Cloud& organized_camera);
-
 /// The camera an observation is seen with: the given intrinsics, else those fitted to an
-/// organized cloud, else a virtual pinhole covering the points of an unorganized cloud.
+/// organized cloud (io::estimate_intrinsics), else a virtual pinhole covering the points of an unorganized cloud.
 Result<Intrinsics> observation_camera(const Cloud& points_camera, const std::optional<Intrinsics>& K);
 
 /// The depth image of a cloud seen from its own camera (an organized cloud: its z; otherwise a
