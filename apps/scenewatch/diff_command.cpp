@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "config_file.h"
 #include "frame_spec.h"
 #include "scenewatch/change/diff.h"
-#include "scenewatch/pipeline/config_loader.h"
 
 namespace scenewatch::cli {
 namespace fs = std::filesystem;
@@ -68,14 +68,10 @@ Result<Frame> load_observation(const std::string& spec) {
 int run_diff(const DiffOptions& options) {
   change::DiffOptions diff_options;
   if (!options.config.empty()) {
-    std::vector<std::string> sections = pipeline::pipeline_sections();
-    sections.push_back("server");
-    auto root = pipeline::load_yaml_file(options.config, sections);
-    if (!root) return fail(root.error().message);
-    pipeline::Config config;
-    if (Status s = pipeline::read_pipeline_config(*root, config); !s) return fail(options.config + ": " + s.error().message);
-    diff_options.change = config.change;
-    diff_options.map = config.background;
+    auto config = read_config_file(options.config);
+    if (!config) return fail(config.error().message);
+    diff_options.change = config->change;
+    diff_options.map = config->background;
   }
   if (options.resolution_m > 0) diff_options.map.resolution_m = options.resolution_m;
   diff_options.force_map = options.force_map;

@@ -6,8 +6,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "config_file.h"
 #include "scenewatch/io/cloud_io.h"
-#include "scenewatch/pipeline/config_loader.h"
 #include "scenewatch/segmentation/tabletop.h"
 
 namespace scenewatch::cli {
@@ -74,28 +74,12 @@ std::string numbered(const char* stem, std::size_t i) {
   return name;
 }
 
-/// The segmentation section of a scenewatchd config file (other sections are checked, not used).
-Result<segmentation::Config> load_segmentation_config(const std::string& path) {
-  std::vector<std::string> sections = pipeline::pipeline_sections();
-  sections.push_back("server");
-  auto root = pipeline::load_yaml_file(path, sections);
-  if (!root) return root.error();
-  pipeline::Config config;
-  if (Status s = pipeline::read_pipeline_config(*root, config); !s) {
-    return Error{s.error().code, path + ": " + s.error().message};
-  }
-  return config.segmentation;
-}
-
 }  // namespace
 
 int run_segment(const SegmentOptions& options) {
-  segmentation::Config config;
-  if (!options.config.empty()) {
-    auto loaded = load_segmentation_config(options.config);
-    if (!loaded) return fail(loaded.error().message);
-    config = *loaded;
-  }
+  auto loaded = read_config_file(options.config);
+  if (!loaded) return fail(loaded.error().message);
+  const segmentation::Config& config = loaded->segmentation;
   auto file = io::read_cloud(options.file);
   if (!file) {
     const std::string& message = file.error().message;

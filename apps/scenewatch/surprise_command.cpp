@@ -8,13 +8,13 @@
 #include <optional>
 
 #include "commands.h"
+#include "config_file.h"
 #include "format.h"
 #include "frame_spec.h"
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/io/image_io.h"
 #include "scenewatch/io/rgbd.h"
-#include "scenewatch/pipeline/config_loader.h"
 #include "scenewatch/service/client.h"
 #include "scenewatch/surprise/surprise_map.h"
 
@@ -22,17 +22,6 @@ namespace scenewatch::cli {
 namespace {
 
 using nlohmann::json;
-
-Result<pipeline::Config> load_config(const std::string& path) {
-  pipeline::Config config;
-  if (path.empty()) return config;
-  std::vector<std::string> sections = pipeline::pipeline_sections();
-  sections.push_back("server");
-  auto root = pipeline::load_yaml_file(path, sections);
-  if (!root) return root.error();
-  if (Status s = pipeline::read_pipeline_config(*root, config); !s) return Error{s.error().code, path + ": " + s.error().message};
-  return config;
-}
 
 struct Outcome {
   surprise::SurpriseMap map;
@@ -86,7 +75,7 @@ int print(const SurpriseOptions& o, const Outcome& out, const std::vector<std::s
 }
 
 Result<Outcome> offline(const SurpriseOptions& o) {
-  auto config = load_config(o.config);
+  auto config = read_config_file(o.config);
   if (!config) return config.error();
   std::optional<Intrinsics> intrinsics;
   if (!o.intrinsics.empty()) {
