@@ -85,7 +85,6 @@ Result<Outcome> offline(const SurpriseOptions& o) {
   }
   // The observation first: a bad one should fail before minutes of reference loading.
   std::optional<background::Keyframe> observed;
-  std::optional<Frame> observed_frame;
   {
     auto n = count_frames(o.observed);
     if (!n) return n.error();
@@ -95,7 +94,6 @@ Result<Outcome> offline(const SurpriseOptions& o) {
       if (!kf) return kf.error();
       if (!f.has_color) return invalid_argument("'" + o.observed + "' has no colour");
       observed = std::move(*kf);
-      observed_frame = std::move(f);
       return {};
     });
     if (!st) return st.error();

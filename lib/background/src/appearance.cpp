@@ -183,9 +183,9 @@ Result<Keyframe> keyframe_from_frame(const Frame& frame) {
   if (!frame.cloud) return invalid_argument(frame.source + ": no cloud");
   const Cloud& cloud = *frame.cloud;
   if (!cloud.isOrganized() || cloud.height <= 1)
-    return invalid_argument(frame.source + ": a keyframe needs an organized cloud (an RGB-D image)");
+    return invalid_argument(frame.source + ": keyframes and image surprise need an organized cloud (an RGB-D image)");
   if (!frame.intrinsics || !frame.intrinsics->valid())
-    return invalid_argument(frame.source + ": a keyframe needs camera intrinsics");
+    return invalid_argument(frame.source + ": keyframes and image surprise need camera intrinsics");
   const Intrinsics& K = *frame.intrinsics;
   if (static_cast<int>(cloud.width) != K.width || static_cast<int>(cloud.height) != K.height)
     return invalid_argument(frame.source + ": cloud is " + std::to_string(cloud.width) + "x" +

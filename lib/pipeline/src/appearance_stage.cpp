@@ -1,24 +1,21 @@
 #include "appearance_stage.h"
 
-#include <chrono>
 #include <mutex>
 
 #include "scenewatch/io/cloud_io.h"
+#include "timing.h"
 
 namespace scenewatch::pipeline {
 namespace {
 
-double ms_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-}
-
-// An organized frame with intrinsics and colour: the only kind the image path can use.
-Status check_observation(const Frame& frame) {
-  const std::string where = frame.source.empty() ? std::string("frame") : "frame from '" + frame.source + "'";
-  if (!frame.cloud || frame.cloud->height <= 1) return invalid_argument(where + ": surprise needs an organized (RGB-D) frame");
-  if (!frame.intrinsics) return invalid_argument(where + ": surprise needs camera intrinsics");
-  if (!frame.has_color) return invalid_argument(where + ": surprise needs colour");
-  return {};
+// The frame as an image (colour, depth, pose, intrinsics): keyframe_from_frame checks that it is
+// organized and has intrinsics; the image path also needs colour.
+Result<background::Keyframe> as_image(const Frame& frame) {
+  if (!frame.has_color) {
+    const std::string where = frame.source.empty() ? std::string("frame") : "frame from '" + frame.source + "'";
+    return invalid_argument(where + ": surprise needs colour");
+  }
+  return background::keyframe_from_frame(frame);
 }
 
 }  // namespace
@@ -27,7 +24,7 @@ AppearanceStage::AppearanceStage(const background::AppearanceConfig& appearance,
     : appearance_config_(appearance), config_(surprise), kernel_(surprise.prior, surprise.min_samples), memory_(appearance) {}
 
 Result<std::shared_ptr<SurpriseResult>> AppearanceStage::compute(const Frame& frame, const background::Keyframe& observed) const {
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   const Pose pose = frame.pose_or_identity();
   auto result = std::make_shared<SurpriseResult>();
   const surprise::ExpectedView view = surprise::render_expected_view(memory_, pose, *frame.intrinsics, config_.view);
@@ -49,8 +46,8 @@ std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& fram
   if (!appearance_config_.enabled && !config_.enabled) return nullptr;
   // Without a pose the camera frame would be taken as the world: keyframes from a moving camera
   // would then be placed wrongly, so only posed frames take part.
-  if (!frame.T_world_camera || !check_observation(frame).ok()) return nullptr;
-  auto observed = background::keyframe_from_frame(frame);
+  if (!frame.T_world_camera) return nullptr;
+  auto observed = as_image(frame);
   if (!observed) return nullptr;
   std::shared_ptr<const SurpriseResult> result;
   {
@@ -76,8 +73,7 @@ std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& fram
 }
 
 Result<std::shared_ptr<const SurpriseResult>> AppearanceStage::evaluate(const Frame& observation) const {
-  if (auto st = check_observation(observation); !st) return st.error();
-  auto observed = background::keyframe_from_frame(observation);
+  auto observed = as_image(observation);
   if (!observed) return observed.error();
   std::shared_lock<std::shared_mutex> read(mutex_);
   if (memory_.size() == 0) return not_found("the appearance memory has no keyframes yet: ingest posed RGB-D frames first");

@@ -13,16 +13,14 @@
 
 #include "appearance_stage.h"
 #include "model_store.h"
+#include "timing.h"
 #include "scenewatch/change/objects.h"
 #include "scenewatch/change/persistence.h"
 
 namespace scenewatch::pipeline {
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
 
 namespace {
-
-double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 Status validate_frame(const Frame& f) {
   const std::string where = f.source.empty() ? std::string("frame") : "frame from '" + f.source + "'";
