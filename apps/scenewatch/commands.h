@@ -87,4 +87,15 @@ struct DiffOptions {
 /// Offline: geometric change detection between two observations (no daemon involved).
 int run_diff(const DiffOptions& options);
 
+struct ReplayOptions {
+  std::vector<std::string> inputs;  ///< frame specs (see frame_spec.h), processed in order
+  std::string config;               ///< YAML config, as the daemon's (the server section is not read)
+  std::size_t stride = 1;           ///< process every N-th frame of each input
+  bool json = false;                ///< one JSON line per event, then a summary line
+  bool progress = true;             ///< a progress line on stderr every 25 frames
+};
+/// Offline: recordings through the working memory as the daemon would run them; prints the
+/// event stream and a summary (events per 100 frames, time per frame and per stage).
+int run_replay(const ReplayOptions& options);
+
 }  // namespace scenewatch::cli

@@ -10,6 +10,7 @@
 #include "config_file.h"
 #include "frame_spec.h"
 #include "scenewatch/change/diff.h"
+#include "scenewatch/core/event_json.h"
 
 namespace scenewatch::cli {
 namespace fs = std::filesystem;
@@ -18,25 +19,6 @@ using nlohmann::json;
 namespace {
 
 json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
-
-json to_json(const Event& e) {
-  json j = {{"id", e.id},
-            {"kind", to_string(e.kind)},
-            {"level", to_string(e.level)},
-            {"score", e.score},
-            {"centroid_world", vec(e.centroid_world)},
-            {"box_world", {{"min", vec(e.box_world.min)}, {"max", vec(e.box_world.max)}}},
-            {"detail", e.detail},
-            {"evidence", e.evidence},
-            {"indices_before", e.indices_before},
-            {"indices_after", e.indices_after}};
-  if (e.displacement_world) j["displacement_world"] = vec(*e.displacement_world);
-  if (e.region) {
-    j["region"] = {{"x", e.region->x}, {"y", e.region->y}, {"width", e.region->width},
-                   {"height", e.region->height}, {"area", e.region->area}};
-  }
-  return j;
-}
 
 std::string fixed(double value, int decimals = 3) {
   char buffer[64];

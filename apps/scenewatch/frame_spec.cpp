@@ -48,11 +48,11 @@ Result<Parsed> parse(const std::string& spec) {
       if (*last < *first) return invalid_argument("'" + spec + "': the range ends before it starts");
       p.last = *last;
     }
-    if (!io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png)");
+    if (!io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png or .color.jpg)");
   }
   if (!fs::exists(p.path, ec)) return not_found("'" + p.path + "': no such file or folder");
   p.sequence = fs::is_directory(p.path, ec);
-  if (p.sequence && !io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png)");
+  if (p.sequence && !io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png or .color.jpg)");
   return p;
 }
 

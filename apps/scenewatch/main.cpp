@@ -134,6 +134,25 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(0.002, 0.2));
   diff->callback([&] { action = [&] { return run_diff(diff_options); }; });
 
+  ReplayOptions replay_options;
+  auto* replay = app.add_subcommand(
+      "replay",
+      "offline: run recordings through the working memory exactly as the daemon would (no daemon), print\n"
+      "each event as it arises, then count them (events per 100 frames, by kind) and time the frames\n"
+      "(median and p90, per stage). The way to see what a planner would be told about a recording.");
+  replay->footer(
+      "Inputs: SEQDIR (every frame, with its poses), SEQDIR:N, SEQDIR:A-B (frames A to B, 0-based), cloud files.\n"
+      "Examples:\n"
+      "  scenewatch replay ../shared/data/redkitchen\n"
+      "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json");
+  replay->add_option("inputs", replay_options.inputs, "sequence folders, frame ranges or cloud files")->required();
+  replay->add_option("--config", replay_options.config, "YAML config, as the daemon's (its pipeline sections are used)");
+  replay->add_option("--stride", replay_options.stride, "process every N-th frame of each input")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  replay->add_flag("--json", replay_options.json, "one JSON object per event (with its frame), then a summary object");
+  replay->callback([&] { action = [&] { return run_replay(replay_options); }; });
+
   SurpriseOptions surprise_options;
   auto* surprise = app.add_subcommand(
       "surprise",

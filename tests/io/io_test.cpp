@@ -311,6 +311,35 @@ TEST_F(IoTest, RedkitchenSequence) {
   EXPECT_FALSE(load_sequence_frame(*seq, 50).ok());
 }
 
+TEST_F(IoTest, JpegColourSequence) {
+  SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_1/frame-000000.color.jpg");
+  const auto dir = test::data_dir() / "hrt1/pick_toy_1";
+  EXPECT_TRUE(is_sequence_dir(dir)) << "frame-NNNNNN.color.jpg makes a sequence folder";
+  auto seq = open_sequence(dir);
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  EXPECT_EQ(seq->frames.size(), 40u);
+  EXPECT_EQ(seq->frames.front().color.filename(), "frame-000000.color.jpg");
+  auto frame = load_sequence_frame(*seq, 0);
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  EXPECT_TRUE(frame->has_color);
+  EXPECT_EQ(frame->cloud->width, 640u);
+  // The white table fills the lower middle of the view: its colour is decoded, not left black.
+  const auto& p = frame->cloud->at(320, 400);
+  EXPECT_GT(int(p.r) + p.g + p.b, 300);
+}
+
+TEST_F(IoTest, SequenceWithTwoColourImagesForOneFrameIsRefused) {
+  ColorImage c{4, 2, std::vector<std::uint8_t>(24, 90)};
+  DepthImage d{4, 2, std::vector<std::uint16_t>(8, 1200)};
+  ASSERT_TRUE(write_color_png(dir_ / "frame-000000.color.png", c).ok());
+  ASSERT_TRUE(write_depth_png(dir_ / "frame-000000.depth.png", d).ok());
+  fs::copy_file(dir_ / "frame-000000.color.png", dir_ / "frame-000000.color.jpg");
+  ASSERT_TRUE(write_intrinsics(dir_ / "camera-intrinsics.txt", Intrinsics{100, 100, 2, 1, 4, 2}).ok());
+  auto seq = open_sequence(dir_);
+  ASSERT_FALSE(seq.ok());
+  expect_error_mentions(seq.error(), {"frame-000000", "two colour images"});
+}
+
 TEST_F(IoTest, TumSequenceAndItsErrors) {
   ColorImage c{4, 2, std::vector<std::uint8_t>(24, 90)};
   DepthImage d{4, 2, std::vector<std::uint16_t>(8, 1200)};

@@ -25,7 +25,7 @@ Result<cv::Mat> read_png(const fs::path& path) {
   } catch (const cv::Exception& e) {
     return invalid_argument(quoted(path) + ": cannot decode image: " + e.what());
   }
-  if (image.empty()) return invalid_argument(quoted(path) + ": cannot decode image (not a PNG, or truncated)");
+  if (image.empty()) return invalid_argument(quoted(path) + ": cannot decode image (not a PNG or JPEG, or truncated)");
   return image;
 }
 
@@ -95,13 +95,13 @@ Result<ColorImage> read_color_png(const fs::path& path) {
   if (!image) return image.error();
   cv::Mat m = *image;
   if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
-  if (m.depth() != CV_8U) return invalid_argument(quoted(path) + ": colour PNG must be 8 or 16 bit");
+  if (m.depth() != CV_8U) return invalid_argument(quoted(path) + ": colour image must be 8 or 16 bit");
   cv::Mat rgb;
   switch (m.channels()) {
     case 1: cv::cvtColor(m, rgb, cv::COLOR_GRAY2RGB); break;
     case 3: cv::cvtColor(m, rgb, cv::COLOR_BGR2RGB); break;
     case 4: cv::cvtColor(m, rgb, cv::COLOR_BGRA2RGB); break;
-    default: return invalid_argument(quoted(path) + ": colour PNG has " + std::to_string(m.channels()) + " channels");
+    default: return invalid_argument(quoted(path) + ": colour image has " + std::to_string(m.channels()) + " channels");
   }
   ColorImage out;
   out.width = rgb.cols;

@@ -1,4 +1,5 @@
-// Sequence folders: frame-NNNNNN.{color,depth}.png with per-frame 4x4 poses or a TUM trajectory.
+// Sequence folders: frame-NNNNNN.color.{png,jpg} and frame-NNNNNN.depth.png with per-frame 4x4 poses
+// or a TUM trajectory.
 #include <algorithm>
 #include <system_error>
 
@@ -11,20 +12,28 @@ namespace scenewatch::io {
 namespace fs = std::filesystem;
 
 namespace {
-constexpr const char* kColorSuffix = ".color.png";
+// Colour as recorded: PNG (7-Scenes, the simulator) or JPEG (many robot recordings, hrt1).
+constexpr const char* kColorSuffixes[] = {".color.png", ".color.jpg", ".color.jpeg"};
 constexpr double kDefaultFrameRateHz = 30.0;
 
 bool ends_with(const std::string& s, const std::string& suffix) {
   return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
-std::vector<std::string> frame_names(const fs::path& dir) {
-  std::vector<std::string> names;
+struct FrameName {
+  std::string name;   ///< "frame-000150"
+  std::string color;  ///< its colour file's name
+  bool operator<(const FrameName& o) const { return name < o.name; }
+};
+
+std::vector<FrameName> frame_names(const fs::path& dir) {
+  std::vector<FrameName> names;
   std::error_code ec;
   for (const auto& entry : fs::directory_iterator(dir, ec)) {
     const std::string file = entry.path().filename().string();
-    if (entry.is_regular_file(ec) && ends_with(file, kColorSuffix)) {
-      names.push_back(file.substr(0, file.size() - std::string(kColorSuffix).size()));
+    if (!entry.is_regular_file(ec)) continue;
+    for (const std::string suffix : kColorSuffixes) {
+      if (ends_with(file, suffix)) names.push_back({file.substr(0, file.size() - suffix.size()), file});
     }
   }
   std::sort(names.begin(), names.end());
@@ -45,16 +54,22 @@ Result<Sequence> open_sequence(const fs::path& dir) {
   Sequence seq;
   seq.dir = dir;
   const auto names = frame_names(dir);
-  if (names.empty()) return invalid_argument(where + ": no frame-*.color.png files; not a sequence folder");
+  if (names.empty()) return invalid_argument(where + ": no frame-*.color.png or .color.jpg files; not a sequence folder");
+  for (std::size_t i = 1; i < names.size(); ++i) {
+    if (names[i].name == names[i - 1].name) {
+      return invalid_argument(where + ": " + names[i].name + " has two colour images ('" + names[i - 1].color + "', '" +
+                              names[i].color + "'); keep one");
+    }
+  }
 
   auto K = read_intrinsics(dir / "camera-intrinsics.txt");
   if (!K) return K.error();
   seq.intrinsics = *K;
 
-  for (const auto& name : names) {
+  for (const auto& [name, color] : names) {
     SequenceEntry e;
     e.name = name;
-    e.color = dir / (name + kColorSuffix);
+    e.color = dir / color;
     e.depth = dir / (name + ".depth.png");
     if (!fs::exists(e.depth, ec)) return invalid_argument("'" + e.depth.string() + "': missing depth image for " + name);
     seq.frames.push_back(std::move(e));

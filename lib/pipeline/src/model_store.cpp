@@ -28,19 +28,6 @@ OrientedBox box_from(const json& j) {
   return b;
 }
 
-EventLevel level_from(const std::string& s) {
-  for (auto l : {EventLevel::kMismatch, EventLevel::kPrediction, EventLevel::kImplausibility}) {
-    if (s == to_string(l)) return l;
-  }
-  throw std::invalid_argument("unknown event level '" + s + "'");
-}
-EventKind kind_from(const std::string& s) {
-  for (int k = 0; k <= static_cast<int>(EventKind::kFrozenDofMotion); ++k) {
-    if (s == to_string(static_cast<EventKind>(k))) return static_cast<EventKind>(k);
-  }
-  throw std::invalid_argument("unknown event kind '" + s + "'");
-}
-
 template <typename T, typename F>
 Result<T> parse(const char* what, F&& f) {
   try {
@@ -63,17 +50,6 @@ json to_json(const TrackedObject& o) {
   return {{"id", o.id}, {"plane_id", c.plane_id}, {"centroid", vec(c.centroid)}, {"box", box_json(c.box)},
           {"point_count", c.point_count}, {"mean_rgb", {c.mean_rgb.x(), c.mean_rgb.y(), c.mean_rgb.z()}},
           {"first_seen_s", o.first_seen_s}, {"last_seen_s", o.last_seen_s}, {"observations", o.observations}};
-}
-
-json to_json(const Event& e) {
-  json j = {{"id", e.id}, {"stamp_s", e.stamp_s}, {"level", to_string(e.level)}, {"kind", to_string(e.kind)},
-            {"score", e.score}, {"box_min", vec(e.box_world.min)}, {"box_max", vec(e.box_world.max)},
-            {"centroid", vec(e.centroid_world)}, {"detail", e.detail}};
-  if (e.object_id) j["object_id"] = *e.object_id;
-  if (!e.evidence.empty()) j["evidence"] = e.evidence;
-  if (e.region) j["region"] = {e.region->x, e.region->y, e.region->width, e.region->height, e.region->area};
-  if (e.displacement_world) j["displacement"] = vec(*e.displacement_world);
-  return j;
 }
 
 Result<Plane> plane_from_json(const json& j) {
@@ -107,28 +83,6 @@ Result<TrackedObject> object_from_json(const json& j) {
   });
 }
 
-Result<Event> event_from_json(const json& j) {
-  return parse<Event>("event", [&] {
-    Event e;
-    e.id = j.at("id").get<std::uint64_t>();
-    e.stamp_s = j.at("stamp_s").get<double>();
-    e.level = level_from(j.at("level").get<std::string>());
-    e.kind = kind_from(j.at("kind").get<std::string>());
-    e.score = j.at("score").get<double>();
-    e.box_world = {vec3(j.at("box_min")), vec3(j.at("box_max"))};
-    e.centroid_world = vec3(j.at("centroid"));
-    e.detail = j.value("detail", "");
-    if (j.contains("object_id")) e.object_id = j.at("object_id").get<std::uint64_t>();
-    if (j.contains("evidence")) e.evidence = j.at("evidence").get<std::map<std::string, double>>();
-    if (j.contains("region")) {
-      const auto& r = j.at("region");
-      e.region = PixelRegion{r.at(0).get<int>(), r.at(1).get<int>(), r.at(2).get<int>(), r.at(3).get<int>(),
-                             r.at(4).get<std::uint32_t>()};
-    }
-    if (j.contains("displacement")) e.displacement_world = vec3(j.at("displacement"));
-    return e;
-  });
-}
 
 Status fsync_path(const fs::path& path, bool directory) {
   const int fd = ::open(path.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);

@@ -17,10 +17,8 @@ namespace scenewatch::pipeline {
 
 nlohmann::json to_json(const Plane& plane);
 nlohmann::json to_json(const TrackedObject& object);
-nlohmann::json to_json(const Event& event);
 Result<Plane> plane_from_json(const nlohmann::json& j);
 Result<TrackedObject> object_from_json(const nlohmann::json& j);
-Result<Event> event_from_json(const nlohmann::json& j);
 
 /// Writes a new snapshot folder with `write_files(dir)`, fsyncs it, then points `current` at it
 /// and removes older snapshots.

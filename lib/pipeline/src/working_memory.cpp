@@ -16,6 +16,7 @@
 #include "timing.h"
 #include "scenewatch/change/objects.h"
 #include "scenewatch/change/persistence.h"
+#include "scenewatch/core/event_json.h"
 
 namespace scenewatch::pipeline {
 namespace fs = std::filesystem;
@@ -455,7 +456,12 @@ Status WorkingMemory::save(const fs::path& model_dir) const {
     {
       std::lock_guard<std::mutex> events_lock(m.events_mutex);
       scene["next_event_id"] = m.next_event_id;
-      for (const auto& e : m.events) log += to_json(e).dump() + "\n";
+      for (const auto& e : m.events) {
+        nlohmann::json j = to_json(e);
+        j.erase("indices_before");  // indices into frames the model no longer holds
+        j.erase("indices_after");
+        log += j.dump() + "\n";
+      }
     }
     if (auto st = m.appearance.save(dir); !st) return st;
     if (auto st = write_file_synced(dir / "scene.json", scene.dump(2)); !st) return st;

@@ -1,6 +1,6 @@
 #pragma once
 /// RGB-D sequences on disk. A sequence is a folder holding
-///   frame-NNNNNN.color.png, frame-NNNNNN.depth.png   (one pair per frame, sorted by name)
+///   frame-NNNNNN.color.png (or .color.jpg), frame-NNNNNN.depth.png   (one pair per frame, by name)
 ///   camera-intrinsics.txt                           (3x3 K)
 /// and poses either as frame-NNNNNN.pose.txt (4x4 camera-to-world, the 7-Scenes layout) or as
 /// one TUM trajectory file (trajectory.txt or groundtruth.txt) with one line per frame, in order.
@@ -28,7 +28,7 @@ struct Sequence {
   std::vector<SequenceEntry> frames;
 };
 
-/// True when the path is a folder that looks like a sequence (has *.color.png files).
+/// True when the path is a folder that looks like a sequence (has *.color.png or *.color.jpg files).
 bool is_sequence_dir(const std::filesystem::path& path);
 
 /// Lists the frames of a sequence folder and reads intrinsics and poses (but no images).
