@@ -93,6 +93,7 @@ struct ReplayOptions {
   std::size_t stride = 1;           ///< process every N-th frame of each input
   bool json = false;                ///< one JSON line per event, then a summary line
   bool progress = true;             ///< a progress line on stderr every 25 frames
+  std::string heatmap_dir;          ///< when set: surprise-NNNNNN.png per frame with a surprise map
 };
 /// Offline: recordings through the working memory as the daemon would run them; prints the
 /// event stream and a summary (events per 100 frames, time per frame and per stage).

@@ -150,6 +150,8 @@ int main(int argc, char** argv) {
   replay->add_option("--stride", replay_options.stride, "process every N-th frame of each input")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  replay->add_option("--heatmaps", replay_options.heatmap_dir,
+                     "write each frame's image surprise over its colour image as DIR/surprise-NNNNNN.png");
   replay->add_flag("--json", replay_options.json, "one JSON object per event (with its frame), then a summary object");
   replay->callback([&] { action = [&] { return run_replay(replay_options); }; });
 

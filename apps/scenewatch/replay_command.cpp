@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <map>
 
@@ -12,7 +13,9 @@
 #include "commands.h"
 #include "config_file.h"
 #include "frame_spec.h"
+#include "scenewatch/background/appearance.h"
 #include "scenewatch/core/event_json.h"
+#include "scenewatch/io/image_io.h"
 #include "scenewatch/pipeline/working_memory.h"
 
 namespace scenewatch::cli {
@@ -40,6 +43,11 @@ std::string event_line(std::size_t frame, const Event& e) {
 int run_replay(const ReplayOptions& options) {
   auto config = read_config_file(options.config);
   if (!config) return fail(config.error().message);
+  if (!options.heatmap_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(options.heatmap_dir, ec);
+    if (ec) return fail("--heatmaps '" + options.heatmap_dir + "': " + ec.message());
+  }
   pipeline::WorkingMemory memory(*config);
   std::size_t frames = 0, total_events = 0;
   std::map<std::string, std::size_t> by_kind;
@@ -60,6 +68,16 @@ int run_replay(const ReplayOptions& options) {
       stage_ms["change"].push_back(result->change_ms);
       stage_ms["surprise"].push_back(result->surprise_ms);
       stage_ms["map insertion"].push_back(result->insert_ms);
+      if (!options.heatmap_dir.empty() && result->surprise) {
+        char name[64];
+        std::snprintf(name, sizeof name, "surprise-%06zu.png", frames);
+        auto kf = background::keyframe_from_frame(frame);
+        const ColorImage observed = kf ? kf->color : ColorImage{};
+        if (auto w = io::write_color_png(std::filesystem::path(options.heatmap_dir) / name,
+                                         surprise::heatmap_overlay(result->surprise->map, observed));
+            !w)
+          return w;
+      }
       for (const auto& e : result->events) {
         ++total_events;
         ++by_kind[to_string(e.kind)];

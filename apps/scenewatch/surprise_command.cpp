@@ -126,7 +126,7 @@ Result<Outcome> offline(const SurpriseOptions& o) {
   const surprise::SurpriseConfig& sc = config->surprise;
   const surprise::ExpectedView view =
       surprise::render_expected_view(memory, observed->T_world_camera, observed->intrinsics, sc.view);
-  auto map = surprise::compute_surprise(view, observed->color, surprise::SurpriseKernel(sc.prior, sc.min_samples));
+  auto map = surprise::compute_surprise(view, observed->color, surprise::SurpriseKernel(sc.prior, sc.min_samples), &sc.robust);
   if (!map) return map.error();
   for (const auto& region : surprise::find_regions(*map, view, &observed->depth, sc.regions))
     out.regions.push_back(service::make_event_message(surprise::to_event(region, observed->stamp_s)));

@@ -28,7 +28,7 @@ Frame posed_frame(const sim::SimFrame& rendered, const Intrinsics& K, double sta
   return frame;
 }
 
-TEST(AppearancePipeline, CupAddedRaisesAppearanceChangeWhereTheCupStands) {
+TEST(AppearancePipeline, CupAddedIsOneEventWithTheSurpriseAsEvidence) {
   auto loaded = sim::load_scenario(test::source_dir() / "sample_clouds/scenarios/cup_added.yaml");
   ASSERT_TRUE(loaded.ok()) << loaded.error().message;
   const sim::Scenario scenario = sim::with_frames(sim::with_resolution(*loaded, 320, 240), 12);
@@ -39,8 +39,8 @@ TEST(AppearancePipeline, CupAddedRaisesAppearanceChangeWhereTheCupStands) {
   Config config;
   config.segmentation.up = Eigen::Vector3d::UnitZ();
   WorkingMemory memory(config);
-  std::vector<Event> appearance[2];
-  std::vector<int> frames_with_events;
+  std::vector<Event> regions[2], events[2];
+  std::vector<int> frames_with_regions;
   double stamp = 0;
   Frame last;
   for (std::size_t phase = 0; phase < 2; ++phase) {
@@ -52,31 +52,44 @@ TEST(AppearancePipeline, CupAddedRaisesAppearanceChangeWhereTheCupStands) {
         ASSERT_TRUE(result->surprise) << "frame " << f << " had a pose and keyframes existed";
         EXPECT_GT(result->surprise->map.known_pixels, 0u);
       }
+      if (result->surprise) {
+        for (const auto& e : result->surprise->events) {
+          regions[phase].push_back(e);
+          if (phase == 1) frames_with_regions.push_back(f);
+          std::printf("phase %zu frame %d: surprise region: %s\n", phase, f, e.detail.c_str());
+        }
+      }
       for (const auto& e : result->events) {
-        if (e.kind != EventKind::kAppearanceChange) continue;
-        appearance[phase].push_back(e);
-        if (phase == 1) frames_with_events.push_back(f);
-        std::printf("phase %zu frame %d: %s\n", phase, f, e.detail.c_str());
+        events[phase].push_back(e);
+        std::printf("phase %zu frame %d: EVENT %s %s\n", phase, f, to_string(e.kind), e.detail.c_str());
       }
       last = frame;
     }
   }
-  EXPECT_TRUE(appearance[0].empty()) << "nothing changed in the first phase";
-  ASSERT_FALSE(appearance[1].empty()) << "the cup was not noticed";
+  // The surprise layer sees the cup, and only the cup.
+  EXPECT_TRUE(regions[0].empty()) << "nothing changed in the first phase";
+  ASSERT_FALSE(regions[1].empty()) << "the cup was not noticed";
   std::size_t at_cup = 0;
-  for (const auto& e : appearance[1]) {
+  for (const auto& e : regions[1]) {
     ASSERT_TRUE(e.region.has_value());
     EXPECT_GT(e.evidence.at("kl_peak_total"), 0.0);
     EXPECT_EQ(e.level, EventLevel::kMismatch);
     at_cup += (e.centroid_world.head<2>() - cup.head<2>()).norm() < 0.08 ? 1 : 0;
   }
-  EXPECT_GE(at_cup, appearance[1].size() * 8 / 10) << "events away from the cup";
+  EXPECT_GE(at_cup, regions[1].size() * 8 / 10) << "regions away from the cup";
   EXPECT_GE(memory.stats().keyframes, 1u);
   // After adopt_after_frames (5) frames of the same change, the memory holds the cup and the
-  // change is no longer reported.
+  // surprise stops.
   ASSERT_EQ(config.surprise.adopt_after_frames, 5);
-  EXPECT_EQ(frames_with_events.front(), 0);
-  EXPECT_LE(frames_with_events.back(), 5) << "the change was not adopted";
+  EXPECT_EQ(frames_with_regions.front(), 0);
+  EXPECT_LE(frames_with_regions.back(), 5) << "the change was not adopted";
+  // The stream says it once: the cup added (geometry), with the appearance evidence merged in.
+  EXPECT_TRUE(events[0].empty());
+  ASSERT_EQ(events[1].size(), 1u) << "one fact, one event";
+  EXPECT_EQ(events[1][0].kind, EventKind::kObjectAdded);
+  EXPECT_LT((events[1][0].centroid_world.head<2>() - cup.head<2>()).norm(), 0.08);
+  ASSERT_EQ(events[1][0].evidence.count("appearance_kl_mean"), 1u) << "the surprise regions are its evidence";
+  EXPECT_GT(events[1][0].evidence.at("appearance_kl_mean"), config.surprise.regions.threshold_low);
 
   // The keyframes and the mesh are saved with the model and come back.
   test::TempDir dir("appearance-model");

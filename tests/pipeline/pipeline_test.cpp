@@ -89,15 +89,12 @@ std::size_t count_kind(const std::vector<Event>& events, EventKind kind) {
   return static_cast<std::size_t>(std::count_if(events.begin(), events.end(), [kind](const Event& e) { return e.kind == kind; }));
 }
 
-TEST(WorkingMemory, ObjectsAppearStayAndGo) {
-  // Cluster tracking alone. With geometric change detection on, a removed object's pixels stay
-  // out of the map until the removal is confirmed (change.persistence_frames), and OBJECT_GONE
-  // follows it; the change tests cover that path.
+TEST(WorkingMemory, ObjectListAppearsStaysAndGoes) {
+  // The object list alone (change detection off): it raises no events; an object leaves the list
+  // once its space was seen free in tracking.gone_frames (2) frames.
   Config config = test_config();
   config.change_enabled = false;
   WorkingMemory wm(config);
-  std::vector<Event> pushed;
-  const int token = wm.subscribe([&](const Event& e) { pushed.push_back(e); });
 
   auto r1 = wm.process(make_frame({kCube, kTall}, 1.0));
   ASSERT_TRUE(r1.ok()) << r1.error().message;
@@ -105,9 +102,8 @@ TEST(WorkingMemory, ObjectsAppearStayAndGo) {
   EXPECT_NEAR(r1->planes[0].normal.z(), 1.0, 1e-3) << "plane in world coordinates";
   EXPECT_NEAR(r1->planes[0].d, 0.0, 0.01);
   ASSERT_EQ(r1->objects.size(), 2u);
-  EXPECT_EQ(count_kind(r1->events, EventKind::kObjectAppeared), 2u);
-  for (const auto& e : r1->events) EXPECT_DOUBLE_EQ(e.score, 0.0) << "first sight: the space was unknown";
-  EXPECT_EQ(pushed.size(), 2u);
+  EXPECT_TRUE(r1->events.empty()) << "first sight of an object is not a change";
+  ASSERT_EQ(wm.snapshot()->objects.size(), 2u);
 
   // The same view again: the objects are matched, nothing new.
   auto r2 = wm.process(make_frame({kCube, kTall}, 2.0));
@@ -116,31 +112,48 @@ TEST(WorkingMemory, ObjectsAppearStayAndGo) {
   auto snap = wm.snapshot();
   ASSERT_EQ(snap->objects.size(), 2u);
   for (const auto& o : snap->objects) EXPECT_EQ(o.observations, 2);
+  const std::uint64_t max_id = std::max(snap->objects[0].id, snap->objects[1].id);
 
-  // The cube is taken away: its space is now seen free -> gone. The tall box stays.
-  auto r3 = wm.process(make_frame({kTall}, 3.0));
-  ASSERT_TRUE(r3.ok());
-  ASSERT_EQ(count_kind(r3->events, EventKind::kObjectGone), 1u);
-  const Event& gone = r3->events.front();
-  EXPECT_NEAR(gone.centroid_world.x(), 0.15, 0.03);
-  EXPECT_NEAR(gone.centroid_world.y(), 0.15, 0.03);
-  EXPECT_EQ(wm.snapshot()->objects.size(), 1u);
+  // The cube is taken away: one frame that sees its space free is not enough, two are.
+  ASSERT_TRUE(wm.process(make_frame({kTall}, 3.0)).ok());
+  EXPECT_EQ(wm.snapshot()->objects.size(), 2u) << "hysteresis: one frame of free space";
+  ASSERT_TRUE(wm.process(make_frame({kTall}, 4.0)).ok());
+  snap = wm.snapshot();
+  ASSERT_EQ(snap->objects.size(), 1u);
+  EXPECT_NEAR(snap->objects[0].cluster.centroid.x(), -0.20, 0.03) << "the tall box stays";
 
-  // A cube is put where the table had been seen three times: it appears in space the map holds
-  // free, so the score is high (the first objects scored 0: their space was unknown).
+  // A cube put somewhere else is a new object with a new id.
   const Box moved{{-0.25, 0.15, 0.0}, {-0.15, 0.25, 0.10}};
-  auto r4 = wm.process(make_frame({kTall, moved}, 4.0));
-  ASSERT_TRUE(r4.ok());
-  ASSERT_EQ(count_kind(r4->events, EventKind::kObjectAppeared), 1u);
-  EXPECT_GT(r4->events.front().score, 0.5);
+  auto r5 = wm.process(make_frame({kTall, moved}, 5.0));
+  ASSERT_TRUE(r5.ok());
+  EXPECT_TRUE(r5->events.empty());
+  snap = wm.snapshot();
+  ASSERT_EQ(snap->objects.size(), 2u);
+  EXPECT_GT(std::max(snap->objects[0].id, snap->objects[1].id), max_id) << "ids are never reused";
+}
+
+TEST(WorkingMemory, AChangeIsOneEventAndReachesSubscribers) {
+  // With change detection on (the default): the cube taken away is one OBJECT_REMOVED, once the
+  // removal held for change.persistence_frames (3) frames; the tracker adds nothing to it.
+  WorkingMemory wm(test_config());
+  std::vector<Event> pushed;
+  const int token = wm.subscribe([&](const Event& e) { pushed.push_back(e); });
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, 1.0 + i)).ok());
+  EXPECT_TRUE(pushed.empty()) << "an unchanged scene raises nothing";
+  for (int i = 0; i < 6; ++i) ASSERT_TRUE(wm.process(make_frame({kTall}, 4.0 + i)).ok());
+  ASSERT_EQ(pushed.size(), 1u);
+  EXPECT_EQ(pushed[0].kind, EventKind::kObjectRemoved);
+  EXPECT_NEAR(pushed[0].centroid_world.x(), 0.15, 0.03);
+  EXPECT_NEAR(pushed[0].centroid_world.y(), 0.15, 0.03);
 
   wm.unsubscribe(token);
-  ASSERT_TRUE(wm.process(make_frame({kTall}, 5.0)).ok());
-  EXPECT_EQ(pushed.size(), 4u) << "no events after unsubscribing";
+  for (int i = 0; i < 6; ++i) ASSERT_TRUE(wm.process(make_frame({kTall, kCube}, 10.0 + i)).ok());
+  EXPECT_EQ(pushed.size(), 1u) << "no events after unsubscribing";
   const auto log = wm.events_since(0);
-  ASSERT_EQ(log.size(), 5u);
-  for (std::size_t i = 1; i < log.size(); ++i) EXPECT_GT(log[i].id, log[i - 1].id);
-  EXPECT_EQ(wm.events_since(log[2].id).size(), 2u);
+  ASSERT_EQ(log.size(), 2u) << "removed, then added back";
+  EXPECT_EQ(log[1].kind, EventKind::kObjectAdded);
+  EXPECT_GT(log[1].id, log[0].id);
+  EXPECT_EQ(wm.events_since(log[0].id).size(), 1u);
 }
 
 TEST(WorkingMemory, OccludedObjectIsNotGone) {
@@ -209,9 +222,9 @@ TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
   {
     WorkingMemory wm(test_config());
     EXPECT_EQ(wm.load(dir).error().code, ErrorCode::kNotFound) << "nothing saved yet";
-    ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, 1.0)).ok());
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, 1.0 + i)).ok());
     ASSERT_TRUE(wm.save(dir).ok());
-    ASSERT_TRUE(wm.process(make_frame({kTall}, 2.0)).ok());
+    for (int i = 0; i < 4; ++i) ASSERT_TRUE(wm.process(make_frame({kTall}, 4.0 + i)).ok());
     ASSERT_TRUE(wm.save(dir).ok()) << "a second save replaces the first";
   }
   EXPECT_TRUE(fs::is_symlink(dir / "current"));
@@ -224,17 +237,25 @@ TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
   auto snap = wm.snapshot();
   ASSERT_EQ(snap->objects.size(), 1u) << "the cube was gone at the second save";
   EXPECT_EQ(snap->planes.size(), 1u);
-  EXPECT_EQ(wm.stats().frames_processed, 2u);
-  EXPECT_DOUBLE_EQ(snap->last_stamp_s, 2.0) << "the last frame's stamp";
-  EXPECT_EQ(wm.events_since(0).size(), 3u) << "2 appeared + 1 gone";
+  EXPECT_EQ(wm.stats().frames_processed, 7u);
+  EXPECT_DOUBLE_EQ(snap->last_stamp_s, 7.0) << "the last frame's stamp";
+  ASSERT_EQ(wm.events_since(0).size(), 1u) << "the cube removed";
+  EXPECT_EQ(wm.events_since(0)[0].kind, EventKind::kObjectRemoved);
   EXPECT_EQ(wm.query_box({{-0.22, -0.18, 0.18}, {-0.18, -0.12, 0.22}}).state, background::Occupancy::kOccupied)
       << "the map came back: the tall box's top";
-  // New events continue the numbering.
-  auto r = wm.process(make_frame({kTall, kCube}, 3.0));
-  ASSERT_TRUE(r.ok());
-  ASSERT_FALSE(r->events.empty());
-  EXPECT_GT(r->events.front().id, 3u);
-  EXPECT_GT(r->events.front().object_id.value(), 2u) << "object ids are not reused";
+  const std::uint64_t first_id = wm.events_since(0)[0].id;
+  // New events continue the numbering; object ids are not reused.
+  std::vector<Event> added;
+  for (int i = 0; i < 5; ++i) {
+    auto r = wm.process(make_frame({kTall, kCube}, 8.0 + i));
+    ASSERT_TRUE(r.ok());
+    added.insert(added.end(), r->events.begin(), r->events.end());
+  }
+  ASSERT_EQ(added.size(), 1u);
+  EXPECT_EQ(added[0].kind, EventKind::kObjectAdded);
+  EXPECT_GT(added[0].id, first_id);
+  ASSERT_EQ(wm.snapshot()->objects.size(), 2u);
+  for (const auto& o : wm.snapshot()->objects) EXPECT_TRUE(o.id == snap->objects[0].id || o.id > 2u);
 
   // A damaged model is refused and the loaded one stays.
   const fs::path current = fs::read_symlink(dir / "current");
@@ -278,7 +299,8 @@ TEST(WorkingMemory, RealKinectFrame) {
               r->objects.size(), r->segment_ms, r->insert_ms, r->total_ms);
   EXPECT_EQ(r->planes.size(), 1u);
   EXPECT_EQ(r->objects.size(), 3u) << "learn13 has three boxes on the table";
-  EXPECT_EQ(count_kind(r->events, EventKind::kObjectAppeared), 3u);
+  EXPECT_EQ(wm.snapshot()->objects.size(), 3u) << "in the object list at first sight (tracking.confirm_frames 1)";
+  EXPECT_TRUE(r->events.empty()) << "a first frame reports no change";
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ Result<std::shared_ptr<SurpriseResult>> AppearanceStage::compute(const Frame& fr
   const Pose pose = frame.pose_or_identity();
   auto result = std::make_shared<SurpriseResult>();
   const surprise::ExpectedView view = surprise::render_expected_view(memory_, pose, *frame.intrinsics, config_.view);
-  auto map = surprise::compute_surprise(view, observed.color, kernel_);
+  auto map = surprise::compute_surprise(view, observed.color, kernel_, &config_.robust);
   if (!map) return map.error();
   for (const auto& region : surprise::find_regions(*map, view, &observed.depth, config_.regions)) {
     result->events.push_back(surprise::to_event(region, frame.stamp_s));
@@ -40,6 +40,19 @@ Result<std::shared_ptr<SurpriseResult>> AppearanceStage::compute(const Frame& fr
   result->stamp_s = frame.stamp_s;
   result->ms = ms_since(t0);
   return result;
+}
+
+bool AppearanceStage::familiar(const Pose& T_world_camera) const {
+  for (const auto& kf : memory_.keyframes()) {
+    auto it = added_at_.find(kf->id);
+    const std::uint64_t added = it == added_at_.end() ? 0 : it->second;  // loaded from disk: old
+    if (frames_ - added < static_cast<std::uint64_t>(config_.familiar_after_frames)) continue;
+    const background::ViewDistance d = background::view_distance(kf->T_world_camera, T_world_camera);
+    if (d.translation_m <= 2 * appearance_config_.keyframe_min_translation_m &&
+        d.rotation_deg <= 2 * appearance_config_.keyframe_min_rotation_deg)
+      return true;
+  }
+  return false;
 }
 
 std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& frame) {
@@ -54,20 +67,38 @@ std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& fram
     std::shared_lock<std::shared_mutex> read(mutex_);
     if (config_.enabled && memory_.size() > 0) {
       auto computed = compute(frame, *observed);
-      if (computed) result = std::move(*computed);
+      if (computed) {
+        (*computed)->familiar_view = familiar(observed->T_world_camera);
+        result = std::move(*computed);
+      }
     }
   }
   std::unique_lock<std::shared_mutex> write(mutex_);
   if (result) last_ = result;
   changed_streak_ = (result && !result->events.empty()) ? changed_streak_ + 1 : 0;
+  ++frames_;
   if (!appearance_config_.enabled) return result;
   if (config_.adopt_after_frames > 0 && changed_streak_ >= config_.adopt_after_frames &&
       !memory_.is_new_view(observed->T_world_camera)) {
     // The change held for long enough from a view the memory holds: remember it.
-    (void)memory_.replace_nearest(std::move(*observed));
+    if (auto id = memory_.replace_nearest(std::move(*observed))) added_at_[*id] = frames_;
     changed_streak_ = 0;
   } else {
-    (void)memory_.consider(std::move(*observed));
+    auto added = memory_.consider(std::move(*observed));
+    if (added && *added) {
+      // consider() does not say which id it gave: the one not seen before.
+      for (const auto& kf : memory_.keyframes())
+        if (added_at_.count(kf->id) == 0) added_at_[kf->id] = frames_;
+    }
+  }
+  // Forget the frames of evicted keyframes.
+  if (added_at_.size() > 2 * memory_.size() + 16) {
+    std::map<std::uint64_t, std::uint64_t> live;
+    for (const auto& kf : memory_.keyframes()) {
+      auto it = added_at_.find(kf->id);
+      if (it != added_at_.end()) live.insert(*it);
+    }
+    added_at_.swap(live);
   }
   return result;
 }
@@ -111,6 +142,7 @@ Status AppearanceStage::load(const std::filesystem::path& dir) {
   std::unique_lock<std::shared_mutex> write(mutex_);
   memory_ = std::move(loaded);
   last_.reset();
+  added_at_.clear();  // loaded keyframes count as old: their views are familiar
   return {};
 }
 
@@ -119,6 +151,7 @@ void AppearanceStage::reset() {
   memory_.clear();
   last_.reset();
   changed_streak_ = 0;
+  added_at_.clear();
 }
 
 std::size_t AppearanceStage::keyframes() const {

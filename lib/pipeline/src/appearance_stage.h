@@ -4,6 +4,7 @@
 // the writers are serialised by the working memory; readers (surprise of an observation, the
 // last map, the mesh) take a shared lock.
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <shared_mutex>
 
@@ -37,6 +38,9 @@ class AppearanceStage {
 
  private:
   Result<std::shared_ptr<SurpriseResult>> compute(const Frame& frame, const background::Keyframe& observed) const;
+  /// A keyframe within twice the keyframe spacing, taken at least familiar_after_frames before.
+  /// The caller holds mutex_.
+  bool familiar(const Pose& T_world_camera) const;
 
   background::AppearanceConfig appearance_config_;
   surprise::SurpriseConfig config_;
@@ -45,6 +49,8 @@ class AppearanceStage {
   background::AppearanceMemory memory_;
   std::shared_ptr<const SurpriseResult> last_;
   int changed_streak_ = 0;  ///< consecutive frames with regions (writer only)
+  std::uint64_t frames_ = 0;  ///< posed colour frames seen (writer only)
+  std::map<std::uint64_t, std::uint64_t> added_at_;  ///< keyframe id -> frames_ when it was taken
 };
 
 }  // namespace scenewatch::pipeline

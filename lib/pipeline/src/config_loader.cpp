@@ -80,7 +80,10 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
     YamlSection s(root["tracking"], "tracking");
     if (auto st = s.check_is_map(); !st) return st;
     if (auto st = read_all([&] { return s.read("match_distance_m", c.tracking.match_distance_m); },
-                           [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); });
+                           [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); },
+                           [&] { return s.read("confirm_frames", c.tracking.confirm_frames); },
+                           [&] { return s.read("gone_frames", c.tracking.gone_frames); },
+                           [&] { return s.read("max_range_m", c.tracking.max_range_m); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;
@@ -140,7 +143,11 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("open_radius_px", u.regions.open_radius_px); },
                            [&] { return s.read("min_area_px", u.regions.min_area_px); },
                            [&] { return s.read("min_extent_px", u.regions.min_extent_px); },
-                           [&] { return s.read("adopt_after_frames", u.adopt_after_frames); });
+                           [&] { return s.read("adopt_after_frames", u.adopt_after_frames); },
+                           [&] { return s.read("photometric", u.robust.photometric); },
+                           [&] { return s.read("align_radius_px", u.robust.align_radius_px); },
+                           [&] { return s.read("align_min_kl", u.robust.align_min_kl); },
+                           [&] { return s.read("familiar_after_frames", u.familiar_after_frames); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;
@@ -148,7 +155,13 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
   {
     YamlSection s(root["events"], "events");
     if (auto st = s.check_is_map(); !st) return st;
-    if (auto st = s.read("max_log", c.max_event_log); !st) return st;
+    if (auto st = read_all([&] { return s.read("max_log", c.max_event_log); },
+                           [&] { return s.read("appearance_persistence_frames", c.fusion.persistence_frames); },
+                           [&] { return s.read("appearance_match_m", c.fusion.match_m); },
+                           [&] { return s.read("merge_margin_m", c.fusion.margin_m); },
+                           [&] { return s.read("silence_frames", c.fusion.zone_frames); });
+        !st)
+      return st;
     if (auto st = s.finish(); !st) return st;
   }
   return validate(c);

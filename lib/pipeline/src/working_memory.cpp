@@ -61,11 +61,6 @@ ObjectCluster to_world(ObjectCluster c, const Pose& T) {
   return c;
 }
 
-bool inside(const OrientedBox& box, const Eigen::Vector3d& p, double margin) {
-  const Eigen::Vector3d q = box.rotation.conjugate() * (p - box.center);
-  return (q.cwiseAbs().array() <= (0.5 * box.extents.array() + margin)).all();
-}
-
 constexpr std::size_t kSamplesPerObject = 200;
 
 // The frame without the points of unconfirmed change candidates: an added candidate's own points,
@@ -101,7 +96,7 @@ CloudConstPtr without_pending(const Cloud& cloud, const std::vector<change::Chan
 
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
-      : map(c.background), appearance(c.appearance, c.surprise), changes(c.change),
+      : map(c.background), appearance(c.appearance, c.surprise), changes(c.change), tracker(c.tracking), fusion(c.fusion),
         snapshot(std::make_shared<SceneSnapshot>()) {}
 
   // process() and the other writers hold this for their whole duration.
@@ -113,10 +108,9 @@ struct WorkingMemory::Impl {
 
   // Owned by the writer.
   change::PersistenceFilter changes;
-  std::vector<TrackedObject> objects;
-  std::map<std::uint64_t, std::vector<Eigen::Vector3d>> object_samples;  // world points per object
+  ObjectTracker tracker;
+  EventFusion fusion;
   std::vector<Plane> planes;
-  std::uint64_t next_object_id = 1;
   std::uint64_t frames = 0, points = 0;
   double total_ms = 0, last_ms = 0;
   double last_stamp_s = 0.0;
@@ -134,7 +128,7 @@ struct WorkingMemory::Impl {
     auto s = std::make_shared<SceneSnapshot>();
     s->frames_processed = frames;
     s->planes = planes;
-    s->objects = objects;
+    s->objects = tracker.objects();
     s->last_stamp_s = last_stamp_s;
     std::atomic_store(&snapshot, std::shared_ptr<const SceneSnapshot>(std::move(s)));
   }
@@ -161,7 +155,14 @@ Status validate(const Config& c) {
   if (auto st = segmentation::validate(c.segmentation); !st) return st;
   if (!(c.tracking.match_distance_m > 0 && c.tracking.match_distance_m < 5)) return invalid_argument("tracking.match_distance_m: must be in (0, 5) m");
   if (!(c.tracking.gone_free_fraction > 0 && c.tracking.gone_free_fraction <= 1)) return invalid_argument("tracking.gone_free_fraction: must be in (0, 1]");
+  if (c.tracking.confirm_frames < 1 || c.tracking.confirm_frames > 100) return invalid_argument("tracking.confirm_frames: must be in [1, 100]");
+  if (c.tracking.gone_frames < 1 || c.tracking.gone_frames > 100) return invalid_argument("tracking.gone_frames: must be in [1, 100]");
+  if (!(c.tracking.max_range_m > 0 && c.tracking.max_range_m <= 20)) return invalid_argument("tracking.max_range_m: must be in (0, 20] m");
   if (c.max_event_log < 1) return invalid_argument("events.max_log: must be >= 1");
+  if (c.fusion.persistence_frames < 1 || c.fusion.persistence_frames > 100) return invalid_argument("events.appearance_persistence_frames: must be in [1, 100]");
+  if (!(c.fusion.match_m > 0 && c.fusion.match_m <= 1)) return invalid_argument("events.appearance_match_m: must be in (0, 1] m");
+  if (!(c.fusion.margin_m >= 0 && c.fusion.margin_m <= 1)) return invalid_argument("events.merge_margin_m: must be in [0, 1] m");
+  if (c.fusion.zone_frames < 0 || c.fusion.zone_frames > 100000) return invalid_argument("events.silence_frames: must be in [0, 100000]");
   if (auto st = background::validate(c.appearance); !st) return st;
   if (auto st = surprise::validate(c.surprise); !st) return st;
   if (auto st = change::validate(c.change); !st) return st;
@@ -189,54 +190,22 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   for (auto& p : s.planes) result.planes.push_back(to_world(std::move(p), T));
   for (auto& o : s.objects) result.objects.push_back(to_world(std::move(o), T));
 
-  // World sample points of each cluster, for the free-space evidence before and after insertion.
-  std::vector<std::vector<Eigen::Vector3d>> samples(result.objects.size());
+  // World sample points of each cluster, for the tracker's free-space evidence.
+  std::vector<TrackerObservation> observations(result.objects.size());
   for (std::size_t i = 0; i < result.objects.size(); ++i) {
     const auto& idx = result.objects[i].indices;
     const std::size_t step = std::max<std::size_t>(1, idx.size() / kSamplesPerObject);
-    for (std::size_t k = 0; k < idx.size(); k += step) samples[i].push_back(T * frame.cloud->points[idx[k]].getVector3fMap().cast<double>());
+    for (std::size_t k = 0; k < idx.size(); k += step)
+      observations[i].samples.push_back(T * frame.cloud->points[idx[k]].getVector3fMap().cast<double>());
+    observations[i].cluster = result.objects[i];
+    observations[i].range_m = (result.objects[i].centroid - T.translation()).norm();
   }
-  auto free_fraction = [&](const std::vector<Eigen::Vector3d>& pts) {
-    std::size_t n = 0;
-    for (const auto& p : pts) n += m.map.query(p) == background::Occupancy::kFree ? 1 : 0;
-    return pts.empty() ? 0.0 : static_cast<double>(n) / pts.size();
-  };
-
-  // Track: greedy nearest matching of clusters to remembered objects.
   std::vector<Event> events;
-  std::vector<char> object_matched(m.objects.size(), 0);
-  std::vector<int> cluster_match(result.objects.size(), -1);
-  {
-    std::vector<std::tuple<double, int, int>> pairs;
-    for (std::size_t c = 0; c < result.objects.size(); ++c)
-      for (std::size_t o = 0; o < m.objects.size(); ++o) {
-        const double d = (result.objects[c].centroid - m.objects[o].cluster.centroid).norm();
-        if (d <= config_.tracking.match_distance_m ||
-            inside(result.objects[c].box, m.objects[o].cluster.centroid, 0.0)) {
-          pairs.emplace_back(d, static_cast<int>(c), static_cast<int>(o));
-        }
-      }
-    std::sort(pairs.begin(), pairs.end());
-    for (const auto& [d, c, o] : pairs) {
-      if (cluster_match[c] >= 0 || object_matched[o]) continue;
-      cluster_match[c] = o;
-      object_matched[o] = 1;
-    }
-  }
-
-  std::vector<double> prior_free(result.objects.size(), 0.0);
-  {
-    std::shared_lock<std::shared_mutex> read(m.map_mutex);
-    for (std::size_t c = 0; c < result.objects.size(); ++c) {
-      if (cluster_match[c] < 0) prior_free[c] = free_fraction(samples[c]);
-    }
-  }
 
   // Image-based surprise against the appearance memory, then its keyframe update.
   const auto t_surprise = Clock::now();
   result.surprise = m.appearance.process(frame);
   result.surprise_ms = ms_since(t_surprise);
-  if (result.surprise) events.insert(events.end(), result.surprise->events.begin(), result.surprise->events.end());
 
   // Geometric change detection against the map as it stands before this frame. Candidates stay
   // out of the map until the persistence filter confirms them, so the comparison keeps being made
@@ -282,79 +251,36 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
     }
   }
   result.insert_ms = ms_since(t_ins);
-  for (const auto& c : confirmed) {
-    Event e = change::to_event(c);
-    e.stamp_s = frame.stamp_s;
-    events.push_back(std::move(e));
-  }
-
-  for (std::size_t c = 0; c < result.objects.size(); ++c) {
-    ObjectCluster cluster = result.objects[c];
-    cluster.indices.clear();  // indices belong to this frame only
-    if (cluster_match[c] >= 0) {
-      TrackedObject& obj = m.objects[cluster_match[c]];
-      obj.cluster = std::move(cluster);
-      obj.last_seen_s = frame.stamp_s;
-      ++obj.observations;
-      m.object_samples[obj.id] = samples[c];
-      continue;
+  // One fact, one event: appearance regions where geometry changes are its evidence; others must persist.
+  {
+    std::vector<Event> geometric;
+    for (const auto& c : confirmed) {
+      Event e = change::to_event(c);
+      e.stamp_s = frame.stamp_s;
+      geometric.push_back(std::move(e));
     }
-    TrackedObject obj;
-    obj.id = m.next_object_id++;
-    obj.cluster = std::move(cluster);
-    obj.first_seen_s = obj.last_seen_s = frame.stamp_s;
-    obj.observations = 1;
-    m.object_samples[obj.id] = samples[c];
-    Event e;
-    e.stamp_s = frame.stamp_s;
-    e.level = EventLevel::kMismatch;
-    e.kind = EventKind::kObjectAppeared;
-    // Score: the share of the object's points in space the map had seen free. 0 means merely
-    // first seen (the space was unknown); 1 means it appeared where there was nothing.
-    e.score = prior_free[c];
-    e.box_world = obj.cluster.box.aabb();
-    e.centroid_world = obj.cluster.centroid;
-    e.object_id = obj.id;
-    std::ostringstream os;
-    os << obj.cluster.point_count << " points on plane " << obj.cluster.plane_id << ", "
-       << static_cast<int>(std::round(100 * prior_free[c])) << "% in previously free space";
-    e.detail = os.str();
-    events.push_back(std::move(e));
-    m.objects.push_back(std::move(obj));
+    std::vector<Aabb> boxes;
+    for (const auto& c : confirmed) {
+      if (c.before) boxes.push_back(c.before->box_world);
+      if (c.after) boxes.push_back(c.after->box_world);
+    }
+    static const std::vector<Event> kNone;
+    const bool familiar = result.surprise && result.surprise->familiar_view;
+    events = m.fusion.update(result.surprise ? result.surprise->events : kNone, pending, std::move(geometric),
+                             std::move(boxes), familiar, m.tracker.objects(), result.objects);
   }
 
-  // Objects not seen in this frame are gone only when the space they filled is now seen free;
-  // an occluded or out-of-view object keeps its place.
+  // The object list (no events: a change is reported by the change detector, once).
   {
     std::shared_lock<std::shared_mutex> read(m.map_mutex);
-    std::vector<TrackedObject> kept;
-    for (std::size_t o = 0; o < m.objects.size(); ++o) {
-      TrackedObject& obj = m.objects[o];
-      if (o >= object_matched.size() || object_matched[o]) {
-        kept.push_back(std::move(obj));
-        continue;
+    m.tracker.update(std::move(observations), frame.stamp_s, [&](const std::vector<Eigen::Vector3d>& pts) {
+      if (pts.empty()) return 0.0;
+      std::size_t n = 0;
+      for (const auto& p : pts) {
+        n += (m.map.freed_by_last_insert(p) || m.map.query(p) == background::Occupancy::kFree) ? 1 : 0;
       }
-      const auto& pts = m.object_samples[obj.id];
-      std::size_t seen_through = 0;
-      for (const auto& p : pts) seen_through += m.map.freed_by_last_insert(p) ? 1 : 0;
-      const double f = std::max(free_fraction(pts), pts.empty() ? 0.0 : static_cast<double>(seen_through) / pts.size());
-      if (f < config_.tracking.gone_free_fraction) {
-        kept.push_back(std::move(obj));
-        continue;
-      }
-      Event e;
-      e.stamp_s = frame.stamp_s;
-      e.level = EventLevel::kMismatch;
-      e.kind = EventKind::kObjectGone;
-      e.score = f;
-      e.box_world = obj.cluster.box.aabb();
-      e.centroid_world = obj.cluster.centroid;
-      e.object_id = obj.id;
-      e.detail = std::to_string(static_cast<int>(std::round(100 * f))) + "% of its space is now seen free";
-      events.push_back(std::move(e));
-      m.object_samples.erase(obj.id);
-    }
-    m.objects.swap(kept);
+      return static_cast<double>(n) / pts.size();
+    });
   }
 
   m.planes = result.planes;
@@ -381,7 +307,7 @@ Stats WorkingMemory::stats() const {
     s.points_processed = impl_->points;
     s.last_frame_ms = impl_->last_ms;
     s.mean_frame_ms = impl_->frames ? impl_->total_ms / impl_->frames : 0.0;
-    s.tracked_objects = impl_->objects.size();
+    s.tracked_objects = impl_->tracker.objects().size();
     s.keyframes = impl_->appearance.keyframes();
     s.mesh_triangles = impl_->appearance.triangles();
     s.appearance_memory_bytes = impl_->appearance.memory_bytes();
@@ -419,9 +345,9 @@ void WorkingMemory::reset() {
     impl_->map.reset();
   }
   impl_->appearance.reset();
-  impl_->objects.clear();
-  impl_->object_samples.clear();
+  impl_->tracker.reset();
   impl_->changes.reset();
+  impl_->fusion.reset();
   impl_->planes.clear();
   impl_->frames = impl_->points = 0;
   impl_->total_ms = impl_->last_ms = 0;
@@ -438,15 +364,14 @@ Status WorkingMemory::save(const fs::path& model_dir) const {
       if (auto st = m.map.save(dir / "background.ot"); !st) return st;
     }
     nlohmann::json scene = {{"format", "scenewatch-model"}, {"version", 1}, {"frames_processed", m.frames},
-                            {"points_processed", m.points}, {"next_object_id", m.next_object_id},
+                            {"points_processed", m.points}, {"next_object_id", m.tracker.next_id()},
                             {"last_stamp_s", m.last_stamp_s}};
     scene["objects"] = nlohmann::json::array();
-    for (const auto& o : m.objects) {
+    for (const auto& o : m.tracker.objects()) {
       nlohmann::json j = to_json(o);
       nlohmann::json pts = nlohmann::json::array();
-      auto it = m.object_samples.find(o.id);
-      if (it != m.object_samples.end())
-        for (const auto& p : it->second) pts.push_back({p.x(), p.y(), p.z()});
+      if (const auto* samples = m.tracker.samples(o.id))
+        for (const auto& p : *samples) pts.push_back({p.x(), p.y(), p.z()});
       j["samples"] = pts;
       scene["objects"].push_back(j);
     }
@@ -532,14 +457,13 @@ Status WorkingMemory::load(const fs::path& model_dir) {
     m.map = std::move(map);
   }
   config_.background.resolution_m = m.map.resolution();
-  m.objects = std::move(objects);
-  m.object_samples = std::move(samples);
+  m.tracker.restore(std::move(objects), std::move(samples), next_object_id);
   m.changes.reset();
+  m.fusion.reset();
   m.planes = std::move(planes);
   m.frames = frames;
   m.points = points;
   m.last_stamp_s = last_stamp_s;
-  m.next_object_id = next_object_id;
   {
     std::lock_guard<std::mutex> events_lock(m.events_mutex);
     m.events = std::move(events);

@@ -21,7 +21,55 @@ float percentile(std::vector<float>& values, double q) {
 
 }  // namespace
 
-Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage& observed, const SurpriseKernel& kernel) {
+namespace {
+
+// Each pixel whose surprise reaches `min_kl` is compared again with the expected samples of its
+// neighbours within `radius` (nearest first) and keeps the least surprise found: a colour that the
+// memory predicts a pixel or two away is misalignment, not change.
+void tolerate_misalignment(const ExpectedView& view, const std::array<std::vector<float>, kChannels>& obs,
+                           const SurpriseKernel& kernel, int radius, float min_kl, SurpriseMap& map) {
+  std::vector<std::pair<int, int>> offsets;
+  for (int dv = -radius; dv <= radius; ++dv)
+    for (int du = -radius; du <= radius; ++du)
+      if (du != 0 || dv != 0) offsets.emplace_back(du, dv);
+  std::sort(offsets.begin(), offsets.end(), [](const auto& a, const auto& b) {
+    return a.first * a.first + a.second * a.second < b.first * b.first + b.second * b.second;
+  });
+  const int w = view.width, h = view.height;
+  for (int v = 0; v < h; ++v) {
+    for (int u = 0; u < w; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      if (!(map.total[i] >= min_kl)) continue;  // also skips NaN
+      float best = map.total[i];
+      std::array<float, kChannels> best_ch{};
+      bool improved = false;
+      for (const auto& [du, dv] : offsets) {
+        const int uu = u + du, vv = v + dv;
+        if (uu < 0 || vv < 0 || uu >= w || vv >= h) continue;
+        const std::size_t j = static_cast<std::size_t>(vv) * w + uu;
+        std::array<float, kChannels> ch{};
+        float total = 0;
+        for (int c = 0; c < kChannels; ++c) {
+          ch[c] = kernel.at(view.count[j], view.mean[c][j], view.ssd[c][j], obs[c][i]);
+          total += ch[c];
+        }
+        if (!(total < best)) continue;  // NaN (no samples there) never wins
+        best = total;
+        best_ch = ch;
+        improved = true;
+        if (best < min_kl) break;
+      }
+      if (!improved) continue;
+      map.total[i] = best;
+      for (int c = 0; c < kChannels; ++c) map.channel[c][i] = best_ch[c];
+    }
+  }
+}
+
+}  // namespace
+
+Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage& observed, const SurpriseKernel& kernel,
+                                     const RobustConfig* robust) {
   if (observed.width != view.width || observed.height != view.height)
     return invalid_argument("observed image is " + std::to_string(observed.width) + "x" + std::to_string(observed.height) +
                             " but the expected view is " + std::to_string(view.width) + "x" + std::to_string(view.height));
@@ -32,8 +80,15 @@ Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage&
   map.height = view.height;
   map.total.resize(n);
   for (auto& channel : map.channel) channel.resize(n);
-  // In blocks, so that the observed opponent signals live in a small buffer rather than in three
-  // more frame-sized arrays (fresh pages cost more than the arithmetic here).
+  if (robust != nullptr && robust->photometric) map.photometric = fit_photometric(view, observed, kernel.min_samples());
+  const int radius = robust == nullptr ? 0
+                                       : static_cast<int>(std::lround(robust->align_radius_px * view.width / 640.0));
+  // The observed opponent signals: in blocks, so that they live in a small buffer rather than in
+  // three more frame-sized arrays (fresh pages cost more than the arithmetic here), unless the
+  // misalignment pass needs them again.
+  std::array<std::vector<float>, kChannels> whole;
+  if (radius > 0)
+    for (auto& c : whole) c.resize(n);
   constexpr std::size_t kBlock = 4096;
   std::array<std::array<float, kBlock>, kChannels> obs;
   for (std::size_t start = 0; start < n; start += kBlock) {
@@ -42,7 +97,7 @@ Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage&
       const std::uint8_t* px = &observed.rgb[3 * (start + i)];
       float opp[kChannels];
       to_opponent(px[0], px[1], px[2], opp);
-      for (int c = 0; c < kChannels; ++c) obs[c][i] = opp[c];
+      for (int c = 0; c < kChannels; ++c) obs[c][i] = map.photometric.apply(c, opp[c]);
     }
     const float* means[kChannels];
     const float* ssds[kChannels];
@@ -53,9 +108,11 @@ Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage&
       ssds[c] = view.ssd[c].data() + start;
       observed_ch[c] = obs[c].data();
       outs[c] = map.channel[c].data() + start;
+      if (radius > 0) std::copy(obs[c].begin(), obs[c].begin() + len, whole[c].begin() + start);
     }
     kernel.run_channels(kChannels, view.count.data() + start, means, ssds, observed_ch, outs, map.total.data() + start, len);
   }
+  if (radius > 0) tolerate_misalignment(view, whole, kernel, radius, static_cast<float>(robust->align_min_kl), map);
   for (std::size_t i = 0; i < n; ++i) map.known_pixels += std::isnan(map.total[i]) ? 0 : 1;
   return map;
 }
@@ -71,9 +128,12 @@ Status validate(const RegionConfig& c) {
 
 Status validate(const SurpriseConfig& c) {
   if (auto st = validate(c.view); !st) return st;
+  if (auto st = validate(c.robust); !st) return st;
   if (auto st = validate(c.regions); !st) return st;
   if (!(c.prior.a0 > 0)) return invalid_argument("surprise.a0 must be > 0");
   if (!(c.prior.b0 > 0)) return invalid_argument("surprise.b0 must be > 0");
+  if (c.familiar_after_frames < 0 || c.familiar_after_frames > 100000)
+    return invalid_argument("surprise.familiar_after_frames must be in [0, 100000]");
   if (c.adopt_after_frames < 0 || c.adopt_after_frames > 1000)
     return invalid_argument("surprise.adopt_after_frames must be in [0, 1000]");
   if (c.min_samples < 1 || c.min_samples > kMaxSamples)

@@ -1,7 +1,7 @@
 #pragma once
-/// The facade: WorkingMemory::process(frame) validates the frame, segments it, tracks objects at
-/// cluster level, detects geometric changes against the background, emits events and updates
-/// the background. It owns the modules; the service
+/// The facade: WorkingMemory::process(frame) validates the frame, segments it, keeps the object
+/// list (ObjectTracker), detects geometric changes against the background and appearance changes
+/// against the keyframes, emits each change once and updates the background. It owns the modules; the service
 /// talks to it and knows nothing of their insides.
 #include <atomic>
 #include <cstdint>
@@ -20,17 +20,12 @@
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
+#include "scenewatch/pipeline/event_fusion.h"
+#include "scenewatch/pipeline/object_tracker.h"
 #include "scenewatch/segmentation/tabletop.h"
 #include "scenewatch/surprise/surprise_map.h"
 
 namespace scenewatch::pipeline {
-
-struct TrackingConfig {
-  double match_distance_m = 0.05;   ///< a cluster matches a known object within this centroid distance
-  /// An unmatched object is gone when this share of its sample points lies in space the frame saw
-  /// through (or that the map already holds free); occluded objects are never gone.
-  double gone_free_fraction = 0.6;
-};
 
 /// Everything the pipeline needs; loaded from YAML by load_config().
 struct Config {
@@ -44,6 +39,7 @@ struct Config {
   background::AppearanceConfig appearance;  ///< keyframes and mesh (posed RGB-D frames only)
   surprise::SurpriseConfig surprise;        ///< image-based Bayesian surprise
   std::size_t max_event_log = 10000;  ///< events kept in memory for GetEvents
+  FusionConfig fusion;                ///< one fact, one event (the `events:` section)
 };
 
 /// The image-based surprise of one observation against the appearance memory.
@@ -51,6 +47,11 @@ struct SurpriseResult {
   surprise::SurpriseMap map;
   std::vector<Event> events;  ///< APPEARANCE_CHANGE regions (ids set only when emitted by process())
   std::size_t reference_views = 0;
+  /// The memory knows this view from an earlier visit: a keyframe within twice the keyframe
+  /// spacing, taken at least `surprise.familiar_after_frames` frames before. Only then may appearance alone
+  /// report a change (a view seen for the first time differs in ways that are not change:
+  /// reflections, transparency, what was hidden before).
+  bool familiar_view = false;
   Pose T_world_camera = Pose::Identity();
   Intrinsics intrinsics;
   double stamp_s = 0.0;

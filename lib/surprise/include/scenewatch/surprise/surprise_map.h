@@ -11,6 +11,7 @@
 #include "scenewatch/core/result.h"
 #include "scenewatch/surprise/bayes.h"
 #include "scenewatch/surprise/expected_view.h"
+#include "scenewatch/surprise/robust.h"
 
 namespace scenewatch::surprise {
 
@@ -20,10 +21,14 @@ struct SurpriseMap {
   std::array<std::vector<float>, kChannels> channel;
   std::vector<float> total;  ///< sum over the three channels (independent pathways)
   std::size_t known_pixels = 0;
+  Photometric photometric;  ///< the correction applied to the observation (identity when none)
 };
 
-/// The surprise of `observed` (same size as the view) per channel and in total.
-Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage& observed, const SurpriseKernel& kernel);
+/// The surprise of `observed` (same size as the view) per channel and in total. With `robust`,
+/// the observation is first mapped into the memory's photometry and misalignment is tolerated
+/// (robust.h); without, the plain per-pixel comparison of the seed.
+Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage& observed, const SurpriseKernel& kernel,
+                                     const RobustConfig* robust = nullptr);
 
 /// How the map becomes regions: hysteresis on the total, a morphological opening, connected
 /// components, and a size filter.
@@ -62,6 +67,11 @@ struct SurpriseConfig {
   /// with the prior alone setting the colour noise.
   int min_samples = 1;
   RegionConfig regions;
+  RobustConfig robust;  ///< photometric correction and misalignment tolerance
+  /// In a stream, appearance alone reports a change only from a view the memory knows from at
+  /// least this many frames ago (a keyframe within twice the keyframe spacing); elsewhere surprise
+  /// is evidence for geometric changes only. 0: every view.
+  int familiar_after_frames = 15;
   /// After this many consecutive frames with APPEARANCE_CHANGE regions from a view the memory
   /// already holds, the frame replaces the nearest keyframe: the change is remembered and stops
   /// being reported. 0: never (the memory keeps the first sight of every place).

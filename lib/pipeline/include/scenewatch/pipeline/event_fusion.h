@@ -1,0 +1,81 @@
+#pragma once
+// One fact, one event. Each frame brings image-surprise regions (APPEARANCE_CHANGE candidates)
+// and the geometric change detector's pending and confirmed changes. This stage decides what the
+// stream says:
+// - a surprise region where geometry is changing (a pending or confirmed geometric change, grown by
+//   a margin) is evidence for that change, not an event of its own; when the geometric change
+//   fires, it carries the strongest such evidence (appearance_kl_mean, appearance_area_px);
+// - any other surprise region must persist: it fires as APPEARANCE_CHANGE once it was seen in
+//   `persistence_frames` frames at the same place in the world (within `match_m`). Misalignment,
+//   specular highlights and sensor noise move with the camera or come and go; a real change of
+//   appearance (the seed's removed glasses) stays where it is;
+// - a geometric change speaks of whole objects: the evidence of a removal is only the part of the
+//   surface that left free space, so a removal (or the old place of a move) takes the box and id
+//   of the listed object there, and an addition (or the new place) the box and points of this
+//   frame's segmented object there;
+// - where an event fired, the same kind of fact is not reported again (a zone, for `zone_frames`):
+//   a removal confirmed later inside the place of an earlier removal (or move) is another piece of
+//   the same object, seen from a new side; likewise for additions; no appearance-only change is
+//   reported where any event fired.
+#include <cstdint>
+#include <vector>
+
+#include "scenewatch/change/objects.h"
+#include "scenewatch/core/event.h"
+#include "scenewatch/core/scene.h"
+
+namespace scenewatch::pipeline {
+
+struct FusionConfig {
+  int persistence_frames = 3;  ///< sightings before an appearance-only change fires
+  double match_m = 0.05;       ///< a region matches a candidate within this centroid distance
+  double margin_m = 0.05;      ///< geometric boxes are grown by this much to claim regions
+  int zone_frames = 300;       ///< a fired event silences its place for this many frames
+};
+
+class EventFusion {
+ public:
+  explicit EventFusion(const FusionConfig& config = {}) : config_(config) {}
+
+  /// One frame: `appearance` holds this frame's surprise regions as events, `pending` the
+  /// geometric candidates seen in this frame, `geometric` the geometric events confirmed by it and
+  /// `geometric_boxes` every box they involve (both places of a move). `familiar_view` says
+  /// whether the memory knows this view well enough to judge appearance alone (see
+  /// AppearanceStage): in a view seen for the first time, surprise regions are only evidence.
+  /// Returns the frame's events: the geometric ones (with appearance evidence merged in), then
+  /// the appearance-only changes that became persistent.
+  /// `objects` is the object list before this frame, `clusters` this frame's segmented objects
+  /// (world frame, with their indices in the frame).
+  std::vector<Event> update(const std::vector<Event>& appearance, const std::vector<change::ChangeCluster>& pending,
+                            std::vector<Event> geometric, std::vector<Aabb> geometric_boxes, bool familiar_view,
+                            const std::vector<TrackedObject>& objects = {},
+                            const std::vector<ObjectCluster>& clusters = {});
+
+  std::size_t candidates() const { return candidates_.size(); }
+  void reset();
+
+ private:
+  struct Candidate {
+    Event latest;
+    int hits = 0;
+    int misses = 0;
+    double best_kl = 0.0;
+  };
+  struct Claimed {  ///< appearance evidence gathered for a pending geometric change
+    Aabb box;
+    double kl = 0.0, area_px = 0.0;
+    int age = 0;
+  };
+  enum class ZoneKind { kAppearance, kRemoved, kAdded };
+  struct Zone {
+    Aabb box;
+    ZoneKind kind;
+    int age = 0;
+  };
+  FusionConfig config_;
+  std::vector<Candidate> candidates_;
+  std::vector<Claimed> claimed_;
+  std::vector<Zone> zones_;
+};
+
+}  // namespace scenewatch::pipeline

@@ -1,0 +1,74 @@
+#pragma once
+/// The object list of the working memory: clusters of each frame matched to remembered objects,
+/// with hysteresis both ways. A cluster becomes an object only after it was seen in
+/// `confirm_frames` frames (a noise cluster that comes and goes never enters the list); an object
+/// leaves only when the space it filled has been seen free in `gone_frames` frames (an occluded or
+/// out-of-view object keeps its place). Clusters farther from the camera than `max_range_m`
+/// (where a Kinect's depth noise is as large as a small object) are not objects.
+///
+/// The tracker raises no events: what changed in the scene is reported once, by the change
+/// detector (OBJECT_ADDED / OBJECT_REMOVED / OBJECT_MOVED); the list is what GetObjects returns.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <vector>
+
+#include "scenewatch/core/scene.h"
+
+namespace scenewatch::pipeline {
+
+struct TrackingConfig {
+  double match_distance_m = 0.05;  ///< a cluster matches a known object within this centroid distance
+  /// An unmatched object's frame counts as "seen free" when this share of its sample points lies
+  /// in space the frame saw through (or that the map holds free).
+  double gone_free_fraction = 0.6;
+  int confirm_frames = 1;    ///< sightings before a cluster joins the object list (1: at first sight)
+  int gone_frames = 2;       ///< frames of seen-free space before an object leaves the list
+  double max_range_m = 2.0;  ///< clusters whose centroid is farther from the camera are ignored
+};
+
+/// One cluster of the frame, in world coordinates, with sample points of its surface.
+struct TrackerObservation {
+  ObjectCluster cluster;
+  std::vector<Eigen::Vector3d> samples;
+  double range_m = 0.0;  ///< distance of its centroid from the camera
+};
+
+/// NOT thread safe: owned by the working memory's writer.
+class ObjectTracker {
+ public:
+  explicit ObjectTracker(const TrackingConfig& config) : config_(config) {}
+
+  /// The share of `points` seen free (by the map, or by the last frame's rays).
+  using FreeFraction = std::function<double(const std::vector<Eigen::Vector3d>& points)>;
+
+  /// One frame. `free_fraction` is asked about objects that were not matched.
+  void update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction);
+
+  /// Confirmed objects, in the order they were confirmed.
+  const std::vector<TrackedObject>& objects() const { return objects_; }
+  std::size_t tentative() const { return tentative_.size(); }
+  /// Sample points of a confirmed object's last observation (world).
+  const std::vector<Eigen::Vector3d>* samples(std::uint64_t id) const;
+
+  /// Restores a saved list (objects are confirmed).
+  void restore(std::vector<TrackedObject> objects, std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples,
+               std::uint64_t next_id);
+  std::uint64_t next_id() const { return next_id_; }
+  void reset();
+
+ private:
+  struct Track {
+    TrackedObject object;
+    std::vector<Eigen::Vector3d> samples;
+    int misses = 0;       ///< consecutive frames unmatched
+    int seen_free = 0;    ///< consecutive frames unmatched with its space seen free
+  };
+  TrackingConfig config_;
+  std::vector<Track> tracks_;          ///< confirmed
+  std::vector<Track> tentative_;       ///< seen, not yet confirmed
+  std::vector<TrackedObject> objects_;  ///< the confirmed objects, as published
+  std::uint64_t next_id_ = 1;
+};
+
+}  // namespace scenewatch::pipeline

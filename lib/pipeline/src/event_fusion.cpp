@@ -1,0 +1,219 @@
+#include "scenewatch/pipeline/event_fusion.h"
+
+#include <algorithm>
+
+namespace scenewatch::pipeline {
+namespace {
+
+constexpr std::size_t kMaxZones = 256;
+constexpr int kClaimFrames = 10;  ///< appearance evidence is kept this long for a pending change
+
+Aabb grown(Aabb b, double m) {
+  b.min.array() -= m;
+  b.max.array() += m;
+  return b;
+}
+
+bool overlaps(const Aabb& a, const Aabb& b) {
+  return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
+}
+
+bool contains(const Aabb& b, const Eigen::Vector3d& p) {
+  return (p.array() >= b.min.array()).all() && (p.array() <= b.max.array()).all();
+}
+
+Aabb united(Aabb a, const Aabb& b) {
+  a.min = a.min.cwiseMin(b.min);
+  a.max = a.max.cwiseMax(b.max);
+  return a;
+}
+
+bool inside(const OrientedBox& box, const Eigen::Vector3d& p, double margin) {
+  const Eigen::Vector3d q = box.rotation.conjugate() * (p - box.center);
+  return (q.cwiseAbs().array() <= (0.5 * box.extents.array() + margin)).all();
+}
+
+double area_of(const Event& e) {
+  auto it = e.evidence.find("area_px");
+  return it == e.evidence.end() ? 0.0 : it->second;
+}
+
+}  // namespace
+
+std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
+                                       const std::vector<change::ChangeCluster>& pending, std::vector<Event> geometric,
+                                       std::vector<Aabb> geometric_boxes, bool familiar_view,
+                                       const std::vector<TrackedObject>& objects,
+                                       const std::vector<ObjectCluster>& clusters) {
+  // Whole objects: a removal takes the listed object where it was, an addition this frame's
+  // segmented object where it is.
+  for (auto& e : geometric) {
+    const bool has_before = e.kind == EventKind::kObjectRemoved || e.kind == EventKind::kObjectMoved;
+    const bool has_after = e.kind == EventKind::kObjectAdded || e.kind == EventKind::kObjectMoved;
+    if (has_before) {
+      const Eigen::Vector3d before_c = e.centroid_world - e.displacement_world.value_or(Eigen::Vector3d::Zero());
+      for (const auto& o : objects) {
+        if (!inside(o.cluster.box, before_c, config_.margin_m)) continue;
+        e.object_id = o.id;
+        e.evidence["object_points_before"] = static_cast<double>(o.cluster.point_count);
+        geometric_boxes.push_back(o.cluster.box.aabb());
+        if (e.kind == EventKind::kObjectRemoved) e.box_world = united(e.box_world, o.cluster.box.aabb());
+        break;
+      }
+    }
+    if (has_after) {
+      for (const auto& c : clusters) {
+        if (!inside(c.box, e.centroid_world, config_.margin_m)) continue;
+        e.box_world = united(e.box_world, c.box.aabb());
+        e.indices_after = c.indices;
+        e.evidence["object_points_after"] = static_cast<double>(c.point_count);
+        geometric_boxes.push_back(c.box.aabb());
+        break;
+      }
+    }
+  }
+
+  for (auto& z : zones_) ++z.age;
+  zones_.erase(std::remove_if(zones_.begin(), zones_.end(), [&](const Zone& z) { return z.age > config_.zone_frames; }),
+               zones_.end());
+  for (auto& c : claimed_) ++c.age;
+  claimed_.erase(std::remove_if(claimed_.begin(), claimed_.end(), [](const Claimed& c) { return c.age > kClaimFrames; }),
+                 claimed_.end());
+
+  // Pieces of one object confirmed in the same frame are one fact: removals of the object that a
+  // move (or an earlier removal in this frame) already names.
+  {
+    std::vector<Event> merged;
+    auto find_named = [&](std::uint64_t id) -> Event* {
+      for (auto& m : merged)
+        if (m.object_id == id && (m.kind == EventKind::kObjectMoved || m.kind == EventKind::kObjectRemoved)) return &m;
+      return nullptr;
+    };
+    std::stable_sort(geometric.begin(), geometric.end(), [](const Event& a, const Event& b) {
+      return (a.kind == EventKind::kObjectMoved) > (b.kind == EventKind::kObjectMoved);
+    });
+    for (auto& e : geometric) {
+      Event* named = e.kind == EventKind::kObjectRemoved && e.object_id ? find_named(*e.object_id) : nullptr;
+      if (named == nullptr) {
+        merged.push_back(std::move(e));
+        continue;
+      }
+      named->evidence["pieces"] = named->evidence.count("pieces") ? named->evidence["pieces"] + 1 : 2;
+      if (named->kind == EventKind::kObjectRemoved) named->box_world = united(named->box_world, e.box_world);
+    }
+    geometric.swap(merged);
+  }
+
+  // A geometric change inside the place of an earlier one of its kind is another piece of the
+  // same fact (the other side of an object that left or came, confirmed a few frames later).
+  auto in_zone = [&](const Eigen::Vector3d& p, ZoneKind kind) {
+    for (const auto& z : zones_)
+      if (z.kind == kind && contains(z.box, p)) return true;
+    return false;
+  };
+  std::vector<Event> fresh;
+  for (auto& e : geometric) {
+    const bool piece = (e.kind == EventKind::kObjectRemoved && in_zone(e.centroid_world, ZoneKind::kRemoved)) ||
+                       (e.kind == EventKind::kObjectAdded && in_zone(e.centroid_world, ZoneKind::kAdded));
+    if (!piece) fresh.push_back(std::move(e));
+  }
+  geometric.swap(fresh);
+
+  // Where geometry speaks, appearance is its evidence.
+  std::vector<Aabb> geometry;
+  for (const auto& c : pending) geometry.push_back(grown(c.box_world, config_.margin_m));
+  for (const auto& b : geometric_boxes) geometry.push_back(grown(b, config_.margin_m));
+  std::vector<const Event*> free_regions;
+  for (const auto& region : appearance) {
+    bool claimed = false;
+    for (const auto& g : geometry) {
+      if (!overlaps(g, region.box_world)) continue;
+      claimed = true;
+      claimed_.push_back(Claimed{g, region.score, area_of(region), 0});
+    }
+    bool silenced = false;
+    for (const auto& z : zones_) silenced = silenced || contains(z.box, region.centroid_world);
+    if (!claimed && !silenced) free_regions.push_back(&region);
+  }
+
+  // Geometric events carry the appearance evidence gathered where they are.
+  for (auto& e : geometric) {
+    if (e.kind == EventKind::kObjectMoved) {
+      const Eigen::Vector3d before_c = e.centroid_world - e.displacement_world.value_or(Eigen::Vector3d::Zero());
+      for (const auto& b : geometric_boxes)
+        if (contains(grown(b, config_.margin_m), before_c)) zones_.push_back(Zone{grown(b, config_.margin_m), ZoneKind::kRemoved, 0});
+      zones_.push_back(Zone{grown(e.box_world, config_.margin_m), ZoneKind::kAdded, 0});
+    } else {
+      const ZoneKind kind = e.kind == EventKind::kObjectRemoved ? ZoneKind::kRemoved : ZoneKind::kAdded;
+      zones_.push_back(Zone{grown(e.box_world, config_.margin_m), kind, 0});
+    }
+    const Aabb where = grown(e.box_world, config_.margin_m);
+    double kl = 0.0, area = 0.0;
+    for (const auto& c : claimed_) {
+      if (!overlaps(c.box, where) || c.kl <= kl) continue;
+      kl = c.kl;
+      area = c.area_px;
+    }
+    if (kl > 0.0) {
+      e.evidence["appearance_kl_mean"] = kl;
+      e.evidence["appearance_area_px"] = area;
+    }
+    // Appearance candidates at the same place are the same fact.
+    candidates_.erase(std::remove_if(candidates_.begin(), candidates_.end(),
+                                     [&](const Candidate& c) { return overlaps(where, c.latest.box_world); }),
+                      candidates_.end());
+  }
+
+  // Appearance-only regions: from a familiar view, persistent in the world, or nothing.
+  if (!familiar_view) free_regions.clear();
+  std::vector<char> matched(candidates_.size(), 0);
+  for (const Event* region : free_regions) {
+    int best = -1;
+    double best_d = config_.match_m;
+    for (std::size_t i = 0; i < candidates_.size(); ++i) {
+      if (matched[i]) continue;
+      const double d = (candidates_[i].latest.centroid_world - region->centroid_world).norm();
+      if (d <= best_d) {
+        best_d = d;
+        best = static_cast<int>(i);
+      }
+    }
+    if (best < 0) {
+      candidates_.push_back(Candidate{*region, 1, 0, region->score});
+      matched.push_back(1);
+      continue;
+    }
+    Candidate& c = candidates_[best];
+    c.latest = *region;
+    ++c.hits;
+    c.misses = 0;
+    c.best_kl = std::max(c.best_kl, region->score);
+    matched[best] = 1;
+  }
+  std::vector<Event> out = std::move(geometric);
+  std::vector<Candidate> kept;
+  for (std::size_t i = 0; i < candidates_.size(); ++i) {
+    Candidate& c = candidates_[i];
+    if (!matched[i]) ++c.misses;
+    if (c.hits >= config_.persistence_frames) {
+      Event e = c.latest;
+      e.evidence["frames_seen"] = c.hits;
+      e.evidence["kl_mean_best"] = c.best_kl;
+      out.push_back(e);
+      zones_.push_back(Zone{grown(e.box_world, config_.margin_m), ZoneKind::kAppearance, 0});
+      continue;
+    }
+    if (c.misses < config_.persistence_frames) kept.push_back(std::move(c));
+  }
+  candidates_.swap(kept);
+  if (zones_.size() > kMaxZones) zones_.erase(zones_.begin(), zones_.end() - kMaxZones);
+  return out;
+}
+
+void EventFusion::reset() {
+  candidates_.clear();
+  claimed_.clear();
+  zones_.clear();
+}
+
+}  // namespace scenewatch::pipeline

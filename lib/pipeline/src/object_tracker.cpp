@@ -1,0 +1,133 @@
+#include "scenewatch/pipeline/object_tracker.h"
+
+#include <algorithm>
+#include <tuple>
+
+namespace scenewatch::pipeline {
+namespace {
+
+bool inside(const OrientedBox& box, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d q = box.rotation.conjugate() * (p - box.center);
+  return (q.cwiseAbs().array() <= 0.5 * box.extents.array()).all();
+}
+
+// Greedy nearest matching of observations to tracks: a pair within the match distance, or whose
+// remembered centroid lies inside the observed box (a larger view of the same object).
+std::vector<int> match(const std::vector<TrackerObservation>& obs, const std::vector<const TrackedObject*>& known,
+                       double max_distance) {
+  std::vector<std::tuple<double, int, int>> pairs;
+  for (std::size_t c = 0; c < obs.size(); ++c)
+    for (std::size_t o = 0; o < known.size(); ++o) {
+      const double d = (obs[c].cluster.centroid - known[o]->cluster.centroid).norm();
+      if (d <= max_distance || inside(obs[c].cluster.box, known[o]->cluster.centroid)) {
+        pairs.emplace_back(d, static_cast<int>(c), static_cast<int>(o));
+      }
+    }
+  std::sort(pairs.begin(), pairs.end());
+  std::vector<int> obs_to_known(obs.size(), -1);
+  std::vector<char> taken(known.size(), 0);
+  for (const auto& [d, c, o] : pairs) {
+    if (obs_to_known[c] >= 0 || taken[o]) continue;
+    obs_to_known[c] = o;
+    taken[o] = 1;
+  }
+  return obs_to_known;
+}
+
+}  // namespace
+
+void ObjectTracker::update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction) {
+  observations.erase(std::remove_if(observations.begin(), observations.end(),
+                                    [&](const TrackerObservation& o) { return o.range_m > config_.max_range_m; }),
+                     observations.end());
+  for (auto& o : observations) o.cluster.indices.clear();  // indices belong to this frame only
+
+  // Confirmed objects first, then the tentative ones get what is left.
+  std::vector<const TrackedObject*> known;
+  for (const auto& t : tracks_) known.push_back(&t.object);
+  const std::size_t n_confirmed = known.size();
+  for (const auto& t : tentative_) known.push_back(&t.object);
+  const std::vector<int> matched = match(observations, known, config_.match_distance_m);
+
+  std::vector<char> hit(known.size(), 0);
+  for (std::size_t c = 0; c < observations.size(); ++c) {
+    const int k = matched[c];
+    if (k < 0) {
+      Track t;
+      t.object.cluster = std::move(observations[c].cluster);
+      t.object.first_seen_s = t.object.last_seen_s = stamp_s;
+      t.object.observations = 1;
+      t.samples = std::move(observations[c].samples);
+      tentative_.push_back(std::move(t));
+      continue;
+    }
+    hit[k] = 1;
+    Track& t = static_cast<std::size_t>(k) < n_confirmed ? tracks_[k] : tentative_[k - n_confirmed];
+    t.object.cluster = std::move(observations[c].cluster);
+    t.object.last_seen_s = stamp_s;
+    ++t.object.observations;
+    t.samples = std::move(observations[c].samples);
+    t.misses = t.seen_free = 0;
+  }
+
+  // Confirmed objects unmatched in this frame leave only when their space keeps being seen free.
+  std::vector<Track> kept;
+  for (std::size_t i = 0; i < tracks_.size(); ++i) {
+    Track& t = tracks_[i];
+    if (!hit[i]) {
+      ++t.misses;
+      const bool free = free_fraction && free_fraction(t.samples) >= config_.gone_free_fraction;
+      t.seen_free = free ? t.seen_free + 1 : 0;
+      if (t.seen_free >= config_.gone_frames) continue;
+    }
+    kept.push_back(std::move(t));
+  }
+  // Tentative ones: confirmed after enough sightings; dropped when missed as often.
+  std::vector<Track> still_tentative;
+  for (std::size_t i = 0; i < tentative_.size(); ++i) {
+    Track& t = tentative_[i];
+    const bool seen_now = n_confirmed + i < hit.size() ? hit[n_confirmed + i] != 0 : true;  // new ones are seen now
+    if (!seen_now) ++t.misses;
+    if (t.object.observations >= config_.confirm_frames) {
+      t.object.id = next_id_++;
+      t.misses = 0;
+      kept.push_back(std::move(t));
+    } else if (t.misses < config_.confirm_frames) {
+      still_tentative.push_back(std::move(t));
+    }
+  }
+  tracks_.swap(kept);
+  tentative_.swap(still_tentative);
+  objects_.clear();
+  for (const auto& t : tracks_) objects_.push_back(t.object);
+}
+
+const std::vector<Eigen::Vector3d>* ObjectTracker::samples(std::uint64_t id) const {
+  for (const auto& t : tracks_)
+    if (t.object.id == id) return &t.samples;
+  return nullptr;
+}
+
+void ObjectTracker::restore(std::vector<TrackedObject> objects, std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples,
+                            std::uint64_t next_id) {
+  reset();
+  for (auto& o : objects) {
+    Track t;
+    t.object = std::move(o);
+    auto it = samples.find(t.object.id);
+    if (it != samples.end()) t.samples = std::move(it->second);
+    next_id = std::max(next_id, t.object.id + 1);
+    tracks_.push_back(std::move(t));
+  }
+  next_id_ = next_id;
+  for (const auto& t : tracks_) objects_.push_back(t.object);
+}
+
+void ObjectTracker::reset() {
+  // next_id_ stays: an id is never given twice, not even across a reset.
+  tracks_.clear();
+  tentative_.clear();
+  objects_.clear();
+}
+
+}  // namespace scenewatch::pipeline
