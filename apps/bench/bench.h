@@ -43,5 +43,6 @@ int run_segmentation(const Options& o);
 int run_latency(const Options& o);
 int run_surprise(const Options& o);
 int run_change(const Options& o);
+int run_stream(const Options& o);
 
 }  // namespace scenewatch::bench
