@@ -200,7 +200,6 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
     observations[i].cluster = result.objects[i];
     observations[i].range_m = (result.objects[i].centroid - T.translation()).norm();
   }
-  std::vector<Event> events;
 
   // Image-based surprise against the appearance memory, then its keyframe update.
   const auto t_surprise = Clock::now();
@@ -210,7 +209,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   // Geometric change detection against the map as it stands before this frame. Candidates stay
   // out of the map until the persistence filter confirms them, so the comparison keeps being made
   // against the model that predates them (OctoMap's log-odds would absorb a new object, or erode
-  // a removed one, within a few frames). The tracker's OBJECT_GONE follows a confirmed removal.
+  // a removed one, within a few frames).
   std::vector<change::ChangeCluster> pending, absorbed;
   std::vector<change::ObjectChange> confirmed;
   Intrinsics K_change;
@@ -254,19 +253,17 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   // One fact, one event: appearance regions where geometry changes are its evidence; others must persist.
   {
     std::vector<Event> geometric;
+    std::vector<Aabb> boxes;  // both places of a move
     for (const auto& c : confirmed) {
       Event e = change::to_event(c);
       e.stamp_s = frame.stamp_s;
       geometric.push_back(std::move(e));
-    }
-    std::vector<Aabb> boxes;
-    for (const auto& c : confirmed) {
       if (c.before) boxes.push_back(c.before->box_world);
       if (c.after) boxes.push_back(c.after->box_world);
     }
     static const std::vector<Event> kNone;
     const bool familiar = result.surprise && result.surprise->familiar_view;
-    events = m.fusion.update(result.surprise ? result.surprise->events : kNone, pending, std::move(geometric),
+    result.events = m.fusion.update(result.surprise ? result.surprise->events : kNone, pending, std::move(geometric),
                              std::move(boxes), familiar, m.tracker.objects(), result.objects);
   }
 
@@ -291,8 +288,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   result.total_ms = ms_since(t0);
   m.last_ms = result.total_ms;
   m.total_ms += result.total_ms;
-  m.emit(events, config_.max_event_log);
-  result.events = std::move(events);
+  m.emit(result.events, config_.max_event_log);
   m.publish();
   return result;
 }

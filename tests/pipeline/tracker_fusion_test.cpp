@@ -1,0 +1,144 @@
+// The object list's hysteresis and the one-fact-one-event rules, each on hand-made inputs.
+#include <gtest/gtest.h>
+
+#include "scenewatch/pipeline/event_fusion.h"
+#include "scenewatch/pipeline/object_tracker.h"
+
+namespace scenewatch::pipeline {
+namespace {
+
+TrackerObservation seen_at(double x, double y, double range_m = 1.0) {
+  TrackerObservation o;
+  o.cluster.centroid = Eigen::Vector3d(x, y, 0.05);
+  o.cluster.box.center = o.cluster.centroid;
+  o.cluster.box.extents = Eigen::Vector3d(0.08, 0.08, 0.1);
+  o.cluster.point_count = 500;
+  o.samples = {o.cluster.centroid};
+  o.range_m = range_m;
+  return o;
+}
+
+const ObjectTracker::FreeFraction kSeenFree = [](const std::vector<Eigen::Vector3d>&) { return 1.0; };
+const ObjectTracker::FreeFraction kOccluded = [](const std::vector<Eigen::Vector3d>&) { return 0.0; };
+
+TEST(ObjectTracker, JoinsAfterConfirmFramesAndNoiseNeverJoins) {
+  TrackingConfig config;
+  config.confirm_frames = 3;
+  ObjectTracker tracker(config);
+  tracker.update({seen_at(0, 0), seen_at(0.5, 0.5)}, 1, kOccluded);
+  tracker.update({seen_at(0.005, 0)}, 2, kOccluded);  // the noise cluster at (0.5, 0.5) is gone
+  EXPECT_TRUE(tracker.objects().empty()) << "two sightings are not enough";
+  tracker.update({seen_at(0.01, 0)}, 3, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 1u);
+  EXPECT_EQ(tracker.objects()[0].observations, 3);
+  for (int i = 4; i < 8; ++i) tracker.update({seen_at(0.01, 0)}, i, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 1u) << "the noise cluster never joined";
+  EXPECT_EQ(tracker.tentative(), 0u) << "and was forgotten";
+}
+
+TEST(ObjectTracker, LeavesOnlyWhenItsSpaceIsSeenFreeInGoneFrames) {
+  TrackingConfig config;
+  config.gone_frames = 2;
+  ObjectTracker tracker(config);
+  tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, 1, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 2u) << "confirm_frames 1: listed at first sight";
+  for (int i = 2; i < 10; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded);
+  EXPECT_EQ(tracker.objects().size(), 2u) << "unseen but occluded: it keeps its place";
+  tracker.update({seen_at(0.3, 0)}, 10, kSeenFree);
+  EXPECT_EQ(tracker.objects().size(), 2u) << "one frame of free space is not enough";
+  tracker.update({seen_at(0.3, 0)}, 11, kSeenFree);
+  ASSERT_EQ(tracker.objects().size(), 1u);
+  EXPECT_NEAR(tracker.objects()[0].cluster.centroid.x(), 0.3, 1e-9);
+}
+
+TEST(ObjectTracker, FarClustersAreNotObjectsAndIdsSurviveARestore) {
+  ObjectTracker tracker(TrackingConfig{});
+  tracker.update({seen_at(0, 0, 1.2), seen_at(2, 2, 3.0)}, 1, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 1u) << "beyond max_range_m (2 m): not an object";
+  const auto saved = tracker.objects();
+  ObjectTracker restored(TrackingConfig{});
+  restored.restore(saved, {}, tracker.next_id());
+  ASSERT_EQ(restored.objects().size(), 1u);
+  EXPECT_EQ(restored.objects()[0].id, saved[0].id);
+  restored.update({seen_at(0, 0), seen_at(0.4, 0)}, 2, kOccluded);
+  ASSERT_EQ(restored.objects().size(), 2u);
+  EXPECT_EQ(restored.objects()[0].id, saved[0].id) << "matched, same id";
+  EXPECT_GT(restored.objects()[1].id, saved[0].id) << "a new id, never one given before";
+}
+
+Event region_at(double x, double y, double kl = 15.0) {
+  Event e;
+  e.kind = EventKind::kAppearanceChange;
+  e.score = kl;
+  e.centroid_world = Eigen::Vector3d(x, y, 0.8);
+  e.box_world = {e.centroid_world - Eigen::Vector3d::Constant(0.03), e.centroid_world + Eigen::Vector3d::Constant(0.03)};
+  e.evidence["area_px"] = 200;
+  return e;
+}
+
+Event geometric_at(EventKind kind, double x, double y) {
+  Event e;
+  e.kind = kind;
+  e.centroid_world = Eigen::Vector3d(x, y, 0.8);
+  e.box_world = {e.centroid_world - Eigen::Vector3d::Constant(0.04), e.centroid_world + Eigen::Vector3d::Constant(0.04)};
+  return e;
+}
+
+TEST(EventFusion, AnAppearanceChangeMustPersistInAFamiliarView) {
+  EventFusion fusion;
+  for (int i = 0; i < 10; ++i) {
+    EXPECT_TRUE(fusion.update({region_at(0.2, 0.1)}, {}, {}, {}, /*familiar_view=*/false).empty())
+        << "a view seen for the first time: surprise is no change on its own";
+  }
+  // Regions that move with the camera (misalignment, reflections) never persist.
+  for (int i = 0; i < 10; ++i) EXPECT_TRUE(fusion.update({region_at(0.1 * i, 0)}, {}, {}, {}, true).empty());
+  std::vector<Event> told;
+  for (int i = 0; i < 10; ++i) {
+    auto out = fusion.update({region_at(0.5 + 0.005 * i, 0.5)}, {}, {}, {}, true);
+    if (!out.empty()) EXPECT_EQ(i, 2) << "persistence_frames 3: told on the third sighting";
+    told.insert(told.end(), out.begin(), out.end());
+  }
+  ASSERT_EQ(told.size(), 1u) << "once, then its place is silent";
+  EXPECT_EQ(told[0].kind, EventKind::kAppearanceChange);
+  EXPECT_EQ(told[0].evidence.at("frames_seen"), 3.0);
+}
+
+TEST(EventFusion, SurpriseWhereGeometryChangesIsItsEvidence) {
+  EventFusion fusion;
+  change::ChangeCluster pending;
+  pending.box_world = {{0.16, 0.06, 0.76}, {0.24, 0.14, 0.84}};
+  pending.centroid_world = {0.2, 0.1, 0.8};
+  for (int i = 0; i < 2; ++i) EXPECT_TRUE(fusion.update({region_at(0.2, 0.1, 20.0 + i)}, {pending}, {}, {}, true).empty());
+  const Event added = geometric_at(EventKind::kObjectAdded, 0.2, 0.1);
+  auto out = fusion.update({region_at(0.2, 0.1)}, {}, {added}, {added.box_world}, true);
+  ASSERT_EQ(out.size(), 1u) << "one fact, one event";
+  EXPECT_EQ(out[0].kind, EventKind::kObjectAdded);
+  EXPECT_DOUBLE_EQ(out[0].evidence.at("appearance_kl_mean"), 21.0) << "the strongest surprise seen there";
+  for (int i = 0; i < 5; ++i) EXPECT_TRUE(fusion.update({region_at(0.2, 0.1)}, {}, {}, {}, true).empty());
+}
+
+TEST(EventFusion, PiecesOfOneObjectAreOneEventButAReturnIsNews) {
+  EventFusion fusion;
+  TrackedObject box;
+  box.id = 7;
+  box.cluster.box.center = {0.1, 0.0, 0.85};
+  box.cluster.box.extents = {0.24, 0.12, 0.2};
+  // Two pieces of the same listed object confirmed in one frame: one removal, with its id and box.
+  const Event a = geometric_at(EventKind::kObjectRemoved, 0.02, 0.0), b = geometric_at(EventKind::kObjectRemoved, 0.18, 0.0);
+  auto out = fusion.update({}, {}, {a, b}, {a.box_world, b.box_world}, true, {box});
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].object_id, std::optional<std::uint64_t>(7));
+  EXPECT_LE(out[0].box_world.min.x(), -0.02) << "the whole object's box";
+  EXPECT_GE(out[0].box_world.max.x(), 0.22);
+  // A later piece inside the removed object's place is the same fact.
+  const Event c = geometric_at(EventKind::kObjectRemoved, 0.1, 0.03);
+  EXPECT_TRUE(fusion.update({}, {}, {c}, {c.box_world}, true).empty());
+  // Something put back there is news.
+  const Event back = geometric_at(EventKind::kObjectAdded, 0.1, 0.0);
+  out = fusion.update({}, {}, {back}, {back.box_world}, true);
+  ASSERT_EQ(out.size(), 1u);
+  EXPECT_EQ(out[0].kind, EventKind::kObjectAdded);
+}
+
+}  // namespace
+}  // namespace scenewatch::pipeline
