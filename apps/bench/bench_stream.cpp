@@ -88,6 +88,12 @@ int run_stream(const Options& o) {
       {"no photometric correction", [](pipeline::Config& c) { c.surprise.robust.photometric = false; }},
       {"no familiar-view gate", [](pipeline::Config& c) { c.surprise.familiar_after_frames = 0; }},
       {"no appearance persistence", [](pipeline::Config& c) { c.fusion.persistence_frames = 1; }},
+      {"none of these (every region)", [](pipeline::Config& c) {
+         c.surprise.robust.align_radius_px = 0;
+         c.surprise.robust.photometric = false;
+         c.surprise.familiar_after_frames = 0;
+         c.fusion.persistence_frames = 1;
+       }},
   };
   std::printf("%-48s %-28s %6s %7s %8s  %s\n", "recording", "configuration", "frames", "events", "per 100", "by kind");
   for (const auto& r : recordings) {
