@@ -85,6 +85,28 @@ TEST_F(ConfigTest, ShippedConfigIsValid) {
   EXPECT_EQ(c.surprise.min_samples, d.surprise.min_samples);
   EXPECT_EQ(c.surprise.view.sample_step_px, d.surprise.view.sample_step_px);
   EXPECT_EQ(c.surprise.regions.threshold_high, d.surprise.regions.threshold_high);
+  EXPECT_EQ(c.surprise.robust.photometric, d.surprise.robust.photometric);
+  EXPECT_EQ(c.surprise.robust.align_radius_px, d.surprise.robust.align_radius_px);
+  EXPECT_EQ(c.surprise.robust.align_min_kl, d.surprise.robust.align_min_kl);
+  EXPECT_EQ(c.surprise.familiar_after_frames, d.surprise.familiar_after_frames);
+  EXPECT_EQ(c.tracking.confirm_frames, d.tracking.confirm_frames);
+  EXPECT_EQ(c.tracking.gone_frames, d.tracking.gone_frames);
+  EXPECT_EQ(c.tracking.max_range_m, d.tracking.max_range_m);
+  EXPECT_EQ(c.fusion.persistence_frames, d.fusion.persistence_frames);
+  EXPECT_EQ(c.fusion.match_m, d.fusion.match_m);
+  EXPECT_EQ(c.fusion.margin_m, d.fusion.margin_m);
+  EXPECT_EQ(c.fusion.zone_frames, d.fusion.zone_frames);
+}
+
+TEST_F(ConfigTest, StreamKeysAreChecked) {
+  EXPECT_NE(error_of("surprise:\n  align_radius_px: 9\n").find("surprise.align_radius_px"), std::string::npos);
+  EXPECT_NE(error_of("surprise:\n  familiar_after_frames: -1\n").find("surprise.familiar_after_frames"), std::string::npos);
+  EXPECT_NE(error_of("tracking:\n  confirm_frames: 0\n").find("tracking.confirm_frames"), std::string::npos);
+  EXPECT_NE(error_of("tracking:\n  max_range_m: -2\n").find("tracking.max_range_m"), std::string::npos);
+  EXPECT_NE(error_of("events:\n  appearance_persistence_frames: 0\n").find("events.appearance_persistence_frames"),
+            std::string::npos);
+  EXPECT_NE(error_of("events:\n  merge_margin_m: 2\n").find("events.merge_margin_m"), std::string::npos);
+  EXPECT_NE(error_of("events:\n  silence: 3\n").find("silence"), std::string::npos) << "unknown key";
 }
 
 TEST_F(ConfigTest, AppearanceAndSurpriseKeysAreChecked) {
