@@ -224,6 +224,45 @@ TEST_F(CliTest, SurpriseOfflineOnAnMosdPair) {
   EXPECT_NE(bad.err.find(":999"), std::string::npos) << bad.err;
 }
 
+TEST_F(CliTest, ReplayTellsTheStreamAndCountsIt) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn13.pcd");
+  const fs::path learn = data_dir() / "mosd/learn";
+  const std::string before = (learn / "learn12.pcd").string(), after = (learn / "learn13.pcd").string();
+  // An object put on the table, seen in three frames: told once, on the fourth frame (index 3).
+  auto result = cli({"replay", before, after, after, after, after, "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::vector<json> lines;
+  std::istringstream in(result.out);
+  for (std::string line; std::getline(in, line);) lines.push_back(parse(line));
+  ASSERT_GE(lines.size(), 2u);
+  const json summary = lines.back();
+  EXPECT_TRUE(summary.at("summary").get<bool>());
+  EXPECT_EQ(summary.at("frames"), 5);
+  EXPECT_EQ(summary.at("events").get<std::size_t>(), lines.size() - 1);
+  EXPECT_DOUBLE_EQ(summary.at("events_per_100_frames").get<double>(), 100.0 * (lines.size() - 1) / 5);
+  for (std::size_t i = 0; i + 1 < lines.size(); ++i) {
+    EXPECT_EQ(lines[i].at("kind"), "OBJECT_ADDED");
+    EXPECT_EQ(lines[i].at("frame"), 3) << "persistence: the third frame that shows it";
+    EXPECT_EQ(lines[i].at("source"), after);
+    EXPECT_GT(lines[i].at("indices_after").size(), 100u) << "the whole object's points";
+  }
+  EXPECT_GT(summary.at("median_frame_ms").get<double>(), 0.0);
+  // Text: one line per event, then the counts.
+  result = cli({"replay", before, after, after, after});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("OBJECT_ADDED"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("4 frames,"), std::string::npos) << result.out;
+  // Bad input is named; a frame range beyond the sequence too.
+  result = cli({"replay", (tmp_ / "absent").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("absent"), std::string::npos) << result.err;
+  result = cli({"replay", (source_dir() / "sample_clouds/tabletop").string() + ":5-9"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("1 frames"), std::string::npos) << result.err;
+  result = cli({"replay", before, "--stride", "0"});
+  EXPECT_EQ(result.exit_code, 2) << "usage error";
+}
+
 TEST_F(CliTest, DiffOfAnMosdPairAndBadInput) {
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn12.pcd");
   const fs::path learn = data_dir() / "mosd/learn";
