@@ -27,7 +27,7 @@
 namespace scenewatch::pipeline {
 
 struct FusionConfig {
-  int persistence_frames = 3;  ///< sightings before an appearance-only change fires
+  int persistence_frames = 5;  ///< sightings before an appearance-only change fires
   double match_m = 0.05;       ///< a region matches a candidate within this centroid distance
   double margin_m = 0.05;      ///< geometric boxes are grown by this much to claim regions
   int zone_frames = 300;       ///< a fired event silences its place for this many frames
