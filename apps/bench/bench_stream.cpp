@@ -24,15 +24,18 @@ struct Recording {
   bool z_up = false;  ///< the simulator's world has z up
 };
 
-std::optional<Recording> real(const Options& o, const std::string& name, const std::string& folder) {
+/// A real recording; `forth_and_back` plays it forwards, then backwards (every view revisited).
+std::optional<Recording> real(const Options& o, const std::string& name, const std::string& folder,
+                              bool forth_and_back = false) {
   auto seq = io::open_sequence(o.data_dir / folder);
   if (!seq) {
     std::printf("  (skipped %s: %s)\n", name.c_str(), seq.error().message.c_str());
     return std::nullopt;
   }
   auto shared = std::make_shared<io::Sequence>(std::move(*seq));
-  return Recording{name, shared->frames.size(), [shared](std::size_t i) -> std::optional<Frame> {
-                     auto f = io::load_sequence_frame(*shared, i);
+  const std::size_t n = shared->frames.size();
+  return Recording{name, forth_and_back ? 2 * n : n, [shared, n](std::size_t i) -> std::optional<Frame> {
+                     auto f = io::load_sequence_frame(*shared, i < n ? i : 2 * n - 1 - i);
                      if (!f) return std::nullopt;
                      return std::move(*f);
                    }};
@@ -77,6 +80,7 @@ int run_stream(const Options& o) {
   std::printf("\n== The event stream: events per 100 frames through WorkingMemory (every kind counted)\n");
   std::vector<Recording> recordings;
   for (auto r : {real(o, "redkitchen (7-Scenes, unchanged room, hand-held)", "redkitchen"),
+                 real(o, "redkitchen forth and back (views revisited)", "redkitchen", true),
                  real(o, "hrt1 pick_toy_1 (a person picks a toy)", "hrt1/pick_toy_1"),
                  real(o, "hrt1 pick_toy_2 (the person stays in view)", "hrt1/pick_toy_2"),
                  simulated("clutter", 320, 240), simulated("cup_added", 320, 240), simulated("object_moved", 320, 240)}) {
