@@ -7,6 +7,7 @@
 #include <cmath>
 #include <deque>
 #include <fstream>
+#include <future>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -94,6 +95,14 @@ CloudConstPtr without_pending(const Cloud& cloud, const std::vector<change::Chan
 
 }  // namespace
 
+/// What geometric change detection made of one frame.
+struct ChangeOutcome {
+  std::vector<change::ChangeCluster> pending;   ///< unconfirmed candidates seen in this frame
+  std::vector<change::ChangeCluster> absorbed;  ///< more of changes already confirmed
+  std::vector<change::ObjectChange> confirmed;  ///< confirmed by this frame
+  Intrinsics K;                                 ///< the camera the frame was compared with
+};
+
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
       : map(c.background), appearance(c.appearance, c.surprise), changes(c.change), tracker(c.tracking), fusion(c.fusion),
@@ -131,6 +140,27 @@ struct WorkingMemory::Impl {
     s->objects = tracker.objects();
     s->last_stamp_s = last_stamp_s;
     std::atomic_store(&snapshot, std::shared_ptr<const SceneSnapshot>(std::move(s)));
+  }
+
+  // Geometric change detection against the map as it stands before this frame. Candidates stay
+  // out of the map until the persistence filter confirms them, so the comparison keeps being made
+  // against the model that predates them (OctoMap's log-odds would absorb a new object, or erode
+  // a removed one, within a few frames). A frame whose region is too large for a dense grid is
+  // left without change detection.
+  ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const change::Config& config) {
+    ChangeOutcome out;
+    auto K = change::observation_camera(*frame.cloud, frame.intrinsics);
+    if (!K) return out;
+    out.K = *K;
+    std::shared_lock<std::shared_mutex> read(map_mutex);
+    auto mismatch = change::mismatch_against_map(map, *frame.cloud, T, *K, config);
+    if (!mismatch) return out;
+    change::ClusterInput input;
+    input.after_camera = frame.cloud.get();
+    input.T_world_after = T;
+    input.K_after = *K;
+    out.confirmed = changes.update(change::cluster_mismatch(*mismatch, input, config), &out.pending, &out.absorbed);
+    return out;
   }
 
   void emit(std::vector<Event>& batch, std::size_t max_log) {
@@ -181,6 +211,21 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   FrameResult result;
   result.frame_index = m.frames;
 
+  // Two independent halves on the two cores: the image surprise and the geometric change detection
+  // (both against the memory as it stands before this frame) beside the segmentation of the frame.
+  ChangeOutcome changed;
+  auto against_memory = std::async(std::launch::async, [&] {
+    const auto t_surprise = Clock::now();
+    result.surprise = m.appearance.process(frame);  // then its keyframe update
+    result.surprise_ms = ms_since(t_surprise);
+    if (config_.change_enabled && m.frames > 0) {
+      const auto t_change = Clock::now();
+      changed = m.detect_changes(frame, T, config_.change);
+      result.change_ms = ms_since(t_change);
+      result.change_candidates = m.changes.candidates();
+    }
+  });
+
   // Segment in the camera frame (indices stay those of the input cloud), then move to the world.
   segmentation::Config seg = config_.segmentation;
   if (seg.up) seg.up = T.linear().transpose() * *seg.up;
@@ -201,37 +246,8 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
     observations[i].range_m = (result.objects[i].centroid - T.translation()).norm();
   }
 
-  // Image-based surprise against the appearance memory, then its keyframe update.
-  const auto t_surprise = Clock::now();
-  result.surprise = m.appearance.process(frame);
-  result.surprise_ms = ms_since(t_surprise);
-
-  // Geometric change detection against the map as it stands before this frame. Candidates stay
-  // out of the map until the persistence filter confirms them, so the comparison keeps being made
-  // against the model that predates them (OctoMap's log-odds would absorb a new object, or erode
-  // a removed one, within a few frames).
-  std::vector<change::ChangeCluster> pending, absorbed;
-  std::vector<change::ObjectChange> confirmed;
-  Intrinsics K_change;
-  if (config_.change_enabled && m.frames > 0) {
-    const auto t_change = Clock::now();
-    auto K = change::observation_camera(*frame.cloud, frame.intrinsics);
-    if (K) {
-      K_change = *K;
-      std::shared_lock<std::shared_mutex> read(m.map_mutex);
-      // A frame whose region is too large for a dense grid is left without change detection.
-      auto mismatch = change::mismatch_against_map(m.map, *frame.cloud, T, *K, config_.change);
-      if (mismatch) {
-        change::ClusterInput input;
-        input.after_camera = frame.cloud.get();
-        input.T_world_after = T;
-        input.K_after = *K;
-        confirmed = m.changes.update(change::cluster_mismatch(*mismatch, input, config_.change), &pending, &absorbed);
-      }
-    }
-    result.change_ms = ms_since(t_change);
-    result.change_candidates = m.changes.candidates();
-  }
+  against_memory.get();  // rethrows what the other half threw
+  const auto& [pending, absorbed, confirmed, K_change] = changed;
   CloudConstPtr to_insert = frame.cloud;
   if (!pending.empty()) to_insert = without_pending(*frame.cloud, pending, K_change);
 
