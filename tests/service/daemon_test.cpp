@@ -9,6 +9,9 @@
 #include "daemon_harness.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/io/sequence.h"
+#include "scenewatch/sim/simulator.h"
+#include "scenewatch/sim/scenario_yaml.h"
+#include "scenewatch/io/rgbd.h"
 #include "scenewatch/service/frame_parser.h"
 
 namespace scenewatch::test {
@@ -193,6 +196,60 @@ TEST_F(DaemonTest, RealKitchenStreamedOverTcpIsCalm) {
   const auto stats = call(client, request([](proto::Request& r) { r.mutable_stats(); }));
   EXPECT_EQ(stats.stats().frames_processed(), seq->frames.size());
   EXPECT_EQ(stats.stats().events_emitted(), 0u);
+}
+
+TEST_F(DaemonTest, SimulatedChangesReachTheSubscriberOnceEach) {
+  // The simulator's cup_added and object_moved (320x240, 12 frames per phase, hand-held camera)
+  // streamed over TCP into a fresh daemon each: the subscriber hears exactly one event, of the
+  // right kind, where the truth says, and nothing else.
+  struct Case {
+    const char* scenario;
+    proto::Event::Kind kind;
+  };
+  for (const Case& c : {Case{"cup_added", proto::Event::OBJECT_ADDED}, Case{"object_moved", proto::Event::OBJECT_MOVED}}) {
+    SCOPED_TRACE(c.scenario);
+    auto loaded = sim::load_scenario(source_dir() / "sample_clouds/scenarios" / (std::string(c.scenario) + ".yaml"));
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    const sim::Scenario scenario = sim::with_frames(sim::with_resolution(*loaded, 320, 240), 12);
+    auto simulator = sim::Simulator::create(scenario);
+    ASSERT_TRUE(simulator.ok()) << simulator.error().message;
+    const auto truth = simulator->changes();
+    ASSERT_EQ(truth.size(), 1u);
+    const Eigen::Vector2d where = c.kind == proto::Event::OBJECT_ADDED
+                                      ? Eigen::Vector2d(truth[0].added.at(0).T_world_object.translation().head<2>())
+                                      : Eigen::Vector2d(truth[0].moved.at(0).T_world_after.translation().head<2>());
+    ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml() + "segmentation:\n  up_vector: [0, 0, 1]\n"));
+    Client subscriber = daemon_.connect();
+    ASSERT_EQ(call(subscriber, request([](proto::Request& r) { r.mutable_subscribe(); })).status().code(),
+              proto::Status::OK);
+    Client client = daemon_.connect();
+    double stamp = 0;
+    for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
+      for (int f = 0; f < simulator->frame_count(phase); ++f) {
+        const sim::SimFrame rendered = simulator->render(phase, f);
+        auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, scenario.intrinsics);
+        ASSERT_TRUE(cloud.ok());
+        Frame frame;
+        frame.cloud = *cloud;
+        frame.T_world_camera = rendered.truth.T_world_camera_reported;
+        frame.intrinsics = scenario.intrinsics;
+        frame.has_color = true;
+        frame.stamp_s = stamp += 1.0 / 30;
+        proto::Request r;
+        *r.mutable_ingest_frame() = service::make_ingest_frame(frame);
+        const auto response = call(client, r);
+        ASSERT_EQ(response.status().code(), proto::Status::OK) << response.status().message();
+      }
+    }
+    auto event = subscriber.next_event(kCallTimeoutS);
+    ASSERT_TRUE(event.ok()) << event.error().message;
+    EXPECT_EQ(event->kind(), c.kind);
+    EXPECT_LT((Eigen::Vector2d(event->centroid_world().x(), event->centroid_world().y()) - where).norm(), 0.10);
+    EXPECT_FALSE(subscriber.next_event(0.5).ok()) << "one fact, one event";
+    ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
+    std::error_code ec;
+    fs::remove_all(model_dir_, ec);  // the next case starts from an empty model
+  }
 }
 
 TEST_F(DaemonTest, BadClientsNeitherChangeTheModelNorStopTheDaemon) {
