@@ -173,8 +173,9 @@ int run_change(const Options& o) {
     std::printf("%-50s %10.2f %8.2f %9.2fx %8.3f %8.3f   IoU %.2f\n", m.name, median(m.ms), quantile(m.ms, 0.9),
                 base / median(m.ms), m.score.precision(), m.score.recall(), m.score.mean_iou());
   }
-  std::printf("(truth: %zu changed objects from the labels; precision = events mostly on changed objects, recall = changes\n"
-              " covered at point IoU >= 0.3; building the 1 cm map from BEFORE takes another %.1f ms median)\n",
+  std::printf("(truth: %zu changed objects from the labels; strict: precision = events matching a whole changed object\n"
+              " at point IoU >= 0.5, recall = changed objects so matched; building the 1 cm map from BEFORE takes another\n"
+              " %.1f ms median)\n",
               methods[0].score.true_changes, median(insert_ms));
   return 0;
 }

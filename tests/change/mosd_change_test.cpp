@@ -1,7 +1,8 @@
 // Real data: consecutive mOSD scenes taken from the same, unmoved Kinect while objects were added,
 // removed or moved. The labels give the objects; a labelled object of AFTER with no labelled
 // object surface of BEFORE within 1 cm is a true addition (and the other way round a removal,
-// unless AFTER occludes it). Object-level precision and recall are printed per pair and overall.
+// unless AFTER occludes it). Object-level precision and recall, strict (point IoU >= 0.5 with the
+// whole object, both ways), are printed per pair and overall.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -89,8 +90,11 @@ TEST(MosdChange, SameCameraPairs) {
               total.matched_changes, total.true_changes, total.mean_iou(), ms.empty() ? 0.0 : ms[ms.size() / 2]);
   EXPECT_GE(pairs, 15u) << "the data README lists about twenty same-camera pairs";
   EXPECT_GE(total.true_changes, 8u);
-  EXPECT_GE(total.precision(), 0.80);
-  EXPECT_GE(total.recall(), 0.85);
+  // Strict scoring (IoU >= 0.5 with the whole object, both ways): 0.558 and 0.634 when these
+  // floors were set; the lenient scoring of before (majority precision, recall at IoU 0.3) gave
+  // 0.826 and 0.871 on the same events. Issue 10 (whole-object events) is to raise them.
+  EXPECT_GE(total.precision(), 0.55);
+  EXPECT_GE(total.recall(), 0.63);
 }
 
 }  // namespace

@@ -12,7 +12,7 @@ namespace scenewatch::segmentation {
 namespace {
 
 struct SceneFigures {
-  std::size_t objects = 0, matched = 0;
+  std::size_t objects = 0, matched = 0, clusters = 0, correct = 0;
   double table_iou = 0;
 };
 
@@ -28,43 +28,54 @@ SceneFigures run_scene(const std::filesystem::path& path, bool print) {
   const std::vector<int> none;
   const LabelScore score = score_against_labels(clusters, seg.planes.empty() ? none : seg.planes[0].indices, *labels);
   if (print) {
-    std::printf("  %-12s planes %zu clusters %2zu | table IoU %.3f | objects %zu matched %zu |", path.filename().c_str(),
-                seg.planes.size(), seg.objects.size(), score.table_iou, score.objects.size(), score.matched());
+    std::printf("  %-12s planes %zu clusters %2zu correct %2zu | table IoU %.3f | objects %zu matched %zu |",
+                path.filename().c_str(), seg.planes.size(), seg.objects.size(), score.correct_clusters(), score.table_iou,
+                score.objects.size(), score.matched());
     for (const auto& o : score.objects) std::printf(" %u:%.2f", o.object_id, o.best_iou);
     std::printf("\n");
   }
-  return {score.objects.size(), score.matched(), score.table_iou};
+  return {score.objects.size(), score.matched(), seg.objects.size(), score.correct_clusters(), score.table_iou};
 }
 
 // Every learn scene: the table plane is found (IoU with the table label), and each labelled object
 // is matched by a cluster with point IoU >= 0.5. Figures per scene are printed.
 TEST(Mosd, TableFoundAndObjectsRecalled) {
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
-  std::size_t objects = 0, matched = 0, tables = 0, scenes = 0;
+  std::size_t objects = 0, matched = 0, clusters = 0, correct = 0, tables = 0, scenes = 0;
   std::size_t by_group_objects[4] = {0, 0, 0, 0}, by_group_matched[4] = {0, 0, 0, 0};
+  std::size_t by_group_clusters[4] = {0, 0, 0, 0}, by_group_correct[4] = {0, 0, 0, 0};
   for (int i = 0; i <= 44; ++i) {
     const auto path = test::data_dir() / "mosd/learn" / ("learn" + std::to_string(i) + ".pcd");
     const SceneFigures f = run_scene(path, true);
     ++scenes;
     objects += f.objects;
     matched += f.matched;
+    clusters += f.clusters;
+    correct += f.correct;
     tables += f.table_iou >= 0.8 ? 1 : 0;
     const int group = i <= 16 ? 0 : i <= 24 ? 1 : i <= 32 ? 2 : 3;
     by_group_objects[group] += f.objects;
     by_group_matched[group] += f.matched;
+    by_group_clusters[group] += f.clusters;
+    by_group_correct[group] += f.correct;
   }
-  const double recall = static_cast<double>(matched) / objects;
-  std::printf("mOSD learn: %zu scenes, table IoU>=0.8 in %zu, object recall (IoU>=0.5) %zu/%zu = %.3f\n", scenes, tables,
-              matched, objects, recall);
+  const double recall = static_cast<double>(matched) / objects, precision = static_cast<double>(correct) / clusters;
+  std::printf("mOSD learn: %zu scenes, table IoU>=0.8 in %zu, at IoU>=0.5 against whole objects: recall %zu/%zu = %.3f, "
+              "precision %zu/%zu = %.3f\n",
+              scenes, tables, matched, objects, recall, correct, clusters, precision);
   const char* names[4] = {"boxes", "stacked boxes", "occluded objects", "cylindric objects"};
   for (int g = 0; g < 4; ++g)
-    std::printf("  %-18s %zu/%zu\n", names[g], by_group_matched[g], by_group_objects[g]);
+    std::printf("  %-18s recall %zu/%zu, precision %zu/%zu\n", names[g], by_group_matched[g], by_group_objects[g],
+                by_group_correct[g], by_group_clusters[g]);
   EXPECT_EQ(tables, scenes) << "the table plane must be found in every scene";
   // Floor: every single box and most cylinders are recovered (38/38 boxes, 32/38 cylinders, 9/20
   // stacked boxes, 13/16 occluded objects, 0.82 overall in the run this floor was set on). Stacked and touching objects are one connected
   // surface, which a model-free Euclidean clusterer cannot split (mOSD's stated purpose), so the
   // stacked-box scenes cap the overall recall.
   EXPECT_GE(recall, 0.80);
+  // Precision, strict (reported clusters that match a whole labelled object at IoU >= 0.5): 0.773
+  // (92/119) when this floor was set; pieces of cylinders and occluded objects pull it down.
+  EXPECT_GE(precision, 0.76);
   EXPECT_EQ(by_group_matched[0], by_group_objects[0]) << "every isolated box must be recovered";
 }
 

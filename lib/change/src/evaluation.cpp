@@ -62,17 +62,11 @@ ChangeScore score_changes(const std::vector<Event>& events, const std::vector<Tr
       s.iou_sum += best;
     }
   }
-  // An event is right when most of its points belong to truly changed objects (on the side it
-  // claims: BEFORE for what vanished, AFTER for what appeared).
-  std::vector<int> changed_before, changed_after;
-  for (const auto& t : truth) {
-    changed_before.insert(changed_before.end(), t.indices_before.begin(), t.indices_before.end());
-    changed_after.insert(changed_after.end(), t.indices_after.begin(), t.indices_after.end());
-  }
+  // An event is right when it matches some true change at the same IoU.
   for (const auto& e : events) {
-    const std::size_t in = intersection(e.indices_before, changed_before) + intersection(e.indices_after, changed_after);
-    const std::size_t n = e.indices_before.size() + e.indices_after.size();
-    s.matched_events += n > 0 && 2 * in >= n ? 1 : 0;
+    double best = 0;
+    for (const auto& t : truth) best = std::max(best, change_iou(e, t));
+    s.matched_events += best >= iou_threshold ? 1 : 0;
   }
   return s;
 }

@@ -11,6 +11,14 @@ std::size_t LabelScore::matched(double t) const {
 
 double LabelScore::recall(double t) const { return objects.empty() ? 1.0 : static_cast<double>(matched(t)) / objects.size(); }
 
+std::size_t LabelScore::correct_clusters(double t) const {
+  return static_cast<std::size_t>(std::count_if(cluster_best_iou.begin(), cluster_best_iou.end(), [t](double v) { return v >= t; }));
+}
+
+double LabelScore::precision(double t) const {
+  return cluster_best_iou.empty() ? 1.0 : static_cast<double>(correct_clusters(t)) / cluster_best_iou.size();
+}
+
 LabelScore score_against_labels(const std::vector<std::vector<int>>& clusters, const std::vector<int>& plane_indices,
                                 const std::vector<std::uint32_t>& labels, std::uint32_t table_label, std::uint32_t divisor,
                                 std::size_t min_object_points) {
@@ -27,8 +35,8 @@ LabelScore score_against_labels(const std::vector<std::vector<int>>& clusters, c
   const std::size_t table_union = table_points + plane_indices.size() - table_hits;
   score.table_iou = table_union ? static_cast<double>(table_hits) / table_union : 0.0;
 
+  score.cluster_best_iou.assign(clusters.size(), 0.0);
   for (const auto& [id, n] : gt_size) {
-    if (n < min_object_points) continue;
     ObjectScore o;
     o.object_id = id;
     o.points = n;
@@ -36,12 +44,14 @@ LabelScore score_against_labels(const std::vector<std::vector<int>>& clusters, c
       std::size_t inter = 0;
       for (int i : clusters[c]) inter += (labels[i] >= divisor && labels[i] / divisor == id) ? 1 : 0;
       const double iou = static_cast<double>(inter) / (n + clusters[c].size() - inter);
+      // A cluster matching an object too small to count is not wrong.
+      score.cluster_best_iou[c] = std::max(score.cluster_best_iou[c], n < min_object_points && iou >= 0.5 ? 1.0 : iou);
       if (iou > o.best_iou) {
         o.best_iou = iou;
         o.best_cluster = static_cast<int>(c);
       }
     }
-    score.objects.push_back(o);
+    if (n >= min_object_points) score.objects.push_back(o);
   }
   return score;
 }

@@ -1,8 +1,10 @@
 #pragma once
-/// Object-level scoring of change events against ground truth, in the manner of Dynablox
-/// (Schmid et al. 2023): precision is the share of events most of whose points belong to truly
-/// changed objects; recall is the share of true changes that some event covers at point
-/// IoU >= a threshold; IoU is the best event's, averaged over the covered changes.
+/// Object-level scoring of change events against ground truth, strict both ways: recall is the
+/// share of true changes (whole objects) that some event matches at point IoU >= a threshold
+/// (0.5), precision the share of events that match some true change at that IoU (an event that
+/// covers only the fringe of an object, or most of it plus much else, is wrong); IoU is the best
+/// event's, averaged over the matched changes. (Until the calm-stream work the precision was
+/// by majority of points and the recall at IoU 0.3, after Dynablox, Schmid et al. 2023: lenient.)
 #include <cstdint>
 #include <vector>
 
@@ -32,7 +34,7 @@ double change_iou(const Event& event, const TrueChange& truth);
 
 /// Scores events against true changes (see above).
 ChangeScore score_changes(const std::vector<Event>& events, const std::vector<TrueChange>& truth,
-                          double iou_threshold = 0.3);
+                          double iou_threshold = 0.5);
 
 /// True changes of a same-camera pair from per-point object labels (mOSD: id = label / 10,
 /// labels below `min_label` are background). An object of AFTER is added when fewer than half of

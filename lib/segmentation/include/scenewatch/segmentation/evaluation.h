@@ -13,12 +13,20 @@ struct ObjectScore {
   int best_cluster = -1;
 };
 
+/// Strict both ways, at point IoU >= a threshold against whole labelled objects: recall is the
+/// share of labelled objects some reported cluster matches, precision the share of reported
+/// clusters that match a labelled object (a piece of an object, a merge of two, or something
+/// unlabelled does not).
 struct LabelScore {
   std::vector<ObjectScore> objects;
+  std::vector<double> cluster_best_iou;  ///< per reported cluster: its best IoU with a labelled object
   double table_iou = 0.0;       ///< IoU of the first plane's indices with label `table_label`
   /// Objects whose best IoU reaches `iou_threshold`.
   std::size_t matched(double iou_threshold = 0.5) const;
   double recall(double iou_threshold = 0.5) const;
+  /// Reported clusters whose best IoU reaches `iou_threshold`.
+  std::size_t correct_clusters(double iou_threshold = 0.5) const;
+  double precision(double iou_threshold = 0.5) const;
 };
 
 /// Scores clusters (point indices per cluster) and a plane (its indices) against labels.
