@@ -154,6 +154,15 @@ TEST(WorkingMemory, AChangeIsOneEventAndReachesSubscribers) {
   EXPECT_EQ(log[1].kind, EventKind::kObjectAdded);
   EXPECT_GT(log[1].id, log[0].id);
   EXPECT_EQ(wm.events_since(log[0].id).size(), 1u);
+
+  // Reset forgets the log too; ids keep counting.
+  wm.reset();
+  EXPECT_TRUE(wm.events_since(0).empty());
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(wm.process(make_frame({kTall, kCube}, 20.0 + i)).ok());
+  for (int i = 0; i < 6; ++i) ASSERT_TRUE(wm.process(make_frame({kTall}, 30.0 + i)).ok());
+  const auto after_reset = wm.events_since(0);
+  ASSERT_EQ(after_reset.size(), 1u);
+  EXPECT_GT(after_reset[0].id, log[1].id);
 }
 
 TEST(WorkingMemory, OccludedObjectIsNotGone) {

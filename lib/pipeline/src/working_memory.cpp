@@ -364,6 +364,11 @@ void WorkingMemory::reset() {
   impl_->frames = impl_->points = 0;
   impl_->total_ms = impl_->last_ms = 0;
   impl_->last_stamp_s = 0.0;
+  {
+    // The log goes too (Reset forgets everything); ids keep counting, so none is given twice.
+    std::lock_guard<std::mutex> events_lock(impl_->events_mutex);
+    impl_->events.clear();
+  }
   impl_->publish();
 }
 
