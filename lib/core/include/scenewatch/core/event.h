@@ -13,8 +13,8 @@ namespace scenewatch {
 enum class EventLevel { kMismatch, kPrediction, kImplausibility };
 
 enum class EventKind {
-  kObjectAppeared,    ///< a cluster with no match in the memory
-  kObjectGone,        ///< a remembered object whose space is now seen free
+  kObjectAppeared,    ///< no longer raised (kept for the wire format): the object list says what is there
+  kObjectGone,        ///< no longer raised (kept for the wire format): kObjectRemoved says what left
   kAppearanceChange,  ///< image-based surprise (issue 4)
   kObjectAdded,       ///< geometric change detection (issue 5)
   kObjectRemoved,
