@@ -44,5 +44,6 @@ int run_latency(const Options& o);
 int run_surprise(const Options& o);
 int run_change(const Options& o);
 int run_stream(const Options& o);
+int run_pipeline(const Options& o);
 
 }  // namespace scenewatch::bench

@@ -4,65 +4,15 @@
 #include "bench.h"
 
 #ifdef SCENEWATCH_BENCH_HAS_SERVICE
-#include <poll.h>
-#include <signal.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <cstdlib>
 #include <string>
 
+#include "bench_daemon.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/service/client.h"
 
 namespace scenewatch::bench {
-namespace {
-
-// scenewatchd on a free port; stops it (SIGTERM) when destroyed.
-class Daemon {
- public:
-  bool start(const std::filesystem::path& model_dir) {
-    const std::string binary = std::string(SCENEWATCH_BINARY_DIR) + "/apps/scenewatchd/scenewatchd";
-    const std::string config = std::string(SCENEWATCH_SOURCE_DIR) + "/config/scenewatchd.yaml";
-    int out[2];
-    if (::pipe(out) != 0) return false;
-    pid_ = ::fork();
-    if (pid_ == 0) {
-      ::dup2(out[1], STDOUT_FILENO);
-      ::close(out[0]);
-      const std::string dir = model_dir.string();
-      ::execl(binary.c_str(), binary.c_str(), "--config", config.c_str(), "--port", "0", "--model-dir", dir.c_str(),
-              static_cast<char*>(nullptr));
-      std::_Exit(127);
-    }
-    ::close(out[1]);
-    std::string line;
-    char c;
-    pollfd p{out[0], POLLIN, 0};
-    while (::poll(&p, 1, 20000) > 0 && ::read(out[0], &c, 1) == 1) {
-      if (c == '\n') break;
-      line += c;
-    }
-    ::close(out[0]);
-    const std::string prefix = "listening on 127.0.0.1:";
-    if (line.rfind(prefix, 0) != 0) return false;
-    port_ = static_cast<std::uint16_t>(std::stoi(line.substr(prefix.size())));
-    return true;
-  }
-  ~Daemon() {
-    if (pid_ > 0) {
-      ::kill(pid_, SIGTERM);
-      ::waitpid(pid_, nullptr, 0);
-    }
-  }
-  std::uint16_t port() const { return port_; }
-
- private:
-  pid_t pid_ = -1;
-  std::uint16_t port_ = 0;
-};
-
-}  // namespace
 
 int run_latency(const Options& o) {
   const auto model_dir = std::filesystem::temp_directory_path() / ("scenewatch-bench-" + std::to_string(::getpid()));

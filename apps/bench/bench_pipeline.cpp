@@ -1,0 +1,162 @@
+// The whole frame: posed VGA RGB-D sequences through WorkingMemory::process as the daemon runs
+// them, with the time per stage, then the same frames streamed into the real scenewatchd over
+// TCP (frames per second sustained, one client sending the next frame when the reply comes).
+// Stages that run beside each other (segmentation on one core; image surprise and change
+// detection on the other) are shown each with its own time; "frame" is the wall time of process().
+#include <cstdio>
+#include <map>
+#include <optional>
+
+#include "bench.h"
+#include "scenewatch/io/rgbd.h"
+#include "scenewatch/io/sequence.h"
+#include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/sim/scenario_yaml.h"
+#include "scenewatch/sim/simulator.h"
+
+#ifdef SCENEWATCH_BENCH_HAS_SERVICE
+#include "bench_daemon.h"
+#include "scenewatch/service/client.h"
+#endif
+
+namespace scenewatch::bench {
+namespace {
+
+struct Sequence {
+  std::string name;
+  std::vector<Frame> frames;
+  std::vector<double> decode_ms;
+  bool z_up = false;
+};
+
+std::optional<Sequence> real_sequence(const Options& o, const std::string& name, const std::string& folder) {
+  auto seq = io::open_sequence(o.data_dir / folder);
+  if (!seq) return std::nullopt;
+  Sequence s{name, {}, {}, false};
+  for (std::size_t i = 0; i < seq->frames.size(); ++i) {
+    std::optional<Frame> f;
+    s.decode_ms.push_back(time_ms([&] {
+      auto loaded = io::load_sequence_frame(*seq, i);
+      if (loaded) f = std::move(*loaded);
+    }));
+    if (!f) return std::nullopt;
+    s.frames.push_back(std::move(*f));
+  }
+  return s;
+}
+
+std::optional<Sequence> simulated_sequence(const std::string& scenario_name) {
+  auto loaded = sim::load_scenario(std::filesystem::path(SCENEWATCH_SOURCE_DIR) / "sample_clouds/scenarios" /
+                                   (scenario_name + ".yaml"));
+  if (!loaded) return std::nullopt;
+  const sim::Scenario sc = sim::with_resolution(*loaded, 640, 480);
+  auto simulator = sim::Simulator::create(sc);
+  if (!simulator) return std::nullopt;
+  Sequence s{"sim " + scenario_name + " 640x480", {}, {}, true};
+  for (std::size_t p = 0; p < simulator->phase_count(); ++p)
+    for (int f = 0; f < simulator->frame_count(p); ++f) {
+      const sim::SimFrame rendered = simulator->render(p, f);
+      std::optional<Frame> frame;
+      s.decode_ms.push_back(time_ms([&] {
+        auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, sc.intrinsics);
+        if (!cloud) return;
+        Frame fr;
+        fr.cloud = *cloud;
+        fr.T_world_camera = rendered.truth.T_world_camera_reported;
+        fr.intrinsics = sc.intrinsics;
+        fr.has_color = true;
+        fr.stamp_s = s.frames.size() / 30.0;
+        frame = std::move(fr);
+      }));
+      if (!frame) return std::nullopt;
+      s.frames.push_back(std::move(*frame));
+    }
+  return s;
+}
+
+void offline(const Sequence& s) {
+  pipeline::Config config;
+  if (s.z_up) config.segmentation.up = Eigen::Vector3d::UnitZ();
+  pipeline::WorkingMemory memory(config);
+  std::map<std::string, std::vector<double>> ms;
+  std::size_t events = 0;
+  for (const auto& f : s.frames) {
+    auto r = memory.process(f);
+    if (!r) {
+      std::printf("  %s: %s\n", s.name.c_str(), r.error().message.c_str());
+      return;
+    }
+    ms["1 segmentation"].push_back(r->segment_ms);
+    ms["2 image surprise + keyframes"].push_back(r->surprise_ms);
+    ms["3 change detection"].push_back(r->change_ms);
+    ms["4 map insertion"].push_back(r->insert_ms);
+    ms["9 frame (process)"].push_back(r->total_ms);
+    events += r->events.size();
+  }
+  std::printf("-- %s: %zu frames, %zu events; decoding (PNG + cloud, before process) median %.1f ms\n", s.name.c_str(),
+              s.frames.size(), events, median(s.decode_ms));
+  std::printf("   %-32s %10s %10s\n", "stage", "median ms", "p90 ms");
+  for (const auto& [stage, v] : ms)
+    std::printf("   %-32s %10.1f %10.1f\n", stage.substr(2).c_str(), median(v), quantile(v, 0.9));
+  const double m = median(ms["9 frame (process)"]);
+  std::printf("   => %.1f frames/s offline (median frame); target 15 (66 ms), goal 30 (33 ms)\n", m > 0 ? 1000.0 / m : 0.0);
+}
+
+#ifdef SCENEWATCH_BENCH_HAS_SERVICE
+// One daemon for one sequence; it stops (and saves into model_dir) when this returns.
+void stream(const Sequence& s, const std::filesystem::path& model_dir) {
+  Daemon daemon;
+  if (!daemon.start(model_dir, s.z_up ? "demo.yaml" : "scenewatchd.yaml")) {
+    std::printf("   (scenewatchd did not start: build it first)\n");
+    return;
+  }
+  auto client = service::Client::connect("127.0.0.1", daemon.port());
+  if (!client) return;
+  std::vector<proto::Request> requests(s.frames.size());
+  for (std::size_t i = 0; i < s.frames.size(); ++i) *requests[i].mutable_ingest_frame() = service::make_ingest_frame(s.frames[i]);
+  std::size_t events = 0;
+  bool ok = true;
+  const double wall = time_ms([&] {
+    for (const auto& r : requests) {
+      auto reply = client->call(r, 120);
+      if (!reply || !service::status_of(*reply).ok()) {
+        ok = false;
+        return;
+      }
+      events += static_cast<std::size_t>(reply->ingest().events_size());
+    }
+  });
+  if (!ok) {
+    std::printf("   over TCP: an ingest failed\n");
+    return;
+  }
+  std::printf("   over TCP into scenewatchd (one client, frame after reply): %.1f frames/s sustained, %zu events\n",
+              1000.0 * s.frames.size() / wall, events);
+}
+
+void over_tcp(const Sequence& s) {
+  const auto model_dir = std::filesystem::temp_directory_path() / ("scenewatch-bench-pipeline-" + std::to_string(::getpid()));
+  stream(s, model_dir);
+  std::error_code ec;
+  std::filesystem::remove_all(model_dir, ec);  // the daemon saved into it when it stopped
+}
+#else
+void over_tcp(const Sequence&) { std::printf("   over TCP: built without the service module; skipped\n"); }
+#endif
+
+}  // namespace
+
+int run_pipeline(const Options& o) {
+  std::printf("\n== The whole frame: posed VGA RGB-D through WorkingMemory::process, then over TCP\n");
+  for (auto s : {real_sequence(o, "7-Scenes redkitchen (50 frames, hand-held)", "redkitchen"), simulated_sequence("cup_added")}) {
+    if (!s) {
+      std::printf("  (a sequence could not be loaded; skipped)\n");
+      continue;
+    }
+    offline(*s);
+    over_tcp(*s);
+  }
+  return 0;
+}
+
+}  // namespace scenewatch::bench
