@@ -8,7 +8,6 @@
 #include <optional>
 
 #include "bench.h"
-#include "scenewatch/io/rgbd.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/sim/scenario_yaml.h"
@@ -58,15 +57,8 @@ std::optional<Sequence> simulated_sequence(const std::string& scenario_name) {
       const sim::SimFrame rendered = simulator->render(p, f);
       std::optional<Frame> frame;
       s.decode_ms.push_back(time_ms([&] {
-        auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, sc.intrinsics);
-        if (!cloud) return;
-        Frame fr;
-        fr.cloud = *cloud;
-        fr.T_world_camera = rendered.truth.T_world_camera_reported;
-        fr.intrinsics = sc.intrinsics;
-        fr.has_color = true;
-        fr.stamp_s = s.frames.size() / 30.0;
-        frame = std::move(fr);
+        auto converted = sim::as_frame(rendered, sc.intrinsics, s.frames.size() / 30.0);
+        if (converted) frame = std::move(*converted);
       }));
       if (!frame) return std::nullopt;
       s.frames.push_back(std::move(*frame));

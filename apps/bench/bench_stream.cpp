@@ -6,7 +6,6 @@
 #include <optional>
 
 #include "bench.h"
-#include "scenewatch/io/rgbd.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/sim/scenario_yaml.h"
@@ -54,16 +53,9 @@ std::optional<Recording> simulated(const std::string& scenario, int width, int h
   const Intrinsics K = sc.intrinsics;
   Recording r{"sim " + scenario + " " + std::to_string(width) + "x" + std::to_string(height), index.size(),
               [shared, index, K](std::size_t i) -> std::optional<Frame> {
-                const sim::SimFrame rendered = shared->render(index[i].first, index[i].second);
-                auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, K);
-                if (!cloud) return std::nullopt;
-                Frame frame;
-                frame.cloud = *cloud;
-                frame.T_world_camera = rendered.truth.T_world_camera_reported;
-                frame.intrinsics = K;
-                frame.has_color = true;
-                frame.stamp_s = i / 30.0;
-                return frame;
+                auto frame = sim::as_frame(shared->render(index[i].first, index[i].second), K, i / 30.0);
+                if (!frame) return std::nullopt;
+                return std::move(*frame);
               }};
   r.z_up = true;
   return r;

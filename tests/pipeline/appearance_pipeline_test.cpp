@@ -17,15 +17,9 @@ namespace scenewatch::pipeline {
 namespace {
 
 Frame posed_frame(const sim::SimFrame& rendered, const Intrinsics& K, double stamp) {
-  auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, K);
-  EXPECT_TRUE(cloud.ok());
-  Frame frame;
-  frame.cloud = *cloud;
-  frame.T_world_camera = rendered.truth.T_world_camera_reported;
-  frame.intrinsics = K;
-  frame.stamp_s = stamp;
-  frame.source = "sim";
-  return frame;
+  auto frame = sim::as_frame(rendered, K, stamp);
+  EXPECT_TRUE(frame.ok());
+  return frame.ok() ? *frame : Frame{};
 }
 
 TEST(AppearancePipeline, CupAddedIsOneEventWithTheSurpriseAsEvidence) {

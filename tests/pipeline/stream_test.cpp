@@ -10,7 +10,6 @@
 
 #include <cstdio>
 
-#include "scenewatch/io/rgbd.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/sim/scenario_yaml.h"
@@ -54,17 +53,10 @@ SequenceRun run_scenario(const std::string& name, int frames, int width, int hei
   double stamp = 0;
   for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
     for (int f = 0; f < simulator->frame_count(phase); ++f) {
-      const sim::SimFrame rendered = simulator->render(phase, f);
-      auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, scenario.intrinsics);
-      EXPECT_TRUE(cloud.ok());
-      if (!cloud.ok()) return run;
-      Frame frame;
-      frame.cloud = *cloud;
-      frame.T_world_camera = rendered.truth.T_world_camera_reported;
-      frame.intrinsics = scenario.intrinsics;
-      frame.has_color = true;
-      frame.stamp_s = stamp += 1.0 / 30;
-      auto result = memory.process(frame);
+      auto frame = sim::as_frame(simulator->render(phase, f), scenario.intrinsics, stamp += 1.0 / 30);
+      EXPECT_TRUE(frame.ok());
+      if (!frame.ok()) return run;
+      auto result = memory.process(*frame);
       EXPECT_TRUE(result.ok());
       if (!result.ok()) return run;
       ++run.frames;

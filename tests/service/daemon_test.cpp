@@ -11,7 +11,6 @@
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/sim/simulator.h"
 #include "scenewatch/sim/scenario_yaml.h"
-#include "scenewatch/io/rgbd.h"
 #include "scenewatch/service/frame_parser.h"
 
 namespace scenewatch::test {
@@ -226,17 +225,10 @@ TEST_F(DaemonTest, SimulatedChangesReachTheSubscriberOnceEach) {
     double stamp = 0;
     for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
       for (int f = 0; f < simulator->frame_count(phase); ++f) {
-        const sim::SimFrame rendered = simulator->render(phase, f);
-        auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, scenario.intrinsics);
-        ASSERT_TRUE(cloud.ok());
-        Frame frame;
-        frame.cloud = *cloud;
-        frame.T_world_camera = rendered.truth.T_world_camera_reported;
-        frame.intrinsics = scenario.intrinsics;
-        frame.has_color = true;
-        frame.stamp_s = stamp += 1.0 / 30;
+        auto frame = sim::as_frame(simulator->render(phase, f), scenario.intrinsics, stamp += 1.0 / 30);
+        ASSERT_TRUE(frame.ok());
         proto::Request r;
-        *r.mutable_ingest_frame() = service::make_ingest_frame(frame);
+        *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
         const auto response = call(client, r);
         ASSERT_EQ(response.status().code(), proto::Status::OK) << response.status().message();
       }

@@ -3,6 +3,7 @@
 #include <algorithm>
 
 #include "random.h"
+#include "scenewatch/io/rgbd.h"
 #include "scenewatch/sim/sequence_writer.h"
 
 namespace scenewatch::sim {
@@ -197,6 +198,19 @@ Result<RunSummary> Simulator::write(const std::filesystem::path& out_dir, const 
     if (auto st = write_changes(summary.changes_json, scenario_.name, changes); !st) return st.error();
   }
   return summary;
+}
+
+Result<Frame> as_frame(const SimFrame& rendered, const Intrinsics& K, double stamp_s) {
+  auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, K);
+  if (!cloud) return cloud.error();
+  Frame frame;
+  frame.cloud = *cloud;
+  frame.T_world_camera = rendered.truth.T_world_camera_reported;
+  frame.intrinsics = K;
+  frame.has_color = true;
+  frame.stamp_s = stamp_s;
+  frame.source = "sim " + rendered.truth.name;
+  return frame;
 }
 
 }  // namespace scenewatch::sim

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "scenewatch/core/frame.h"
 #include "scenewatch/core/image.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/sim/animation.h"
@@ -24,6 +25,10 @@ struct SimFrame {
   LabelImage labels;
   FrameTruth truth;
 };
+
+/// The frame as a posed RGB-D sensor delivers it: the organized colour cloud of `rendered`, its
+/// reported pose and the intrinsics `K` (what a client sends, what the working memory takes).
+Result<Frame> as_frame(const SimFrame& rendered, const Intrinsics& K, double stamp_s);
 
 /// Where a run wrote its sequences.
 struct RunSummary {
