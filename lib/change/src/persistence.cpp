@@ -10,10 +10,6 @@ namespace scenewatch::change {
 namespace {
 constexpr double kZoneMargin_m = 0.05;
 constexpr std::size_t kMaxZones = 256;
-
-bool inside(const Aabb& box, const Eigen::Vector3d& p) {
-  return (p.array() >= box.min.array()).all() && (p.array() <= box.max.array()).all();
-}
 }  // namespace
 
 std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeCluster>& clusters,
@@ -23,7 +19,7 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
   std::vector<char> matched(candidates_.size(), 0);
   for (const auto& c : clusters) {
     bool in_zone = false;
-    for (const auto& z : zones_) in_zone = in_zone || (z.kind == c.kind && inside(z.box_world, c.centroid_world));
+    for (const auto& z : zones_) in_zone = in_zone || (z.kind == c.kind && z.box_world.contains(c.centroid_world));
     if (in_zone) {
       if (absorbed != nullptr) absorbed->push_back(c);
       continue;
@@ -110,10 +106,7 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
     for (const auto& f : out) {
       const auto& side = c.latest.kind == ChangeKind::kAdded ? f.after : f.before;
       if (!side) continue;
-      Aabb grown = side->box_world;
-      grown.min.array() -= kZoneMargin_m;
-      grown.max.array() += kZoneMargin_m;
-      part_of_fired = part_of_fired || inside(grown, c.latest.centroid_world);
+      part_of_fired = part_of_fired || side->box_world.grown(kZoneMargin_m).contains(c.latest.centroid_world);
     }
     if (part_of_fired) {
       if (absorbed != nullptr) absorbed->push_back(c.latest);
@@ -130,10 +123,7 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
     out.push_back(std::move(change));
   }
   auto add_zone = [&](const ChangeCluster& c) {
-    Zone z{c.kind, c.box_world};
-    z.box_world.min.array() -= kZoneMargin_m;
-    z.box_world.max.array() += kZoneMargin_m;
-    zones_.push_back(z);
+    zones_.push_back(Zone{c.kind, c.box_world.grown(kZoneMargin_m)});
   };
   for (const auto& c : out) {
     if (c.before) add_zone(*c.before);

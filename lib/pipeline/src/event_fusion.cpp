@@ -8,31 +8,6 @@ namespace {
 constexpr std::size_t kMaxZones = 256;
 constexpr int kClaimFrames = 10;  ///< appearance evidence is kept this long for a pending change
 
-Aabb grown(Aabb b, double m) {
-  b.min.array() -= m;
-  b.max.array() += m;
-  return b;
-}
-
-bool overlaps(const Aabb& a, const Aabb& b) {
-  return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
-}
-
-bool contains(const Aabb& b, const Eigen::Vector3d& p) {
-  return (p.array() >= b.min.array()).all() && (p.array() <= b.max.array()).all();
-}
-
-Aabb united(Aabb a, const Aabb& b) {
-  a.min = a.min.cwiseMin(b.min);
-  a.max = a.max.cwiseMax(b.max);
-  return a;
-}
-
-bool inside(const OrientedBox& box, const Eigen::Vector3d& p, double margin) {
-  const Eigen::Vector3d q = box.rotation.conjugate() * (p - box.center);
-  return (q.cwiseAbs().array() <= (0.5 * box.extents.array() + margin)).all();
-}
-
 double area_of(const Event& e) {
   auto it = e.evidence.find("area_px");
   return it == e.evidence.end() ? 0.0 : it->second;
@@ -53,18 +28,18 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
     if (has_before) {
       const Eigen::Vector3d before_c = e.centroid_world - e.displacement_world.value_or(Eigen::Vector3d::Zero());
       for (const auto& o : objects) {
-        if (!inside(o.cluster.box, before_c, config_.margin_m)) continue;
+        if (!o.cluster.box.contains(before_c, config_.margin_m)) continue;
         e.object_id = o.id;
         e.evidence["object_points_before"] = static_cast<double>(o.cluster.point_count);
         geometric_boxes.push_back(o.cluster.box.aabb());
-        if (e.kind == EventKind::kObjectRemoved) e.box_world = united(e.box_world, o.cluster.box.aabb());
+        if (e.kind == EventKind::kObjectRemoved) e.box_world = e.box_world.united(o.cluster.box.aabb());
         break;
       }
     }
     if (has_after) {
       for (const auto& c : clusters) {
-        if (!inside(c.box, e.centroid_world, config_.margin_m)) continue;
-        e.box_world = united(e.box_world, c.box.aabb());
+        if (!c.box.contains(e.centroid_world, config_.margin_m)) continue;
+        e.box_world = e.box_world.united(c.box.aabb());
         e.indices_after = c.indices;
         e.evidence["object_points_after"] = static_cast<double>(c.point_count);
         geometric_boxes.push_back(c.box.aabb());
@@ -99,7 +74,7 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
         continue;
       }
       named->evidence["pieces"] = named->evidence.count("pieces") ? named->evidence["pieces"] + 1 : 2;
-      if (named->kind == EventKind::kObjectRemoved) named->box_world = united(named->box_world, e.box_world);
+      if (named->kind == EventKind::kObjectRemoved) named->box_world = named->box_world.united(e.box_world);
     }
     geometric.swap(merged);
   }
@@ -108,7 +83,7 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
   // same fact (the other side of an object that left or came, confirmed a few frames later).
   auto in_zone = [&](const Eigen::Vector3d& p, ZoneKind kind) {
     for (const auto& z : zones_)
-      if (z.kind == kind && contains(z.box, p)) return true;
+      if (z.kind == kind && z.box.contains(p)) return true;
     return false;
   };
   std::vector<Event> fresh;
@@ -121,18 +96,18 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
 
   // Where geometry speaks, appearance is its evidence.
   std::vector<Aabb> geometry;
-  for (const auto& c : pending) geometry.push_back(grown(c.box_world, config_.margin_m));
-  for (const auto& b : geometric_boxes) geometry.push_back(grown(b, config_.margin_m));
+  for (const auto& c : pending) geometry.push_back(c.box_world.grown(config_.margin_m));
+  for (const auto& b : geometric_boxes) geometry.push_back(b.grown(config_.margin_m));
   std::vector<const Event*> free_regions;
   for (const auto& region : appearance) {
     bool claimed = false;
     for (const auto& g : geometry) {
-      if (!overlaps(g, region.box_world)) continue;
+      if (!g.overlaps(region.box_world)) continue;
       claimed = true;
       claimed_.push_back(Claimed{g, region.score, area_of(region), 0});
     }
     bool silenced = false;
-    for (const auto& z : zones_) silenced = silenced || contains(z.box, region.centroid_world);
+    for (const auto& z : zones_) silenced = silenced || z.box.contains(region.centroid_world);
     if (!claimed && !silenced) free_regions.push_back(&region);
   }
 
@@ -140,17 +115,19 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
   for (auto& e : geometric) {
     if (e.kind == EventKind::kObjectMoved) {
       const Eigen::Vector3d before_c = e.centroid_world - e.displacement_world.value_or(Eigen::Vector3d::Zero());
-      for (const auto& b : geometric_boxes)
-        if (contains(grown(b, config_.margin_m), before_c)) zones_.push_back(Zone{grown(b, config_.margin_m), ZoneKind::kRemoved, 0});
-      zones_.push_back(Zone{grown(e.box_world, config_.margin_m), ZoneKind::kAdded, 0});
+      for (const auto& b : geometric_boxes) {
+        const Aabb place = b.grown(config_.margin_m);
+        if (place.contains(before_c)) zones_.push_back(Zone{place, ZoneKind::kRemoved, 0});
+      }
+      zones_.push_back(Zone{e.box_world.grown(config_.margin_m), ZoneKind::kAdded, 0});
     } else {
       const ZoneKind kind = e.kind == EventKind::kObjectRemoved ? ZoneKind::kRemoved : ZoneKind::kAdded;
-      zones_.push_back(Zone{grown(e.box_world, config_.margin_m), kind, 0});
+      zones_.push_back(Zone{e.box_world.grown(config_.margin_m), kind, 0});
     }
-    const Aabb where = grown(e.box_world, config_.margin_m);
+    const Aabb where = e.box_world.grown(config_.margin_m);
     double kl = 0.0, area = 0.0;
     for (const auto& c : claimed_) {
-      if (!overlaps(c.box, where) || c.kl <= kl) continue;
+      if (!c.box.overlaps(where) || c.kl <= kl) continue;
       kl = c.kl;
       area = c.area_px;
     }
@@ -160,7 +137,7 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
     }
     // Appearance candidates at the same place are the same fact.
     candidates_.erase(std::remove_if(candidates_.begin(), candidates_.end(),
-                                     [&](const Candidate& c) { return overlaps(where, c.latest.box_world); }),
+                                     [&](const Candidate& c) { return where.overlaps(c.latest.box_world); }),
                       candidates_.end());
   }
 
@@ -200,7 +177,7 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
       e.evidence["frames_seen"] = c.hits;
       e.evidence["kl_mean_best"] = c.best_kl;
       out.push_back(e);
-      zones_.push_back(Zone{grown(e.box_world, config_.margin_m), ZoneKind::kAppearance, 0});
+      zones_.push_back(Zone{e.box_world.grown(config_.margin_m), ZoneKind::kAppearance, 0});
       continue;
     }
     if (c.misses < config_.persistence_frames) kept.push_back(std::move(c));

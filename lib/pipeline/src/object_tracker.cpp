@@ -6,11 +6,6 @@
 namespace scenewatch::pipeline {
 namespace {
 
-bool inside(const OrientedBox& box, const Eigen::Vector3d& p) {
-  const Eigen::Vector3d q = box.rotation.conjugate() * (p - box.center);
-  return (q.cwiseAbs().array() <= 0.5 * box.extents.array()).all();
-}
-
 // Greedy nearest matching of observations to tracks: a pair within the match distance, or whose
 // remembered centroid lies inside the observed box (a larger view of the same object).
 std::vector<int> match(const std::vector<TrackerObservation>& obs, const std::vector<const TrackedObject*>& known,
@@ -19,7 +14,7 @@ std::vector<int> match(const std::vector<TrackerObservation>& obs, const std::ve
   for (std::size_t c = 0; c < obs.size(); ++c)
     for (std::size_t o = 0; o < known.size(); ++o) {
       const double d = (obs[c].cluster.centroid - known[o]->cluster.centroid).norm();
-      if (d <= max_distance || inside(obs[c].cluster.box, known[o]->cluster.centroid)) {
+      if (d <= max_distance || obs[c].cluster.box.contains(known[o]->cluster.centroid)) {
         pairs.emplace_back(d, static_cast<int>(c), static_cast<int>(o));
       }
     }

@@ -32,6 +32,12 @@ struct Aabb {
   Eigen::Vector3d max = Eigen::Vector3d::Zero();
   bool valid() const { return (min.array() <= max.array()).all() && min.allFinite() && max.allFinite(); }
   Eigen::Vector3d center() const { return 0.5 * (min + max); }
+  bool contains(const Eigen::Vector3d& p) const { return (p.array() >= min.array()).all() && (p.array() <= max.array()).all(); }
+  bool overlaps(const Aabb& o) const { return (min.array() <= o.max.array()).all() && (o.min.array() <= max.array()).all(); }
+  /// Larger by `margin` on every side.
+  Aabb grown(double margin) const { return {(min.array() - margin).matrix(), (max.array() + margin).matrix()}; }
+  /// The smallest box holding both.
+  Aabb united(const Aabb& o) const { return {min.cwiseMin(o.min), max.cwiseMax(o.max)}; }
 };
 
 /// Oriented box: centre, rotation of the box axes in the frame, full side lengths.
@@ -41,6 +47,11 @@ struct OrientedBox {
   Eigen::Vector3d extents = Eigen::Vector3d::Zero();
   /// The axis-aligned box that encloses this one.
   Aabb aabb() const;
+  /// True when p lies inside the box grown by `margin` on every side.
+  bool contains(const Eigen::Vector3d& p, double margin = 0.0) const {
+    const Eigen::Vector3d q = rotation.conjugate() * (p - center);
+    return (q.cwiseAbs().array() <= 0.5 * extents.array() + margin).all();
+  }
 };
 
 }  // namespace scenewatch
