@@ -83,13 +83,9 @@ std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& fram
     // The change held for long enough from a view the memory holds: remember it.
     if (auto id = memory_.replace_nearest(std::move(*observed))) added_at_[*id] = frames_;
     changed_streak_ = 0;
-  } else {
-    auto added = memory_.consider(std::move(*observed));
-    if (added && *added) {
-      // consider() does not say which id it gave: the one not seen before.
-      for (const auto& kf : memory_.keyframes())
-        if (added_at_.count(kf->id) == 0) added_at_[kf->id] = frames_;
-    }
+  } else if (memory_.is_new_view(observed->T_world_camera)) {
+    // A new view becomes a keyframe (what AppearanceMemory::consider does, keeping the id).
+    if (auto id = memory_.add(std::move(*observed))) added_at_[*id] = frames_;
   }
   // Forget the frames of evicted keyframes.
   if (added_at_.size() > 2 * memory_.size() + 16) {
