@@ -26,8 +26,8 @@ namespace {
 // Each pixel whose surprise reaches `min_kl` is compared again with the expected samples of its
 // neighbours within `radius` (nearest first) and keeps the least surprise found: a colour that the
 // memory predicts a pixel or two away is misalignment, not change.
-void tolerate_misalignment(const ExpectedView& view, const std::array<std::vector<float>, kChannels>& obs,
-                           const SurpriseKernel& kernel, int radius, float min_kl, SurpriseMap& map) {
+void tolerate_misalignment(const ExpectedView& view, const ColorImage& observed, const SurpriseKernel& kernel,
+                           int radius, float min_kl, SurpriseMap& map) {
   std::vector<std::pair<int, int>> offsets;
   for (int dv = -radius; dv <= radius; ++dv)
     for (int du = -radius; du <= radius; ++du)
@@ -40,6 +40,10 @@ void tolerate_misalignment(const ExpectedView& view, const std::array<std::vecto
     for (int u = 0; u < w; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * w + u;
       if (!(map.total[i] >= min_kl)) continue;  // also skips NaN
+      // The observed signal again, for the few pixels that get here (no frame-sized copy).
+      float obs[kChannels];
+      to_opponent(observed.rgb[3 * i], observed.rgb[3 * i + 1], observed.rgb[3 * i + 2], obs);
+      for (int c = 0; c < kChannels; ++c) obs[c] = map.photometric.apply(c, obs[c]);
       float best = map.total[i];
       std::array<float, kChannels> best_ch{};
       bool improved = false;
@@ -50,7 +54,7 @@ void tolerate_misalignment(const ExpectedView& view, const std::array<std::vecto
         std::array<float, kChannels> ch{};
         float total = 0;
         for (int c = 0; c < kChannels; ++c) {
-          ch[c] = kernel.at(view.count[j], view.mean[c][j], view.ssd[c][j], obs[c][i]);
+          ch[c] = kernel.at(view.count[j], view.mean[c][j], view.ssd[c][j], obs[c]);
           total += ch[c];
         }
         if (!(total < best)) continue;  // NaN (no samples there) never wins
@@ -84,11 +88,7 @@ Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage&
   const int radius = robust == nullptr ? 0
                                        : static_cast<int>(std::lround(robust->align_radius_px * view.width / 640.0));
   // The observed opponent signals: in blocks, so that they live in a small buffer rather than in
-  // three more frame-sized arrays (fresh pages cost more than the arithmetic here), unless the
-  // misalignment pass needs them again.
-  std::array<std::vector<float>, kChannels> whole;
-  if (radius > 0)
-    for (auto& c : whole) c.resize(n);
+  // three more frame-sized arrays (fresh pages cost more than the arithmetic here).
   constexpr std::size_t kBlock = 4096;
   std::array<std::array<float, kBlock>, kChannels> obs;
   for (std::size_t start = 0; start < n; start += kBlock) {
@@ -108,11 +108,10 @@ Result<SurpriseMap> compute_surprise(const ExpectedView& view, const ColorImage&
       ssds[c] = view.ssd[c].data() + start;
       observed_ch[c] = obs[c].data();
       outs[c] = map.channel[c].data() + start;
-      if (radius > 0) std::copy(obs[c].begin(), obs[c].begin() + len, whole[c].begin() + start);
     }
     kernel.run_channels(kChannels, view.count.data() + start, means, ssds, observed_ch, outs, map.total.data() + start, len);
   }
-  if (radius > 0) tolerate_misalignment(view, whole, kernel, radius, static_cast<float>(robust->align_min_kl), map);
+  if (radius > 0) tolerate_misalignment(view, observed, kernel, radius, static_cast<float>(robust->align_min_kl), map);
   for (std::size_t i = 0; i < n; ++i) map.known_pixels += std::isnan(map.total[i]) ? 0 : 1;
   return map;
 }
