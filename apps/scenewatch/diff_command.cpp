@@ -18,8 +18,6 @@ using nlohmann::json;
 
 namespace {
 
-json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
-
 std::string fixed(double value, int decimals = 3) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);

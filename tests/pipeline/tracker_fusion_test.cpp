@@ -95,7 +95,9 @@ TEST(EventFusion, AnAppearanceChangeMustPersistInAFamiliarView) {
   std::vector<Event> told;
   for (int i = 0; i < 10; ++i) {
     auto out = fusion.update({region_at(0.5 + 0.005 * i, 0.5)}, {}, {}, {}, true);
-    if (!out.empty()) EXPECT_EQ(i, 4) << "persistence_frames 5: told on the fifth sighting";
+    if (!out.empty()) {
+      EXPECT_EQ(i, 4) << "persistence_frames 5: told on the fifth sighting";
+    }
     told.insert(told.end(), out.begin(), out.end());
   }
   ASSERT_EQ(told.size(), 1u) << "once, then its place is silent";
