@@ -42,7 +42,8 @@ nlohmann::json to_json(const proto::Cluster& cluster) {
           {"centroid", to_json(cluster.centroid())},
           {"box", to_json(cluster.box())},
           {"point_count", cluster.point_count()},
-          {"mean_rgb", to_json(cluster.mean_rgb())}};
+          {"mean_rgb", to_json(cluster.mean_rgb())},
+          {"supported_by", cluster.supported_by()}};
 }
 
 nlohmann::json to_json(const proto::Object& object) {
@@ -54,7 +55,8 @@ nlohmann::json to_json(const proto::Object& object) {
           {"mean_rgb", to_json(object.mean_rgb())},
           {"first_seen_s", object.first_seen_s()},
           {"last_seen_s", object.last_seen_s()},
-          {"observations", object.observations()}};
+          {"observations", object.observations()},
+          {"supported_by", object.supported_by()}};
 }
 
 nlohmann::json to_json(const proto::Event& event) {
@@ -150,7 +152,9 @@ std::string text(const proto::Plane& plane) {
 std::string text(const proto::Object& object) {
   std::ostringstream os;
   const auto& e = object.box().extents();
-  os << "  object " << object.id() << ": at " << text(object.centroid()) << ", size " << fixed(e.x()) << " x "
+  os << "  object " << object.id();
+  if (object.supported_by() != 0) os << " on object " << object.supported_by();
+  os << ": at " << text(object.centroid()) << ", size " << fixed(e.x()) << " x "
      << fixed(e.y()) << " x " << fixed(e.z()) << " m, " << object.point_count() << " points, rgb ("
      << fixed(object.mean_rgb().x(), 0) << ", " << fixed(object.mean_rgb().y(), 0) << ", "
      << fixed(object.mean_rgb().z(), 0) << "), seen " << object.observations() << "x (first "
@@ -161,7 +165,9 @@ std::string text(const proto::Object& object) {
 std::string text(const proto::Cluster& cluster) {
   std::ostringstream os;
   const auto& e = cluster.box().extents();
-  os << "  cluster on plane " << cluster.plane_id() << ": at " << text(cluster.centroid()) << ", size "
+  os << "  cluster on "
+     << (cluster.supported_by() >= 0 ? "cluster " + std::to_string(cluster.supported_by()) : "plane " + std::to_string(cluster.plane_id()))
+     << ": at " << text(cluster.centroid()) << ", size "
      << fixed(e.x()) << " x " << fixed(e.y()) << " x " << fixed(e.z()) << " m, " << cluster.point_count()
      << " points";
   return os.str();

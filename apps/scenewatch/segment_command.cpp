@@ -36,6 +36,7 @@ json to_json(std::size_t id, const ObjectCluster& object) {
   const Eigen::Quaterniond& q = object.box.rotation;
   return {{"id", id},
           {"plane_id", object.plane_id},
+          {"supported_by", object.supported_by},
           {"centroid", vec(object.centroid)},
           {"box",
            {{"center", vec(object.box.center)},
@@ -130,7 +131,8 @@ int run_segment(const SegmentOptions& options) {
   std::cout << result.objects.size() << (result.objects.size() == 1 ? " object\n" : " objects\n");
   for (std::size_t i = 0; i < result.objects.size(); ++i) {
     const auto& o = result.objects[i];
-    std::cout << "  object " << i << " on plane " << o.plane_id << ": at " << text(o.centroid) << ", size "
+    const std::string on = o.supported_by >= 0 ? "on object " + std::to_string(o.supported_by) : "on plane " + std::to_string(o.plane_id);
+    std::cout << "  object " << i << " " << on << ": at " << text(o.centroid) << ", size "
               << fixed(o.box.extents.x()) << " x " << fixed(o.box.extents.y()) << " x " << fixed(o.box.extents.z())
               << " m, " << o.point_count << " points\n";
   }

@@ -68,23 +68,27 @@ TEST(Mosd, TableFoundAndObjectsRecalled) {
     std::printf("  %-18s recall %zu/%zu, precision %zu/%zu\n", names[g], by_group_matched[g], by_group_objects[g],
                 by_group_correct[g], by_group_clusters[g]);
   EXPECT_EQ(tables, scenes) << "the table plane must be found in every scene";
-  // Floor: every single box and most cylinders are recovered (38/38 boxes, 32/38 cylinders, 9/20
-  // stacked boxes, 13/16 occluded objects, 0.82 overall in the run this floor was set on). Stacked and touching objects are one connected
-  // surface, which a model-free Euclidean clusterer cannot split (mOSD's stated purpose), so the
-  // stacked-box scenes cap the overall recall.
-  EXPECT_GE(recall, 0.80);
-  // Precision, strict (reported clusters that match a whole labelled object at IoU >= 0.5): 0.773
-  // (92/119) when this floor was set; pieces of cylinders and occluded objects pull it down.
-  EXPECT_GE(precision, 0.76);
+  // Floors at what the run they were set on measured (README, "Segmentation"): recall 105/112 =
+  // 0.938 and precision 105/130 = 0.808, stacked boxes 18/20 (9/20 before the split at concave
+  // creases; Euclidean clusters alone cannot part stacked boxes). The losses: occluded objects seen
+  // as two pieces (mOSD gives the pieces one object id), a pot whose inside and outside come apart,
+  // the curved inside of open mugs.
+  EXPECT_GE(recall, 0.93);
+  EXPECT_GE(precision, 0.80);
+  EXPECT_GE(by_group_matched[1], 18u) << "stacked boxes come apart";
   EXPECT_EQ(by_group_matched[0], by_group_objects[0]) << "every isolated box must be recovered";
 }
 
-// The mug of PCL's stereo scene is one cluster standing on the table plane.
+// The mug of PCL's stereo scene is one Euclidean cluster standing on the table plane. With the
+// split at concave creases (the default) the open mug's inside comes apart from its outside in
+// this noisy stereo cloud: a known limit for containers, see README "Segmentation".
 TEST(Mosd, MugIsOneClusterOnTheTable) {
   SCENEWATCH_REQUIRE_DATA("pcl/table_scene_mug_stereo_textured.pcd");
   auto file = io::read_cloud(test::data_dir() / "pcl/table_scene_mug_stereo_textured.pcd");
   ASSERT_TRUE(file.ok()) << file.error().message;
-  const Segmentation seg = segment(*file->cloud, Config{}, file->sensor_origin);
+  Config euclidean;
+  euclidean.split_concave = false;
+  const Segmentation seg = segment(*file->cloud, euclidean, file->sensor_origin);
   ASSERT_GE(seg.planes.size(), 1u);
   std::printf("mug scene: %zu planes, %zu clusters\n", seg.planes.size(), seg.objects.size());
   for (const auto& o : seg.objects) {

@@ -67,7 +67,11 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("height_noise_sigmas", g.height_noise_sigmas); },
                            [&] { return s.read("cluster_tolerance_m", g.cluster_tolerance_m); },
                            [&] { return s.read("min_cluster_points", g.min_cluster_points); },
-                           [&] { return s.read("max_cluster_points", g.max_cluster_points); });
+                           [&] { return s.read("max_cluster_points", g.max_cluster_points); },
+                           [&] { return s.read("split_concave", g.split_concave); },
+                           [&] { return s.read("patch_size_m", g.patch_size_m); },
+                           [&] { return s.read("concavity_tolerance_deg", g.concavity_tolerance_deg); },
+                           [&] { return s.read("crease_angle_deg", g.crease_angle_deg); });
         !st)
       return st;
     if (!up.empty()) {

@@ -49,7 +49,8 @@ json to_json(const TrackedObject& o) {
   const ObjectCluster& c = o.cluster;
   return {{"id", o.id}, {"plane_id", c.plane_id}, {"centroid", vec(c.centroid)}, {"box", box_json(c.box)},
           {"point_count", c.point_count}, {"mean_rgb", {c.mean_rgb.x(), c.mean_rgb.y(), c.mean_rgb.z()}},
-          {"first_seen_s", o.first_seen_s}, {"last_seen_s", o.last_seen_s}, {"observations", o.observations}};
+          {"first_seen_s", o.first_seen_s}, {"last_seen_s", o.last_seen_s}, {"observations", o.observations},
+          {"supported_by", o.supported_by}};
 }
 
 Result<Plane> plane_from_json(const json& j) {
@@ -78,6 +79,7 @@ Result<TrackedObject> object_from_json(const json& j) {
     o.cluster.mean_rgb = Eigen::Vector3f(c.at(0).get<float>(), c.at(1).get<float>(), c.at(2).get<float>());
     o.first_seen_s = j.at("first_seen_s").get<double>();
     o.last_seen_s = j.at("last_seen_s").get<double>();
+    o.supported_by = j.value("supported_by", std::uint64_t{0});  // absent in models saved before it existed
     o.observations = j.at("observations").get<int>();
     return o;
   });

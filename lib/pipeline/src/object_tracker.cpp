@@ -32,10 +32,25 @@ std::vector<int> match(const std::vector<TrackerObservation>& obs, const std::ve
 }  // namespace
 
 void ObjectTracker::update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction) {
-  observations.erase(std::remove_if(observations.begin(), observations.end(),
-                                    [&](const TrackerObservation& o) { return o.range_m > config_.max_range_m; }),
-                     observations.end());
   for (auto& o : observations) o.cluster.indices.clear();  // indices belong to this frame only
+  // What each observation stands on, by the centroid of the supporting observation (the indices
+  // of supported_by are this frame's and do not survive matching).
+  std::vector<std::optional<Eigen::Vector3d>> support(observations.size());
+  for (std::size_t c = 0; c < observations.size(); ++c) {
+    const int s = observations[c].cluster.supported_by;
+    if (s >= 0 && static_cast<std::size_t>(s) < observations.size()) support[c] = observations[s].cluster.centroid;
+  }
+  std::size_t in_range = 0;
+  for (std::size_t c = 0; c < observations.size(); ++c) {
+    if (observations[c].range_m > config_.max_range_m) continue;
+    if (in_range != c) {
+      observations[in_range] = std::move(observations[c]);
+      support[in_range] = support[c];
+    }
+    ++in_range;
+  }
+  observations.resize(in_range);
+  support.resize(in_range);
 
   // Confirmed objects first, then the tentative ones get what is left.
   std::vector<const TrackedObject*> known;
@@ -53,6 +68,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
       t.object.first_seen_s = t.object.last_seen_s = stamp_s;
       t.object.observations = 1;
       t.samples = std::move(observations[c].samples);
+      t.support_centroid = support[c];
       tentative_.push_back(std::move(t));
       continue;
     }
@@ -62,6 +78,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     t.object.last_seen_s = stamp_s;
     ++t.object.observations;
     t.samples = std::move(observations[c].samples);
+    t.support_centroid = support[c];
     t.misses = t.seen_free = 0;
   }
 
@@ -93,8 +110,19 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
   }
   tracks_.swap(kept);
   tentative_.swap(still_tentative);
+  resolve_supports();
   objects_.clear();
   for (const auto& t : tracks_) objects_.push_back(t.object);
+}
+
+void ObjectTracker::resolve_supports() {
+  for (auto& t : tracks_) {
+    t.object.supported_by = 0;
+    if (!t.support_centroid) continue;
+    for (const auto& other : tracks_) {
+      if (&other != &t && other.object.cluster.centroid == *t.support_centroid) t.object.supported_by = other.object.id;
+    }
+  }
 }
 
 const std::vector<Eigen::Vector3d>* ObjectTracker::samples(std::uint64_t id) const {

@@ -15,12 +15,15 @@
 #include <random>
 
 #include "scenewatch/segmentation/tabletop.h"
+#include "convex_parts.h"
+#include "hull2d.h"
+#include "support.h"
+#include "union_find.h"
 #include "voxel_index.h"
 
 namespace scenewatch::segmentation {
 namespace {
 
-using Vec2 = Eigen::Vector2d;
 
 struct PlaneModel {
   Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
@@ -101,53 +104,6 @@ RansacResult ransac_plane(const std::vector<Eigen::Vector3f>& centroids, const s
   return best;
 }
 
-// An orthonormal basis (u, v) of the plane.
-void plane_basis(const Eigen::Vector3d& n, Eigen::Vector3d& u, Eigen::Vector3d& v) {
-  u = n.unitOrthogonal();
-  v = n.cross(u);
-}
-
-double cross2(const Vec2& o, const Vec2& a, const Vec2& b) {
-  return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
-}
-
-// Andrew's monotone chain; counter-clockwise, no repeated end point.
-std::vector<Vec2> convex_hull(std::vector<Vec2> pts) {
-  std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
-  if (pts.size() < 3) return pts;
-  std::vector<Vec2> hull(2 * pts.size());
-  std::size_t k = 0;
-  for (const auto& p : pts) {
-    while (k >= 2 && cross2(hull[k - 2], hull[k - 1], p) <= 0) --k;
-    hull[k++] = p;
-  }
-  for (std::size_t i = pts.size() - 1, t = k + 1; i-- > 0;) {
-    while (k >= t && cross2(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
-    hull[k++] = pts[i];
-  }
-  hull.resize(k - 1);
-  return hull;
-}
-
-double polygon_area(const std::vector<Vec2>& poly) {
-  double a = 0.0;
-  for (std::size_t i = 0; i < poly.size(); ++i) {
-    const Vec2& p = poly[i];
-    const Vec2& q = poly[(i + 1) % poly.size()];
-    a += p.x() * q.y() - q.x() * p.y();
-  }
-  return 0.5 * std::abs(a);
-}
-
-bool inside_convex(const std::vector<Vec2>& hull, const Vec2& p) {
-  if (hull.size() < 3) return false;
-  for (std::size_t i = 0; i < hull.size(); ++i) {
-    if (cross2(hull[i], hull[(i + 1) % hull.size()], p) < 0) return false;
-  }
-  return true;
-}
-
 // Largest 8-connected group of the inlier voxels on a 2D grid of cell `cell_m` in the plane.
 std::vector<int> largest_component(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
                                    const Eigen::Vector3d& u, const Eigen::Vector3d& v, double cell_m) {
@@ -202,20 +158,6 @@ double object_height_threshold(const Config& cfg, double range_m) {
   const double dz = std::max(0.0, range_m - 0.4);
   return std::max(cfg.min_object_height_m, cfg.height_noise_sigmas * (0.0012 + 0.0019 * dz * dz));
 }
-
-struct UnionFind {
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
-  int find(int x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-  }
-  void unite(int a, int b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-  std::vector<int> parent;
-};
 
 struct PlaneFrame {
   PlaneModel model;
@@ -273,6 +215,50 @@ OrientedBox box_on_plane(const Cloud& cloud, const std::vector<int>& idx, const 
   return box;
 }
 
+// Whether most voxels of a plane candidate lie in the prism of an earlier support, at object
+// height: then they are an object's face.
+bool on_objects_of(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& part,
+                   const std::vector<PlaneFrame>& supports, const Config& cfg, const Eigen::Vector3d& sensor_origin) {
+  std::size_t above = 0;
+  for (int v : part) {
+    const Eigen::Vector3d q = centroids[v].cast<double>();
+    for (const PlaneFrame& f : supports) {
+      const double h = f.model.distance(centroids[v]);
+      if (h >= object_height_threshold(cfg, (q - sensor_origin).norm()) && h <= cfg.max_object_height_m &&
+          inside_convex(f.hull2d, Vec2(q.dot(f.u), q.dot(f.v)))) {
+        ++above;
+        break;
+      }
+    }
+  }
+  return 2 * above > part.size();
+}
+
+ObjectCluster make_object(const Cloud& cloud, std::vector<int> indices, int plane_id, const Eigen::Vector3d& up) {
+  ObjectCluster obj;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero(), rgb = Eigen::Vector3d::Zero();
+  for (int i : indices) {
+    sum += cloud[i].getVector3fMap().cast<double>();
+    rgb += Eigen::Vector3d(cloud[i].r, cloud[i].g, cloud[i].b);
+  }
+  const double n = static_cast<double>(indices.size());
+  obj.plane_id = plane_id;
+  obj.point_count = indices.size();
+  obj.centroid = sum / n;
+  obj.mean_rgb = (rgb / n).cast<float>();
+  obj.box = box_on_plane(cloud, indices, up);
+  obj.indices = std::move(indices);
+  return obj;
+}
+
+ConvexityParams convexity_params(const Config& cfg) {
+  ConvexityParams p;
+  p.patch_size_m = cfg.patch_size_m;
+  p.concavity_tolerance_deg = cfg.concavity_tolerance_deg;
+  p.crease_angle_deg = cfg.crease_angle_deg;
+  return p;
+}
+
 }  // namespace
 
 Status validate(const Config& c) {
@@ -291,6 +277,10 @@ Status validate(const Config& c) {
   if (!(c.cluster_tolerance_m > 0 && c.cluster_tolerance_m <= 0.5)) return bad("cluster_tolerance_m", "must be in (0, 0.5] m");
   if (c.min_cluster_points < 1 || c.min_cluster_points > c.max_cluster_points)
     return bad("min_cluster_points", "must be >= 1 and <= max_cluster_points");
+  if (!(c.patch_size_m >= 0.005 && c.patch_size_m <= 0.1)) return bad("patch_size_m", "must be in [0.005, 0.1] m");
+  if (!(c.concavity_tolerance_deg >= 0 && c.concavity_tolerance_deg < 90)) return bad("concavity_tolerance_deg", "must be in [0, 90)");
+  if (!(c.crease_angle_deg >= c.concavity_tolerance_deg && c.crease_angle_deg <= 180))
+    return bad("crease_angle_deg", "must be in [concavity_tolerance_deg, 180]");
   return {};
 }
 
@@ -350,6 +340,15 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     const double area = polygon_area(frame.hull2d);
     // The largest remaining plane is too small: no further supporting plane can be found.
     if (frame.hull2d.size() < 3 || area < cfg.min_plane_area_m2) break;
+    // A plane standing in the prism of a support found before is the face of an object on it
+    // (the top of a large box), not a support: it stays with the objects. What stands on it
+    // is found by support reasoning (support.h).
+    if (on_objects_of(centroids, part, frames, cfg, sensor_origin)) {
+      std::vector<char> face(nvox, 0);
+      for (int v : part) face[v] = 1;
+      remaining.erase(std::remove_if(remaining.begin(), remaining.end(), [&](int v) { return face[v] != 0; }), remaining.end());
+      continue;
+    }
 
     Plane plane;
     plane.id = static_cast<int>(out.planes.size());
@@ -452,36 +451,35 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     if (attached[uf.find(local[groups[g].front()])]) continue;  // part of a taller structure
     for (int v : groups[g]) voxel_group[v] = static_cast<int>(g);
   }
-  std::vector<ObjectCluster> candidates(groups.size());
-  std::vector<Eigen::Vector3d> sums(groups.size(), Eigen::Vector3d::Zero()), rgbs(groups.size(), Eigen::Vector3d::Zero());
+  std::vector<std::vector<int>> group_points(groups.size());
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const int v = grid.point_voxel[i];
     if (v < 0 || voxel_group[v] < 0) continue;
-    const int g = voxel_group[v];
-    const PointT& q = cloud[i];
-    const double h = frames[owner[v]].model.distance(q.getVector3fMap());
-    if (h > cfg.max_object_height_m ||
-        h < object_height_threshold(cfg, (q.getVector3fMap().cast<double>() - sensor_origin).norm())) {
-      continue;
-    }
-    candidates[g].indices.push_back(static_cast<int>(i));
-    sums[g] += q.getVector3fMap().cast<double>();
-    rgbs[g] += Eigen::Vector3d(q.r, q.g, q.b);
+    const Eigen::Vector3f q = cloud[i].getVector3fMap();
+    const double h = frames[owner[v]].model.distance(q);
+    if (h > cfg.max_object_height_m || h < object_height_threshold(cfg, (q.cast<double>() - sensor_origin).norm())) continue;
+    group_points[voxel_group[v]].push_back(static_cast<int>(i));
   }
+  // Only a single view orients the patch normals (towards its sensor); a merged cloud of several
+  // views keeps its Euclidean clusters.
+  const bool split = cfg.split_concave && cloud.height > 1;
   for (std::size_t g = 0; g < groups.size(); ++g) {
-    ObjectCluster& obj = candidates[g];
-    const int n = static_cast<int>(obj.indices.size());
-    if (n < cfg.min_cluster_points || n > cfg.max_cluster_points) continue;
+    if (group_points[g].empty()) continue;
     const int p = owner[groups[g].front()];
-    obj.plane_id = p;
-    obj.point_count = obj.indices.size();
-    obj.centroid = sums[g] / n;
-    obj.mean_rgb = (rgbs[g] / n).cast<float>();
-    obj.box = box_on_plane(cloud, obj.indices, frames[p].model.n);
-    out.objects.push_back(std::move(obj));
+    std::vector<std::vector<int>> parts;
+    if (split) parts = split_at_concavities(cloud, group_points[g], sensor_origin, convexity_params(cfg));
+    else parts.push_back(std::move(group_points[g]));
+    for (auto& indices : parts) {
+      const int n = static_cast<int>(indices.size());
+      if (n < cfg.min_cluster_points || n > cfg.max_cluster_points) continue;
+      out.objects.push_back(make_object(cloud, std::move(indices), p, frames[p].model.n));
+    }
   }
   std::stable_sort(out.objects.begin(), out.objects.end(),
                    [](const ObjectCluster& a, const ObjectCluster& b) { return a.point_count > b.point_count; });
+  SupportParams support;
+  support.min_object_height_m = cfg.min_object_height_m;
+  assign_supports(cloud, out.objects, out.planes, support);
   return out;
 }
 

@@ -5,17 +5,30 @@
 namespace scenewatch::segmentation {
 
 VoxelIndex::VoxelIndex(const Cloud& cloud, double voxel_size_m) : size(voxel_size_m) {
-  const float inv = static_cast<float>(1.0 / voxel_size_m);
-  point_voxel.assign(cloud.size(), -1);
   lookup.reserve(cloud.size() / 8 + 16);
+  build(cloud, [&](auto&& visit) {
+    for (std::size_t i = 0; i < cloud.size(); ++i) visit(i);
+  });
+}
+
+VoxelIndex::VoxelIndex(const Cloud& cloud, const std::vector<int>& indices, double voxel_size_m) : size(voxel_size_m) {
+  build(cloud, [&](auto&& visit) {
+    for (int i : indices) visit(static_cast<std::size_t>(i));
+  });
+}
+
+template <typename ForEachIndex>
+void VoxelIndex::build(const Cloud& cloud, ForEachIndex&& for_each_index) {
+  const float inv = static_cast<float>(1.0 / size);
+  point_voxel.assign(cloud.size(), -1);
   std::vector<Eigen::Vector3f> sums;
   // Neighbouring points of an organized cloud mostly share a voxel: remember the last one and
   // skip the hash lookup when the key repeats.
   std::uint64_t last_key = ~std::uint64_t{0};
   int last_voxel = -1;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
+  for_each_index([&](std::size_t i) {
     const PointT& p = cloud.points[i];
-    if (!is_valid(p)) continue;
+    if (!is_valid(p)) return;
     const int x = static_cast<int>(std::floor(p.x * inv));
     const int y = static_cast<int>(std::floor(p.y * inv));
     const int z = static_cast<int>(std::floor(p.z * inv));
@@ -35,7 +48,7 @@ VoxelIndex::VoxelIndex(const Cloud& cloud, double voxel_size_m) : size(voxel_siz
     sums[v] += p.getVector3fMap();
     ++member_offsets[v];
     point_voxel[i] = v;
-  }
+  });
   // Counting sort of the points by voxel (counts become offsets).
   const std::size_t n = sums.size();
   centroids.resize(n);

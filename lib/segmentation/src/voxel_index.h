@@ -15,6 +15,9 @@ namespace scenewatch::segmentation {
 struct VoxelIndex {
   /// Builds the grid of the valid points of `cloud` at edge `voxel_size_m`.
   VoxelIndex(const Cloud& cloud, double voxel_size_m);
+  /// The same over the points `indices` of `cloud` only (point_voxel still has cloud.size()
+  /// entries, -1 outside the subset).
+  VoxelIndex(const Cloud& cloud, const std::vector<int>& indices, double voxel_size_m);
 
   /// Voxel index at integer coordinates, or -1.
   int find(int x, int y, int z) const {
@@ -33,6 +36,8 @@ struct VoxelIndex {
   const int* members_end(int v) const { return member_points.data() + member_offsets[v + 1]; }
 
  private:
+  template <typename ForEachIndex>
+  void build(const Cloud& cloud, ForEachIndex&& for_each_index);
   static std::uint64_t pack(int x, int y, int z) {
     constexpr std::uint64_t kMask = (1u << 21) - 1;  // +-1M voxels per axis
     return ((static_cast<std::uint64_t>(x + (1 << 20)) & kMask) << 42) |

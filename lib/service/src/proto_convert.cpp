@@ -134,6 +134,7 @@ void to_proto(const ObjectCluster& cluster, proto::Cluster* out) {
   to_proto(cluster.box, out->mutable_box());
   out->set_point_count(cluster.point_count);
   to_proto(Eigen::Vector3d(cluster.mean_rgb.cast<double>()), out->mutable_mean_rgb());
+  out->set_supported_by(cluster.supported_by);
 }
 
 void to_proto(const TrackedObject& object, proto::Object* out) {
@@ -146,6 +147,7 @@ void to_proto(const TrackedObject& object, proto::Object* out) {
   out->set_first_seen_s(object.first_seen_s);
   out->set_last_seen_s(object.last_seen_s);
   out->set_observations(static_cast<std::uint32_t>(std::max(0, object.observations)));
+  out->set_supported_by(object.supported_by);
 }
 
 void to_proto(const Event& event, proto::Event* out) {

@@ -25,6 +25,9 @@ struct Plane {
 /// A cluster of points standing on a plane.
 struct ObjectCluster {
   int plane_id = 0;
+  /// What the object stands on: -1 for its plane, else the index of the object under it in the
+  /// same segmentation (a box on a box).
+  int supported_by = -1;
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   OrientedBox box;                    ///< z axis along the plane normal, yaw from the points
   std::size_t point_count = 0;
@@ -39,6 +42,8 @@ struct TrackedObject {
   double first_seen_s = 0.0;
   double last_seen_s = 0.0;
   int observations = 0;
+  /// Id of the object it stands on (a box on a box); 0: it stands on its plane.
+  std::uint64_t supported_by = 0;
 };
 
 }  // namespace scenewatch

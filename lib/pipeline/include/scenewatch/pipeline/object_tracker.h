@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <vector>
 
 #include "scenewatch/core/scene.h"
@@ -63,7 +64,10 @@ class ObjectTracker {
     std::vector<Eigen::Vector3d> samples;
     int misses = 0;       ///< consecutive frames unmatched
     int seen_free = 0;    ///< consecutive frames unmatched with its space seen free
+    /// Centroid of the observation it stood on in its last frame (a box on a box), if any.
+    std::optional<Eigen::Vector3d> support_centroid;
   };
+  void resolve_supports();
   TrackingConfig config_;
   std::vector<Track> tracks_;          ///< confirmed
   std::vector<Track> tentative_;       ///< seen, not yet confirmed
