@@ -6,7 +6,7 @@ find_package(Boost 1.74 REQUIRED)
 
 # PCL: find_package(PCL) appends VTK, Qt, OpenNI and every other optional dependency to
 # PCL_LIBRARIES. We link only the component libraries we use, so binaries do not drag VTK in.
-find_package(PCL 1.12 REQUIRED COMPONENTS common io search kdtree filters sample_consensus segmentation octree)
+find_package(PCL 1.12 REQUIRED COMPONENTS common io search kdtree filters sample_consensus segmentation octree features)
 add_library(scenewatch_pcl INTERFACE)
 target_include_directories(scenewatch_pcl SYSTEM INTERFACE ${PCL_INCLUDE_DIRS})
 target_link_libraries(scenewatch_pcl INTERFACE
