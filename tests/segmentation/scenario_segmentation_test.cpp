@@ -27,7 +27,7 @@ struct SceneRun {
   std::vector<Segmentation> segmentations;
 };
 
-SceneRun run_scenario(const std::string& name) {
+SceneRun run_scenario(const std::string& name, int frame_step = 1, Config config = Config{}) {
   SceneRun run;
   auto loaded = sim::load_scenario(test::source_dir() / "sample_clouds/scenarios" / (name + ".yaml"));
   EXPECT_TRUE(loaded.ok()) << (loaded.ok() ? "" : loaded.error().message);
@@ -35,12 +35,14 @@ SceneRun run_scenario(const std::string& name) {
   auto simulator = sim::Simulator::create(*loaded);
   EXPECT_TRUE(simulator.ok());
   if (!simulator.ok()) return run;
-  for (int f = 0; f < simulator->frame_count(0); ++f) {
+  for (int f = 0; f < simulator->frame_count(0); f += frame_step) {
     const sim::SimFrame rendered = simulator->render(0, f);
     auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, simulator->scenario().intrinsics);
     EXPECT_TRUE(cloud.ok());
     if (!cloud.ok()) return run;
-    const std::vector<std::uint32_t> labels(rendered.labels.labels.begin(), rendered.labels.labels.end());
+    // Only what the sensor saw can be found (the glass has colour but no depth).
+    std::vector<std::uint32_t> labels(rendered.labels.labels.begin(), rendered.labels.labels.end());
+    for (std::size_t i = 0; i < labels.size(); ++i) labels[i] = is_valid((**cloud)[i]) ? labels[i] : 0;
     // As the working memory segments: in the world frame, z up (the room's floor is larger than
     // the table; the up-vector and the height band keep the table the support).
     Cloud world = **cloud;
@@ -51,7 +53,6 @@ SceneRun run_scenario(const std::string& name) {
       if (p.z > kMaxRangeM) p.x = p.y = p.z = std::numeric_limits<float>::quiet_NaN();
       else p.getVector3fMap() = (T * p.getVector3fMap().cast<double>()).cast<float>();
     }
-    Config config;
     config.up = Eigen::Vector3d::UnitZ();
     Segmentation seg = segment(world, config, T.translation());
     std::vector<std::vector<int>> clusters;
@@ -109,10 +110,21 @@ TEST(ScenarioSegmentation, StackedBoxesComeApartAndRestOnEachOther) {
 TEST(ScenarioSegmentation, TouchingObjectsComeApart) {
   const SceneRun run = run_scenario("touching");
   ASSERT_EQ(run.frames, 12u);
-  EXPECT_GE(run.matched, 27u) << "of " << run.objects << " visible objects";
-  EXPECT_GE(run.correct, 27u) << "of " << run.clusters << " clusters";
+  EXPECT_GE(run.matched, 28u) << "of " << run.objects << " visible objects";
+  EXPECT_GE(run.correct, 28u) << "of " << run.clusters << " clusters";
   for (const auto& seg : run.segmentations)
     for (const auto& o : seg.objects) EXPECT_EQ(o.supported_by, -1) << "everything stands on the table";
+}
+
+// Twelve objects close together (the clutter scenario of the stream tests, every sixth of its 90
+// frames): touching, occluded, a transparent glass (no depth: not counted), an open bowl and mug.
+TEST(ScenarioSegmentation, Clutter) {
+  const SceneRun run = run_scenario("clutter", 6);
+  ASSERT_EQ(run.frames, 15u);
+  // 148/151 and 154/175 when set (Euclidean clusters alone: 135/151 and 141/151); the wrong
+  // clusters are pieces of the open mug and bowl and the mug merged with the box it touches.
+  EXPECT_GE(run.matched, 148u) << "of " << run.objects << " visible objects";
+  EXPECT_GE(run.correct, 154u) << "of " << run.clusters << " clusters";
 }
 
 }  // namespace

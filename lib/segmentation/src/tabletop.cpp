@@ -17,6 +17,7 @@
 #include "scenewatch/segmentation/tabletop.h"
 #include "convex_parts.h"
 #include "hull2d.h"
+#include "occlusion_join.h"
 #include "support.h"
 #include "union_find.h"
 #include "voxel_index.h"
@@ -463,6 +464,7 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
   // Only a single view orients the patch normals (towards its sensor); a merged cloud of several
   // views keeps its Euclidean clusters.
   const bool split = cfg.split_concave && cloud.height > 1;
+  std::vector<Piece> pieces;
   for (std::size_t g = 0; g < groups.size(); ++g) {
     if (group_points[g].empty()) continue;
     const int p = owner[groups[g].front()];
@@ -471,9 +473,13 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     else parts.push_back(std::move(group_points[g]));
     for (auto& indices : parts) {
       const int n = static_cast<int>(indices.size());
-      if (n < cfg.min_cluster_points || n > cfg.max_cluster_points) continue;
-      out.objects.push_back(make_object(cloud, std::move(indices), p, frames[p].model.n));
+      if (n >= cfg.min_cluster_points && n <= cfg.max_cluster_points) pieces.push_back({std::move(indices), p});
     }
+  }
+  if (cfg.join_occluded) pieces = join_occluded_pieces(cloud, std::move(pieces), out.planes, OcclusionParams{});
+  for (Piece& piece : pieces) {
+    if (static_cast<int>(piece.indices.size()) > cfg.max_cluster_points) continue;
+    out.objects.push_back(make_object(cloud, std::move(piece.indices), piece.plane, frames[piece.plane].model.n));
   }
   std::stable_sort(out.objects.begin(), out.objects.end(),
                    [](const ObjectCluster& a, const ObjectCluster& b) { return a.point_count > b.point_count; });

@@ -47,6 +47,10 @@ struct Config {
   /// Concave links flatter than this are one object's curvature (the inside of a cup); steeper
   /// ones are creases between objects, which meet at about right angles: half of that.
   double crease_angle_deg = 45.0;
+  /// An object behind a narrower one shows on both sides of it: join two pieces when the image
+  /// between them is covered by something nearer and the surface continues across (organized
+  /// clouds only).
+  bool join_occluded = true;
 };
 
 /// Validates ranges; the message names the key (e.g. "segmentation.voxel_size_m").

@@ -1,0 +1,134 @@
+// Pieces of one occluded object: see occlusion_join.h. The walk goes along the image line between
+// the two pieces' pixel centroids.
+#include "occlusion_join.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "union_find.h"
+
+namespace scenewatch::segmentation {
+namespace {
+
+constexpr int kNone = -1, kSupport = -2;
+// Depth slope of a piece along the walk: from its last pixels before the gap.
+constexpr int kSlopePixels = 8;
+// Valid pixels of neither a piece nor the support tolerated on the walk (mixed pixels at edges).
+constexpr int kMaxStrayPixels = 3;
+
+struct PieceStats {
+  double u = 0, v = 0;  ///< pixel centroid
+  double top = 0;       ///< 95th percentile height above its plane
+};
+
+PieceStats stats_of(const Cloud& cloud, const Piece& piece, const Plane& plane) {
+  PieceStats s;
+  std::vector<double> heights;
+  heights.reserve(piece.indices.size());
+  for (int i : piece.indices) {
+    s.u += i % cloud.width;
+    s.v += i / cloud.width;
+    heights.push_back(plane.signed_distance(cloud[i].getVector3fMap().cast<double>()));
+  }
+  const double n = static_cast<double>(piece.indices.size());
+  s.u /= n;
+  s.v /= n;
+  const std::size_t k = heights.size() - 1 - heights.size() / 20;
+  std::nth_element(heights.begin(), heights.begin() + k, heights.end());
+  s.top = heights[k];
+  return s;
+}
+
+// Whether the walk from piece a to piece b crosses only nearer things (or no data) and the
+// surface of a, carried on, meets b.
+bool hidden_continuation(const Cloud& cloud, const std::vector<int>& owner, int a, int b, const PieceStats& sa,
+                         const PieceStats& sb, const OcclusionParams& params) {
+  const int steps = static_cast<int>(std::ceil(std::max(std::abs(sb.u - sa.u), std::abs(sb.v - sa.v))));
+  if (steps < 2) return false;
+  std::vector<int> line;
+  line.reserve(steps + 1);
+  for (int k = 0; k <= steps; ++k) {
+    const double t = static_cast<double>(k) / steps;
+    const int u = static_cast<int>(std::lround(sa.u + t * (sb.u - sa.u)));
+    const int v = static_cast<int>(std::lround(sa.v + t * (sb.v - sa.v)));
+    line.push_back(v * static_cast<int>(cloud.width) + u);
+  }
+  int last_a = -1, first_b = -1;
+  for (int k = 0; k <= steps; ++k) {
+    if (owner[line[k]] == a && first_b < 0) last_a = k;
+    if (owner[line[k]] == b && last_a >= 0 && first_b < 0) first_b = k;
+  }
+  if (last_a < 0 || first_b < 0 || first_b - last_a < 2) return false;
+  int occluder = 0, stray = 0;
+  for (int k = last_a + 1; k < first_b; ++k) {
+    const int o = owner[line[k]];
+    if (o == a || o == b || o == kSupport) return false;  // a glimpse of the support: a real gap
+    if (!is_valid(cloud[line[k]])) continue;
+    // Unsegmented: a few mixed pixels at a depth edge, or a gap onto something else.
+    if (o == kNone && ++stray > kMaxStrayPixels) return false;
+    if (o != kNone) ++occluder;
+  }
+  if (occluder == 0) return false;
+  // Depth of a along the walk (a least-squares line over its last pixels), carried to b.
+  double sk = 0, sz = 0, skk = 0, skz = 0, m = 0;
+  for (int k = std::max(0, last_a - kSlopePixels); k <= last_a; ++k) {
+    if (owner[line[k]] != a || !is_valid(cloud[line[k]])) continue;
+    const double z = cloud[line[k]].z;
+    sk += k, sz += z, skk += k * k, skz += k * z, m += 1;
+  }
+  const PointT& pb = cloud[line[first_b]];
+  if (m < 2 || !is_valid(pb)) return false;
+  const double den = m * skk - sk * sk;
+  const double slope = std::abs(den) < 1e-9 ? 0.0 : (m * skz - sk * sz) / den;
+  const double predicted = (sz - slope * sk) / m + slope * first_b;
+  // Everything crossed is in front of the carried surface.
+  for (int k = last_a + 1; k < first_b; ++k) {
+    const PointT& q = cloud[line[k]];
+    if (is_valid(q) && q.z > (sz - slope * sk) / m + slope * k) return false;
+  }
+  return std::abs(predicted - pb.z) <= params.max_depth_gap_m + params.max_depth_gap_rel * pb.z;
+}
+
+}  // namespace
+
+std::vector<Piece> join_occluded_pieces(const Cloud& cloud, std::vector<Piece> pieces, const std::vector<Plane>& planes,
+                                        const OcclusionParams& params) {
+  if (cloud.height <= 1 || pieces.size() < 2) return pieces;
+  std::vector<int> owner(cloud.size(), kNone);
+  for (const Plane& p : planes)
+    for (int i : p.indices) owner[i] = kSupport;
+  for (std::size_t p = 0; p < pieces.size(); ++p)
+    for (int i : pieces[p].indices) owner[i] = static_cast<int>(p);
+  std::vector<PieceStats> stats;
+  stats.reserve(pieces.size());
+  for (const Piece& p : pieces) stats.push_back(stats_of(cloud, p, planes[p.plane]));
+
+  UnionFind uf(pieces.size());
+  for (std::size_t a = 0; a < pieces.size(); ++a) {
+    for (std::size_t b = a + 1; b < pieces.size(); ++b) {
+      if (pieces[a].plane != pieces[b].plane) continue;
+      if (std::abs(stats[a].top - stats[b].top) > params.max_height_difference_m) continue;
+      const int ia = static_cast<int>(a), ib = static_cast<int>(b);
+      // Both ways: each side's surface, carried across, must meet the other.
+      if (hidden_continuation(cloud, owner, ia, ib, stats[a], stats[b], params) &&
+          hidden_continuation(cloud, owner, ib, ia, stats[b], stats[a], params)) {
+        uf.unite(ia, ib);
+      }
+    }
+  }
+  std::vector<Piece> joined(pieces.size());
+  for (std::size_t p = 0; p < pieces.size(); ++p) {
+    Piece& into = joined[uf.find(static_cast<int>(p))];
+    into.plane = pieces[p].plane;
+    into.indices.insert(into.indices.end(), pieces[p].indices.begin(), pieces[p].indices.end());
+  }
+  std::vector<Piece> out;
+  for (Piece& p : joined) {
+    if (p.indices.empty()) continue;
+    std::sort(p.indices.begin(), p.indices.end());
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+}  // namespace scenewatch::segmentation
