@@ -1,6 +1,8 @@
 // Two single observations: same-camera per-pixel reasoning, or BEFORE as a map and AFTER against it.
 #include "scenewatch/change/diff.h"
 
+#include "scenewatch/change/completion.h"
+
 #include <algorithm>
 #include <chrono>
 
@@ -36,6 +38,18 @@ bool same_pose(const Frame& a, const Frame& b) {
   return (Ta.matrix() - Tb.matrix()).cwiseAbs().maxCoeff() < 1e-6;
 }
 
+// Whole-object completion: each frame segmented in its own camera frame (the sensor at the
+// origin), each cluster replaced by the objects it belongs to.
+std::vector<ChangeCluster> complete(std::vector<ChangeCluster> clusters, const ClusterInput& in,
+                                    const segmentation::Config& seg_config, const Config& config) {
+  if (clusters.empty()) return clusters;  // nothing to complete: spare the segmentation
+  const ObjectLabels before = label_objects(segmentation::segment(*in.before_camera, seg_config), in.before_camera->size());
+  const ObjectLabels after = label_objects(segmentation::segment(*in.after_camera, seg_config), in.after_camera->size());
+  const CompletionFrame fb{in.before_camera, in.T_world_before, &before, in.K_after};
+  const CompletionFrame fa{in.after_camera, in.T_world_after, &after, in.K_after};
+  return complete_clusters(std::move(clusters), fb, fa, config);
+}
+
 }  // namespace
 
 const char* to_string(DiffMethod m) { return m == DiffMethod::kSameCamera ? "same-camera" : "map"; }
@@ -46,6 +60,7 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
   if (auto st = validate_side(after, "AFTER"); !st) return st.error();
   if (auto st = validate(options.change); !st) return st.error();
   if (auto st = background::validate(options.map); !st) return st.error();
+  if (auto st = segmentation::validate(options.segmentation); !st) return st.error();
   const Cloud& b = *before.cloud;
   const Cloud& a = *after.cloud;
   const bool both_organized = b.height > 1 && a.height > 1;
@@ -79,7 +94,13 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
     if (!mm) return mm.error();
     result.mismatch = std::move(*mm);
   }
-  result.changes = pair_changes(cluster_mismatch(result.mismatch, input, options.change), options.change);
+  std::vector<ChangeCluster> clusters = cluster_mismatch(result.mismatch, input, options.change);
+  if (options.change.complete_objects) {
+    const auto t1 = std::chrono::steady_clock::now();
+    clusters = complete(std::move(clusters), input, options.segmentation, options.change);
+    result.completion_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+  }
+  result.changes = pair_changes(std::move(clusters), options.change);
   std::uint64_t id = 1;
   for (const auto& c : result.changes) {
     Event e = to_event(c);
