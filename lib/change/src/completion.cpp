@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 #include <numeric>
 
 namespace scenewatch::change {
@@ -18,6 +19,47 @@ const CompletionFrame& frame_of(ChangeKind kind, const CompletionFrame& before, 
 }
 
 bool usable(const CompletionFrame& f) { return f.cloud_camera != nullptr && f.objects != nullptr; }
+
+// The other frame of the pair, asked about a point of a completion: does it see that surface
+// where it is, on an object of its own that no change claims? Then the surface stayed, on
+// something that did not change (a box under a new one, an object partly hidden behind a new
+// one), and is not part of the change. Needs the other frame's pixel grid (organized cloud).
+class Witness {
+ public:
+  Witness(const CompletionFrame& frame, const std::vector<char>& claimed, const Config& config)
+      : frame_(frame), claimed_(claimed), config_(config), T_camera_world_(frame.T_world_camera.inverse()) {}
+
+  bool sees_unchanged(const Eigen::Vector3d& p_world) const {
+    if (!usable(frame_) || frame_.cloud_camera->height <= 1 || !frame_.K.valid()) return false;
+    const Cloud& cloud = *frame_.cloud_camera;
+    const Eigen::Vector3d q = T_camera_world_ * p_world;
+    if (q.z() <= 0) return false;
+    const long u = std::lround(frame_.K.fx * q.x() / q.z() + frame_.K.cx);
+    const long v = std::lround(frame_.K.fy * q.y() / q.z() + frame_.K.cy);
+    if (u < 0 || v < 0 || u >= static_cast<long>(cloud.width) || v >= static_cast<long>(cloud.height)) return false;
+    const std::size_t j = static_cast<std::size_t>(v) * cloud.width + static_cast<std::size_t>(u);
+    const PointT& seen = cloud.points[j];
+    if (!is_valid(seen) || std::abs(seen.z - q.z()) > tolerance_m(config_, q.z())) return false;
+    const int o = frame_.objects->object_of[j];
+    return o >= 0 && !claimed_[o];
+  }
+
+ private:
+  const CompletionFrame& frame_;
+  const std::vector<char>& claimed_;
+  const Config& config_;
+  Pose T_camera_world_;
+};
+
+// Per object of `frame`: whether it explains some cluster of that frame's kind.
+std::vector<char> claimed_objects(const std::vector<ChangeCluster>& clusters, const std::vector<std::vector<int>>& objects,
+                                  ChangeKind kind, const CompletionFrame& frame) {
+  std::vector<char> claimed(usable(frame) ? frame.objects->members.size() : 0, 0);
+  for (std::size_t i = 0; i < clusters.size(); ++i)
+    if (clusters[i].kind == kind)
+      for (int o : objects[i]) claimed[o] = 1;
+  return claimed;
+}
 
 // Groups of clusters to become one: clusters of one kind that share an explaining object.
 // Groups come in the order of their first member.
@@ -78,11 +120,12 @@ void describe(ChangeCluster& c, const CompletionFrame& frame) {
   c.region = PixelRegion{u0, v0, u1 - u0 + 1, v1 - v0 + 1, static_cast<std::uint32_t>(c.indices.size())};
 }
 
-// One cluster from a group whose members have explaining objects: the objects' points plus the
-// members' evidence on no object (the foot of an object below the segmentation's minimum
-// height, a part the clustering dropped), which is still this change's.
+// One cluster from a group whose members have explaining objects: the objects' points that the
+// other frame does not see unchanged, plus the members' evidence on no object (the foot of an
+// object below the segmentation's minimum height, a part the clustering dropped), which is still
+// this change's.
 ChangeCluster completed(const std::vector<ChangeCluster>& clusters, const std::vector<std::vector<int>>& objects,
-                        const std::vector<int>& group, const CompletionFrame& frame) {
+                        const std::vector<int>& group, const CompletionFrame& frame, const Witness& other) {
   const ObjectLabels& labels = *frame.objects;
   ChangeCluster c = clusters[group.front()];
   std::vector<char> taken(labels.members.size(), 0);
@@ -96,8 +139,12 @@ ChangeCluster completed(const std::vector<ChangeCluster>& clusters, const std::v
     gap_sum += clusters[m].mean_gap_m * static_cast<double>(clusters[m].evidence_count);
     evidence += clusters[m].evidence_count;
   }
-  for (std::size_t o = 0; o < taken.size(); ++o)
-    if (taken[o]) c.indices.insert(c.indices.end(), labels.members[o].begin(), labels.members[o].end());
+  const Cloud& cloud = *frame.cloud_camera;
+  for (std::size_t o = 0; o < taken.size(); ++o) {
+    if (!taken[o]) continue;
+    for (int i : labels.members[o])
+      if (!other.sees_unchanged(frame.T_world_camera * cloud.points[i].getVector3fMap().cast<double>())) c.indices.push_back(i);
+  }
   std::sort(c.indices.begin(), c.indices.end());
   c.indices.erase(std::unique(c.indices.begin(), c.indices.end()), c.indices.end());
   c.evidence_count = evidence;
@@ -108,17 +155,6 @@ ChangeCluster completed(const std::vector<ChangeCluster>& clusters, const std::v
 }
 
 }  // namespace
-
-ObjectLabels label_objects(const segmentation::Segmentation& segmentation, std::size_t cloud_size) {
-  ObjectLabels labels;
-  labels.object_of.assign(cloud_size, -1);
-  for (const auto& object : segmentation.objects) {
-    const int id = static_cast<int>(labels.members.size());
-    for (int i : object.indices) labels.object_of[i] = id;
-    labels.members.push_back(object.indices);
-  }
-  return labels;
-}
 
 std::vector<int> explaining_objects(const std::vector<int>& evidence, const ObjectLabels& labels, const Config& config) {
   std::vector<std::size_t> on(labels.members.size(), 0);
@@ -146,13 +182,17 @@ std::vector<ChangeCluster> complete_clusters(std::vector<ChangeCluster> clusters
     const CompletionFrame& f = frame_of(clusters[i].kind, before, after);
     if (usable(f)) objects[i] = explaining_objects(clusters[i].indices, *f.objects, config);
   }
+  const std::vector<char> claimed_before = claimed_objects(clusters, objects, ChangeKind::kRemoved, before);
+  const std::vector<char> claimed_after = claimed_objects(clusters, objects, ChangeKind::kAdded, after);
+  const Witness witness_before(before, claimed_before, config), witness_after(after, claimed_after, config);
   std::vector<ChangeCluster> out;
   for (const auto& group : merge_groups(clusters, objects)) {
     if (objects[group.front()].empty()) {  // no object explains it (a group of one): keep the evidence
       out.push_back(std::move(clusters[group.front()]));
       continue;
     }
-    out.push_back(completed(clusters, objects, group, frame_of(clusters[group.front()].kind, before, after)));
+    const bool added = clusters[group.front()].kind == ChangeKind::kAdded;
+    out.push_back(completed(clusters, objects, group, added ? after : before, added ? witness_before : witness_after));
   }
   return out;
 }

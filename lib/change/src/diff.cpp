@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <future>
 
 namespace scenewatch::change {
 namespace {
@@ -40,12 +41,17 @@ bool same_pose(const Frame& a, const Frame& b) {
 
 // Whole-object completion: each frame segmented in its own camera frame (the sensor at the
 // origin), each cluster replaced by the objects it belongs to.
-std::vector<ChangeCluster> complete(std::vector<ChangeCluster> clusters, const ClusterInput& in,
+std::vector<ChangeCluster> complete(std::vector<ChangeCluster> clusters, const ClusterInput& in, const Intrinsics& K_before,
                                     const segmentation::Config& seg_config, const Config& config) {
   if (clusters.empty()) return clusters;  // nothing to complete: spare the segmentation
-  const ObjectLabels before = label_objects(segmentation::segment(*in.before_camera, seg_config), in.before_camera->size());
-  const ObjectLabels after = label_objects(segmentation::segment(*in.after_camera, seg_config), in.after_camera->size());
-  const CompletionFrame fb{in.before_camera, in.T_world_before, &before, in.K_after};
+  // The frames are independent: BEFORE is segmented on a second thread meanwhile (as the
+  // pipeline compares against map and memory at once).
+  auto before_future = std::async(std::launch::async, [&] {
+    return segment_objects(*in.before_camera, seg_config, config.completion_stride_px);
+  });
+  const ObjectLabels after = segment_objects(*in.after_camera, seg_config, config.completion_stride_px);
+  const ObjectLabels before = before_future.get();
+  const CompletionFrame fb{in.before_camera, in.T_world_before, &before, K_before};
   const CompletionFrame fa{in.after_camera, in.T_world_after, &after, in.K_after};
   return complete_clusters(std::move(clusters), fb, fa, config);
 }
@@ -79,6 +85,14 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
   if (!K) return invalid_argument("AFTER: " + K.error().message);
   input.K_after = *K;
 
+  // BEFORE's camera: AFTER's when it is the same camera (one pixel grid), else its own.
+  Intrinsics K_before = *K;
+  if (!(both_organized && same_pose(before, after))) {
+    auto Kb = observation_camera(b, before.intrinsics);
+    if (!Kb) return invalid_argument("BEFORE: " + Kb.error().message);
+    K_before = *Kb;
+  }
+
   if (both_organized && same_pose(before, after) && !options.force_map) {
     result.method = DiffMethod::kSameCamera;
     auto mm = mismatch_same_camera(b, a, options.change);
@@ -97,7 +111,7 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
   std::vector<ChangeCluster> clusters = cluster_mismatch(result.mismatch, input, options.change);
   if (options.change.complete_objects) {
     const auto t1 = std::chrono::steady_clock::now();
-    clusters = complete(std::move(clusters), input, options.segmentation, options.change);
+    clusters = complete(std::move(clusters), input, K_before, options.segmentation, options.change);
     result.completion_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
   }
   result.changes = pair_changes(std::move(clusters), options.change);

@@ -6,19 +6,10 @@
 /// clusters of one kind completed to a shared object become one.
 #include <vector>
 
+#include "scenewatch/change/frame_objects.h"
 #include "scenewatch/change/objects.h"
-#include "scenewatch/segmentation/tabletop.h"
 
 namespace scenewatch::change {
-
-/// Which segmented object each point of a frame belongs to, and each object's points.
-struct ObjectLabels {
-  std::vector<int> object_of;              ///< per point of the cloud: object index, -1 for none
-  std::vector<std::vector<int>> members;  ///< per object: its point indices, ascending
-};
-
-/// The labels of a segmentation of a cloud of `cloud_size` points.
-ObjectLabels label_objects(const segmentation::Segmentation& segmentation, std::size_t cloud_size);
 
 /// The objects that `evidence` (point indices) substantially belongs to: each carrying at least
 /// config.completion_evidence_share of the evidence, or covered by it for at least
