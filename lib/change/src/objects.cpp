@@ -194,12 +194,11 @@ std::vector<ChangeCluster> cluster_mismatch(const Mismatch& mm, const ClusterInp
 }
 
 double move_similarity(const ChangeCluster& removed, const ChangeCluster& added, const Config& config) {
-  // Evidence clusters closer than move_min_distance_m are one object's border residue. Whole
-  // objects (completed) compare their own centroids: any displacement beyond the smallest depth
-  // difference the detector claims (min_tolerance_m) is measured, so a 2 cm move is a move.
+  // Evidence clusters closer than move_min_distance_m are one object's border residue. Not so
+  // whole objects (completed): evidence that left one and entered the other shows the object
+  // moved, by however little (2 cm), or turned in place (its centroid may then stay put).
   const bool whole = removed.completed && added.completed;
-  const double min_distance_m = whole ? config.min_tolerance_m : config.move_min_distance_m;
-  if ((added.centroid_world - removed.centroid_world).norm() < min_distance_m) return 0.0;
+  if (!whole && (added.centroid_world - removed.centroid_world).norm() < config.move_min_distance_m) return 0.0;
   const Eigen::Vector3d a = removed.sorted_extent(), b = added.sorted_extent();
   double size = 1.0;
   for (int i = 0; i < 2; ++i) {  // the two largest sides; the third is often a partial view
