@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <numeric>
 
 #include "scenewatch/change/completion.h"
@@ -152,6 +153,43 @@ TEST(Completion, SurfacesTheOtherFrameSeesOnAnUnchangedObjectStayOut) {
   const auto out = complete_clusters({cluster_on(after, ChangeKind::kAdded, evidence)}, fb, fa, Config{});
   ASSERT_EQ(out.size(), 1u);
   EXPECT_EQ(out[0].indices, evidence) << "the old object's surface, seen where it was, is not the new one's";
+}
+
+// A 100x10 wall at 1 m; pieces at 0.9 m over columns [10, 30) and [60, 80); between them
+// columns [30, 60) at `gap_z` (NaN: no depth), with a sensor shadow at columns 30-31.
+struct SplitScene {
+  Cloud cloud = flat_cloud();
+  ObjectLabels labels;
+  explicit SplitScene(float gap_z) {
+    labels.object_of.assign(cloud.size(), -1);
+    labels.members.resize(2);
+    for (int v = 0; v < 10; ++v)
+      for (int u = 10; u < 80; ++u) {
+        const int i = v * 100 + u;
+        PointT& p = cloud.points[i];
+        const float z = u < 30 || u >= 60 ? 0.9f : u < 32 ? std::numeric_limits<float>::quiet_NaN() : gap_z;
+        p.x = (u - 49.5f) * z / 525.f;
+        p.y = (v - 4.5f) * z / 525.f;
+        p.z = z;
+        if (u >= 30 && u < 60) continue;
+        const int o = u < 30 ? 0 : 1;
+        labels.object_of[i] = o;
+        labels.members[o].push_back(i);
+      }
+  }
+};
+
+TEST(Completion, PiecesSplitByANearerSurfaceAreOneObject) {
+  SplitScene hidden(0.6f);
+  join_hidden_pieces(hidden.labels, hidden.cloud, Config{});
+  ASSERT_EQ(hidden.labels.members.size(), 1u) << "a box in front cuts one object in two";
+  EXPECT_EQ(hidden.labels.members[0].size(), 400u);
+  SplitScene apart(1.0f);
+  join_hidden_pieces(apart.labels, apart.cloud, Config{});
+  EXPECT_EQ(apart.labels.members.size(), 2u) << "the wall behind shows between them: two objects";
+  SplitScene shadow(std::numeric_limits<float>::quiet_NaN());
+  join_hidden_pieces(shadow.labels, shadow.cloud, Config{});
+  EXPECT_EQ(shadow.labels.members.size(), 2u) << "nothing seen between them: no reason to join";
 }
 
 // Point IoU of two index sets.

@@ -46,10 +46,13 @@ std::vector<ChangeCluster> complete(std::vector<ChangeCluster> clusters, const C
   if (clusters.empty()) return clusters;  // nothing to complete: spare the segmentation
   // The frames are independent: BEFORE is segmented on a second thread meanwhile (as the
   // pipeline compares against map and memory at once).
-  auto before_future = std::async(std::launch::async, [&] {
-    return segment_objects(*in.before_camera, seg_config, config.completion_stride_px);
-  });
-  const ObjectLabels after = segment_objects(*in.after_camera, seg_config, config.completion_stride_px);
+  auto objects_of = [&](const Cloud& cloud) {
+    ObjectLabels labels = segment_objects(cloud, seg_config, config.completion_stride_px);
+    join_hidden_pieces(labels, cloud, config);
+    return labels;
+  };
+  auto before_future = std::async(std::launch::async, [&] { return objects_of(*in.before_camera); });
+  const ObjectLabels after = objects_of(*in.after_camera);
   const ObjectLabels before = before_future.get();
   const CompletionFrame fb{in.before_camera, in.T_world_before, &before, K_before};
   const CompletionFrame fa{in.after_camera, in.T_world_after, &after, in.K_after};

@@ -2,6 +2,7 @@
 /// The segmented objects of one frame by point, for whole-object completion (completion.h).
 #include <vector>
 
+#include "scenewatch/change/mismatch.h"
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/segmentation/tabletop.h"
 
@@ -22,5 +23,12 @@ ObjectLabels label_objects(const segmentation::Segmentation& segmentation, std::
 /// pixel, when that sample lies within one segmentation voxel of it. Unorganized clouds, and
 /// stride_px 1, are segmented whole.
 ObjectLabels segment_objects(const Cloud& cloud_camera, const segmentation::Config& config, int stride_px);
+
+/// Joins the pieces of one object that a nearer one splits (a lying tin behind a standing box):
+/// two objects of an organized cloud whose pixels, along the line between their pixel centroids,
+/// are separated by a stretch that shows a surface in front of both (by more than the tolerance
+/// at its depth, `config`; pixels without depth aside, so long as they are fewer). Unorganized
+/// clouds are left as they are.
+void join_hidden_pieces(ObjectLabels& labels, const Cloud& cloud_camera, const Config& config);
 
 }  // namespace scenewatch::change
