@@ -92,6 +92,13 @@ std::vector<std::vector<int>> merge_groups(const std::vector<ChangeCluster>& clu
   return groups;
 }
 
+// Appends an ascending run to an ascending list, keeping it ascending.
+void merge_run(std::vector<int>& sorted, const std::vector<int>& run) {
+  const auto mid = static_cast<std::ptrdiff_t>(sorted.size());
+  sorted.insert(sorted.end(), run.begin(), run.end());
+  std::inplace_merge(sorted.begin(), sorted.begin() + mid, sorted.end());
+}
+
 // Points, box, centroid, colour and pixel region of a cluster from its indices in `frame`.
 void describe(ChangeCluster& c, const CompletionFrame& frame) {
   const Cloud& cloud = *frame.cloud_camera;
@@ -127,29 +134,32 @@ void describe(ChangeCluster& c, const CompletionFrame& frame) {
 ChangeCluster completed(const std::vector<ChangeCluster>& clusters, const std::vector<std::vector<int>>& objects,
                         const std::vector<int>& group, const CompletionFrame& frame, const Witness& other) {
   const ObjectLabels& labels = *frame.objects;
-  ChangeCluster c = clusters[group.front()];
+  ChangeCluster c;
+  c.kind = clusters[group.front()].kind;
+  c.completed = true;
   std::vector<char> taken(labels.members.size(), 0);
   double gap_sum = 0;
-  std::size_t evidence = 0;
-  c.indices.clear();
+  std::vector<int> run;
+  // Every run below is ascending and disjoint from the others (clusters share no evidence,
+  // objects no points, and this evidence lies on no object): merging keeps the indices sorted.
   for (int m : group) {
     for (int o : objects[m]) taken[o] = 1;
+    run.clear();
     for (int i : clusters[m].indices)
-      if (labels.object_of[i] < 0) c.indices.push_back(i);
+      if (labels.object_of[i] < 0) run.push_back(i);
+    merge_run(c.indices, run);
     gap_sum += clusters[m].mean_gap_m * static_cast<double>(clusters[m].evidence_count);
-    evidence += clusters[m].evidence_count;
+    c.evidence_count += clusters[m].evidence_count;
   }
   const Cloud& cloud = *frame.cloud_camera;
   for (std::size_t o = 0; o < taken.size(); ++o) {
     if (!taken[o]) continue;
+    run.clear();
     for (int i : labels.members[o])
-      if (!other.sees_unchanged(frame.T_world_camera * cloud.points[i].getVector3fMap().cast<double>())) c.indices.push_back(i);
+      if (!other.sees_unchanged(frame.T_world_camera * cloud.points[i].getVector3fMap().cast<double>())) run.push_back(i);
+    merge_run(c.indices, run);
   }
-  std::sort(c.indices.begin(), c.indices.end());
-  c.indices.erase(std::unique(c.indices.begin(), c.indices.end()), c.indices.end());
-  c.evidence_count = evidence;
-  c.mean_gap_m = evidence > 0 ? gap_sum / static_cast<double>(evidence) : c.mean_gap_m;
-  c.completed = true;
+  c.mean_gap_m = c.evidence_count > 0 ? gap_sum / static_cast<double>(c.evidence_count) : 0.0;
   describe(c, frame);
   return c;
 }

@@ -2,6 +2,7 @@
 #include "scenewatch/change/frame_objects.h"
 
 #include <algorithm>
+#include <array>
 #include <limits>
 
 namespace scenewatch::change {
@@ -41,31 +42,38 @@ class Upsampler {
     std::vector<int> out;
     for (int v = std::max(0, (sv0 - 1) * stride_); v <= std::min(h_ - 1, (sv1 + 1) * stride_); ++v)
       for (int u = std::max(0, (su0 - 1) * stride_); u <= std::min(w_ - 1, (su1 + 1) * stride_); ++u) {
-        const int i = v * w_ + u;
-        if (nearest_object(u, v) == o) out.push_back(i);
+        if (near_object(u, v, o)) out.push_back(v * w_ + u);
       }
     return out;
   }
 
  private:
-  int nearest_object(int u, int v) const {
+  // True when the nearest valid sample around pixel (u, v) belongs to object o and lies within
+  // reach. Pixels with no sample of o around them (most of a bounding box) return at once.
+  bool near_object(int u, int v, int o) const {
+    std::array<int, 4> samples{-1, -1, -1, -1};
+    bool any = false;
+    for (int k = 0; k < 4; ++k) {
+      const int su = u / stride_ + (k & 1), sv = v / stride_ + (k >> 1);
+      if (su >= sw_ || sv >= sh_) continue;
+      samples[k] = sv * sw_ + su;
+      any = any || coarse_.object_of[samples[k]] == o;
+    }
     const PointT& p = cloud_.points[static_cast<std::size_t>(v) * w_ + u];
-    if (!is_valid(p)) return -1;
+    if (!any || !is_valid(p)) return false;
     float best = std::numeric_limits<float>::infinity();
     int object = -1;
-    for (int dv = 0; dv <= 1; ++dv)
-      for (int du = 0; du <= 1; ++du) {
-        const int su = u / stride_ + du, sv = v / stride_ + dv;
-        if (su >= sw_ || sv >= sh_) continue;
-        const PointT& q = cloud_.points[static_cast<std::size_t>(sv * stride_) * w_ + su * stride_];
-        if (!is_valid(q)) continue;
-        const float d2 = (q.getVector3fMap() - p.getVector3fMap()).squaredNorm();
-        if (d2 < best) {
-          best = d2;
-          object = coarse_.object_of[static_cast<std::size_t>(sv) * sw_ + su];
-        }
+    for (int s : samples) {
+      if (s < 0) continue;
+      const PointT& q = cloud_.points[static_cast<std::size_t>(s / sw_ * stride_) * w_ + (s % sw_) * stride_];
+      if (!is_valid(q)) continue;
+      const float d2 = (q.getVector3fMap() - p.getVector3fMap()).squaredNorm();
+      if (d2 < best) {
+        best = d2;
+        object = coarse_.object_of[s];
       }
-    return best <= reach2_ ? object : -1;
+    }
+    return object == o && best <= reach2_;
   }
 
   const Cloud& cloud_;
