@@ -339,6 +339,7 @@ TEST(CompletionSim, AnObjectHiddenBehindANewOneIsNotRemoved) {
   TrueChange added;
   added.object_id = 3;
   added.indices_after = box;
+  std::printf("IoU with the new box: %.3f\n", change_iou(e, added));
   EXPECT_GE(change_iou(e, added), 0.9);
   std::vector<int> tin_in_event;
   std::set_intersection(e.indices_after.begin(), e.indices_after.end(), tin_after.begin(), tin_after.end(),
