@@ -20,18 +20,28 @@
 namespace scenewatch::change {
 namespace {
 
-// Labels of a frame of `n` points with objects over index ranges [begin, end).
-ObjectLabels labels_of(std::size_t n, const std::vector<std::pair<int, int>>& objects) {
+using Spans = std::vector<std::pair<int, int>>;  // index ranges [begin, end)
+
+// Labels of a frame of `n` points, one object per list of index ranges.
+ObjectLabels labels_of(std::size_t n, const std::vector<Spans>& objects) {
   ObjectLabels l;
   l.object_of.assign(n, -1);
-  for (const auto& [begin, end] : objects) {
+  for (const Spans& spans : objects) {
     l.members.emplace_back();
-    for (int i = begin; i < end; ++i) {
-      l.object_of[i] = static_cast<int>(l.members.size()) - 1;
-      l.members.back().push_back(i);
-    }
+    for (const auto& [begin, end] : spans)
+      for (int i = begin; i < end; ++i) {
+        l.object_of[i] = static_cast<int>(l.members.size()) - 1;
+        l.members.back().push_back(i);
+      }
   }
   return l;
+}
+
+// Columns [u0, u1) of every row of a 100x10 image.
+Spans columns(int u0, int u1) {
+  Spans spans;
+  for (int v = 0; v < 10; ++v) spans.emplace_back(v * 100 + u0, v * 100 + u1);
+  return spans;
 }
 
 std::vector<int> range(int begin, int end) {
@@ -41,7 +51,7 @@ std::vector<int> range(int begin, int end) {
 }
 
 TEST(Completion, AFringeBelongsToItsObjectAStrayMinorityDoesNot) {
-  const ObjectLabels l = labels_of(1000, {{0, 400}, {400, 500}, {500, 900}});
+  const ObjectLabels l = labels_of(1000, {{{0, 400}}, {{400, 500}}, {{500, 900}}});
   const Config config;
   // The fringe a short move uncovers: a tenth of object 0, all of the evidence on it.
   EXPECT_EQ(explaining_objects(range(0, 40), l, config), std::vector<int>{0});
@@ -97,17 +107,8 @@ Intrinsics flat_camera() {
 
 TEST(Completion, TwoFringesOfOneObjectBecomeOneWholeObject) {
   const Cloud before = flat_cloud(), after = flat_cloud();
-  // AFTER: one object over rows 0-9, columns 20-59 (indices by row); BEFORE: none.
-  std::vector<std::pair<int, int>> spans;
-  for (int v = 0; v < 10; ++v) spans.emplace_back(v * 100 + 20, v * 100 + 60);
-  ObjectLabels la;
-  la.object_of.assign(after.size(), -1);
-  la.members.emplace_back();
-  for (const auto& [b, e] : spans)
-    for (int i = b; i < e; ++i) {
-      la.object_of[i] = 0;
-      la.members[0].push_back(i);
-    }
+  // AFTER: one object over columns 20-59; BEFORE: none.
+  const ObjectLabels la = labels_of(after.size(), {columns(20, 60)});
   const ObjectLabels lb = labels_of(before.size(), {});
   const CompletionFrame fb{&before, Pose::Identity(), &lb, flat_camera()};
   const CompletionFrame fa{&after, Pose::Identity(), &la, flat_camera()};
@@ -128,23 +129,7 @@ TEST(Completion, SurfacesTheOtherFrameSeesOnAnUnchangedObjectStayOut) {
   // AFTER: one segment over columns 0-59 (a new object merged with an old one it touches);
   // BEFORE: the old object alone over columns 40-59, at the same depth, with no change on it.
   const Cloud before = flat_cloud(), after = flat_cloud();
-  std::vector<std::pair<int, int>> merged, old;
-  for (int v = 0; v < 10; ++v) {
-    merged.emplace_back(v * 100, v * 100 + 60);
-    old.emplace_back(v * 100 + 40, v * 100 + 60);
-  }
-  auto spans_labels = [&](const std::vector<std::pair<int, int>>& spans) {
-    ObjectLabels l;
-    l.object_of.assign(before.size(), -1);
-    l.members.emplace_back();
-    for (const auto& [b, e] : spans)
-      for (int i = b; i < e; ++i) {
-        l.object_of[i] = 0;
-        l.members[0].push_back(i);
-      }
-    return l;
-  };
-  const ObjectLabels la = spans_labels(merged), lb = spans_labels(old);
+  const ObjectLabels la = labels_of(after.size(), {columns(0, 60)}), lb = labels_of(before.size(), {columns(40, 60)});
   const CompletionFrame fb{&before, Pose::Identity(), &lb, flat_camera()};
   const CompletionFrame fa{&after, Pose::Identity(), &la, flat_camera()};
   std::vector<int> evidence;

@@ -88,12 +88,12 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
   if (!K) return invalid_argument("AFTER: " + K.error().message);
   input.K_after = *K;
 
-  // BEFORE's camera: AFTER's when it is the same camera (one pixel grid), else its own.
+  // BEFORE's camera, for completion: AFTER's when it is the same camera (one pixel grid), else
+  // its own, or AFTER's when none fits BEFORE (as for the evidence: only BEFORE's pixel regions
+  // suffer, and the other-frame test needs an organized cloud anyway).
   Intrinsics K_before = *K;
   if (!(both_organized && same_pose(before, after))) {
-    auto Kb = observation_camera(b, before.intrinsics);
-    if (!Kb) return invalid_argument("BEFORE: " + Kb.error().message);
-    K_before = *Kb;
+    if (auto Kb = observation_camera(b, before.intrinsics)) K_before = *Kb;
   }
 
   if (both_organized && same_pose(before, after) && !options.force_map) {
