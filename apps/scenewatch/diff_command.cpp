@@ -52,6 +52,7 @@ int run_diff(const DiffOptions& options) {
     if (!config) return fail(config.error().message);
     diff_options.change = config->change;
     diff_options.map = config->background;
+    diff_options.segmentation = config->segmentation;
   }
   if (options.resolution_m > 0) diff_options.map.resolution_m = options.resolution_m;
   diff_options.force_map = options.force_map;

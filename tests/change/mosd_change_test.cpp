@@ -2,7 +2,8 @@
 // removed or moved. The labels give the objects; a labelled object of AFTER with no labelled
 // object surface of BEFORE within 1 cm is a true addition (and the other way round a removal,
 // unless AFTER occludes it). Object-level precision and recall, strict (point IoU >= 0.5 with the
-// whole object, both ways), are printed per pair and overall.
+// whole object, both ways), are printed per pair and overall, and overall for the evidence alone
+// (change.complete_objects off: what diff reported before issue 10's whole-object events).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -47,9 +48,11 @@ TEST(MosdChange, SameCameraPairs) {
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
   std::vector<Scene> scenes;
   for (int i = 0; i <= 44; ++i) scenes.push_back(load(i));
-  ChangeScore total;
+  ChangeScore total, evidence_only;
+  DiffOptions without_completion;
+  without_completion.change.complete_objects = false;
   std::size_t pairs = 0, pairs_with_change = 0;
-  std::vector<double> ms;
+  std::vector<double> ms, completion_ms;
   for (int i = 0; i + 1 <= 44; ++i) {
     const Scene &b = scenes[i], &a = scenes[i + 1];
     if (!b.file.cloud || !a.file.cloud || !same_camera(b, a)) continue;
@@ -62,18 +65,29 @@ TEST(MosdChange, SameCameraPairs) {
     EXPECT_EQ(result->method, DiffMethod::kSameCamera);
     const ChangeScore s = score_changes(result->events, truth);
     total += s;
+    auto fringe = diff(fb, fa, without_completion);
+    ASSERT_TRUE(fringe.ok()) << fringe.error().message;
+    evidence_only += score_changes(fringe->events, truth);
     ++pairs;
     pairs_with_change += truth.empty() ? 0 : 1;
     ms.push_back(result->total_ms);
+    completion_ms.push_back(result->completion_ms);
     std::printf("  learn%-2d -> learn%-2d  truth %zu (", i, i + 1, truth.size());
     for (const auto& t : truth) std::printf(" %s%u", t.indices_after.empty() ? "-" : "+", t.object_id);
     std::printf(" ) events %zu:", result->events.size());
     for (const auto& e : result->events) {
-      std::printf(" %s(%zu/%zu)", to_string(e.kind), e.indices_before.size(), e.indices_after.size());
+      double best = 0;
+      for (const auto& t : truth) best = std::max(best, change_iou(e, t));
+      std::printf(" %s(%zu/%zu %.2f)", to_string(e.kind), e.indices_before.size(), e.indices_after.size(), best);
+    }
+    for (const auto& t : truth) {
+      double best = 0;
+      for (const auto& e : result->events) best = std::max(best, change_iou(e, t));
+      if (best < 0.5) std::printf("\n     missed %s%u (%zu/%zu points) best IoU %.2f", t.indices_after.empty() ? "-" : "+", t.object_id, t.indices_before.size(), t.indices_after.size(), best);
     }
     for (const auto& e : result->events) {
       bool m = false;
-      for (const auto& t : truth) m = m || change_iou(e, t) >= 0.3;
+      for (const auto& t : truth) m = m || change_iou(e, t) >= 0.5;
       if (m) continue;
       std::map<std::uint32_t, int> hist;
       for (int k : e.indices_after) ++hist[a.labels[k]];
@@ -81,20 +95,33 @@ TEST(MosdChange, SameCameraPairs) {
       std::printf("\n     unmatched %s size %.3f at %.2f %.2f %.2f:", to_string(e.kind), e.evidence.at("size_m"), e.centroid_world.x(), e.centroid_world.y(), e.centroid_world.z());
       for (auto [l, n] : hist) std::printf(" %u:%d", l, n);
     }
-    std::printf(" | matched events %zu/%zu changes %zu/%zu IoU %.2f | %.1f ms\n", s.matched_events, s.events,
-                s.matched_changes, s.true_changes, s.mean_iou(), result->total_ms);
+    std::printf(" | matched events %zu/%zu changes %zu/%zu IoU %.2f | %.1f ms (completion %.1f)\n", s.matched_events,
+                s.events, s.matched_changes, s.true_changes, s.mean_iou(), result->total_ms, result->completion_ms);
   }
-  std::sort(ms.begin(), ms.end());
-  std::printf("mOSD same-camera pairs: %zu (%zu with a change): precision %.3f (%zu/%zu) recall %.3f (%zu/%zu) mean IoU %.3f, median %.1f ms\n",
+  auto median = [](std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : v[v.size() / 2];
+  };
+  std::printf("mOSD same-camera pairs: %zu (%zu with a change): precision %.3f (%zu/%zu) recall %.3f (%zu/%zu) mean IoU %.3f, "
+              "median %.1f ms per pair, of which whole-object completion %.1f ms\n",
               pairs, pairs_with_change, total.precision(), total.matched_events, total.events, total.recall(),
-              total.matched_changes, total.true_changes, total.mean_iou(), ms.empty() ? 0.0 : ms[ms.size() / 2]);
+              total.matched_changes, total.true_changes, total.mean_iou(), median(ms), median(completion_ms));
+  std::printf("the evidence alone (no completion): precision %.3f (%zu/%zu) recall %.3f (%zu/%zu) mean IoU %.3f\n",
+              evidence_only.precision(), evidence_only.matched_events, evidence_only.events, evidence_only.recall(),
+              evidence_only.matched_changes, evidence_only.true_changes, evidence_only.mean_iou());
   EXPECT_GE(pairs, 15u) << "the data README lists about twenty same-camera pairs";
   EXPECT_GE(total.true_changes, 8u);
-  // Strict scoring (IoU >= 0.5 with the whole object, both ways): 0.558 and 0.634 when these
-  // floors were set; the lenient scoring of before (majority precision, recall at IoU 0.3) gave
-  // 0.826 and 0.871 on the same events. Issue 10 (whole-object events) is to raise them.
-  EXPECT_GE(total.precision(), 0.55);
-  EXPECT_GE(total.recall(), 0.63);
+  // Strict scoring (IoU >= 0.5 with the whole object, both ways). Whole-object events (issue 10):
+  // 0.870 (60/69) and 0.861 (87/101) when these floors were set, against 0.558 and 0.634 for the
+  // evidence alone. Most of what is left: stacked boxes (learn17-24) and stacked tins (learn40->41),
+  // which the segmentation returns as one object (12 of the 14 missed changes, 4 of the 9
+  // unmatched events); moves of 2 cm and turns in place that the label truth cannot see (an object
+  // mostly within 1 cm of where it was counts as unchanged: learn3->4, 10->11, 12->13, 3 unmatched
+  // events); bowls the segmentation cuts into pieces (2).
+  EXPECT_GE(total.precision(), 0.86);
+  EXPECT_GE(total.recall(), 0.85);
+  EXPECT_GT(total.precision(), evidence_only.precision()) << "completion must pay for itself";
+  EXPECT_GT(total.recall(), evidence_only.recall()) << "completion must pay for itself";
 }
 
 }  // namespace

@@ -84,10 +84,10 @@ PairFigures run_pair(const std::string& scenario_name, std::size_t phase_before,
   EXPECT_TRUE(result.ok()) << (result.ok() ? "" : result.error().message);
   if (!result.ok()) return figures;
   figures.score = score_changes(result->events, truth);
-  std::printf("%-16s %s: %zu events, %zu true changes (%zu without depth left out) | precision %.2f recall %.2f IoU %.2f | %.1f ms (grid %.1f added %.1f removed %.1f)\n",
+  std::printf("%-16s %s: %zu events, %zu true changes (%zu without depth left out) | precision %.2f recall %.2f IoU %.2f | %.1f ms (grid %.1f added %.1f removed %.1f completion %.1f)\n",
               scenario_name.c_str(), to_string(result->method), result->events.size(), truth.size(), figures.left_out,
               figures.score.precision(), figures.score.recall(), figures.score.mean_iou(), result->total_ms,
-              result->mismatch.grid_ms, result->mismatch.added_ms, result->mismatch.missing_ms);
+              result->mismatch.grid_ms, result->mismatch.added_ms, result->mismatch.missing_ms, result->completion_ms);
   for (const auto& e : result->events) {
     std::printf("    %s at (%.3f %.3f %.3f) %s | before %zu after %zu pts\n", to_string(e.kind), e.centroid_world.x(),
                 e.centroid_world.y(), e.centroid_world.z(), e.detail.c_str(), e.indices_before.size(), e.indices_after.size());

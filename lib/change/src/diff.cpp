@@ -1,8 +1,11 @@
 // Two single observations: same-camera per-pixel reasoning, or BEFORE as a map and AFTER against it.
 #include "scenewatch/change/diff.h"
 
+#include "scenewatch/change/completion.h"
+
 #include <algorithm>
 #include <chrono>
+#include <future>
 
 namespace scenewatch::change {
 namespace {
@@ -36,6 +39,26 @@ bool same_pose(const Frame& a, const Frame& b) {
   return (Ta.matrix() - Tb.matrix()).cwiseAbs().maxCoeff() < 1e-6;
 }
 
+// Whole-object completion: each frame segmented in its own camera frame (the sensor at the
+// origin), each cluster replaced by the objects it belongs to.
+std::vector<ChangeCluster> complete(std::vector<ChangeCluster> clusters, const ClusterInput& in, const Intrinsics& K_before,
+                                    const segmentation::Config& seg_config, const Config& config) {
+  if (clusters.empty()) return clusters;  // nothing to complete: spare the segmentation
+  // The frames are independent: BEFORE is segmented on a second thread meanwhile (as the
+  // pipeline compares against map and memory at once).
+  auto objects_of = [&](const Cloud& cloud) {
+    ObjectLabels labels = segment_objects(cloud, seg_config, config.completion_stride_px);
+    join_hidden_pieces(labels, cloud, config);
+    return labels;
+  };
+  auto before_future = std::async(std::launch::async, [&] { return objects_of(*in.before_camera); });
+  const ObjectLabels after = objects_of(*in.after_camera);
+  const ObjectLabels before = before_future.get();
+  const CompletionFrame fb{in.before_camera, in.T_world_before, &before, K_before};
+  const CompletionFrame fa{in.after_camera, in.T_world_after, &after, in.K_after};
+  return complete_clusters(std::move(clusters), fb, fa, config);
+}
+
 }  // namespace
 
 const char* to_string(DiffMethod m) { return m == DiffMethod::kSameCamera ? "same-camera" : "map"; }
@@ -46,6 +69,7 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
   if (auto st = validate_side(after, "AFTER"); !st) return st.error();
   if (auto st = validate(options.change); !st) return st.error();
   if (auto st = background::validate(options.map); !st) return st.error();
+  if (auto st = segmentation::validate(options.segmentation); !st) return st.error();
   const Cloud& b = *before.cloud;
   const Cloud& a = *after.cloud;
   const bool both_organized = b.height > 1 && a.height > 1;
@@ -64,6 +88,14 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
   if (!K) return invalid_argument("AFTER: " + K.error().message);
   input.K_after = *K;
 
+  // BEFORE's camera, for completion: AFTER's when it is the same camera (one pixel grid), else
+  // its own, or AFTER's when none fits BEFORE (as for the evidence: only BEFORE's pixel regions
+  // suffer, and the other-frame test needs an organized cloud anyway).
+  Intrinsics K_before = *K;
+  if (!(both_organized && same_pose(before, after))) {
+    if (auto Kb = observation_camera(b, before.intrinsics)) K_before = *Kb;
+  }
+
   if (both_organized && same_pose(before, after) && !options.force_map) {
     result.method = DiffMethod::kSameCamera;
     auto mm = mismatch_same_camera(b, a, options.change);
@@ -79,7 +111,13 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
     if (!mm) return mm.error();
     result.mismatch = std::move(*mm);
   }
-  result.changes = pair_changes(cluster_mismatch(result.mismatch, input, options.change), options.change);
+  std::vector<ChangeCluster> clusters = cluster_mismatch(result.mismatch, input, options.change);
+  if (options.change.complete_objects) {
+    const auto t1 = std::chrono::steady_clock::now();
+    clusters = complete(std::move(clusters), input, K_before, options.segmentation, options.change);
+    result.completion_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+  }
+  result.changes = pair_changes(std::move(clusters), options.change);
   std::uint64_t id = 1;
   for (const auto& c : result.changes) {
     Event e = to_event(c);

@@ -36,6 +36,9 @@ Status validate(const Config& c) {
   if (!(c.move_max_size_ratio >= 1)) return bad("move_max_size_ratio", "must be >= 1");
   if (!(c.move_max_color_distance >= 0)) return bad("move_max_color_distance", "must be >= 0");
   if (!(c.move_min_distance_m >= 0)) return bad("move_min_distance_m", "must be >= 0 m");
+  if (!(c.completion_evidence_share > 0 && c.completion_evidence_share <= 1)) return bad("completion_evidence_share", "must be in (0, 1]");
+  if (!(c.completion_object_share > 0 && c.completion_object_share <= 1)) return bad("completion_object_share", "must be in (0, 1]");
+  if (c.completion_stride_px < 1 || c.completion_stride_px > 8) return bad("completion_stride_px", "must be in [1, 8]");
   if (c.persistence_frames < 1 || c.persistence_frames > 100) {
     return bad("persistence_frames", "must be in [1, 100], got " + std::to_string(c.persistence_frames));
   }

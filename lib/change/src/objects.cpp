@@ -66,12 +66,6 @@ struct Evidence {
   std::vector<float> area;  // metric surface each piece of evidence stands for
 };
 
-std::array<int, 2> pixel_of(const Cloud& cloud, int i, const Pose& /*unused*/, const Intrinsics& K) {
-  if (cloud.height > 1) return {i % static_cast<int>(cloud.width), i / static_cast<int>(cloud.width)};
-  const PointT& p = cloud.points[i];
-  return {static_cast<int>(std::lround(K.fx * p.x / p.z + K.cx)), static_cast<int>(std::lround(K.fy * p.y / p.z + K.cy))};
-}
-
 Eigen::Vector3d rgb_of(const PointT& p) { return Eigen::Vector3d(p.r, p.g, p.b); }
 
 std::vector<ChangeCluster> group(const Evidence& ev, ChangeKind kind, double cell, const Config& config) {
@@ -104,6 +98,7 @@ std::vector<ChangeCluster> group(const Evidence& ev, ChangeKind kind, double cel
     c.centroid_world /= static_cast<double>(m.size());
     c.mean_rgb /= static_cast<double>(m.size());
     c.mean_gap_m = gap / static_cast<double>(m.size());
+    c.evidence_count = m.size();
     c.region = PixelRegion{u0, v0, u1 - u0 + 1, v1 - v0 + 1, static_cast<std::uint32_t>(m.size())};
     if (c.sorted_extent().x() < config.min_object_size_m || area < config.min_object_area_m2) continue;
     std::sort(c.indices.begin(), c.indices.end());
@@ -116,6 +111,12 @@ std::vector<ChangeCluster> group(const Evidence& ev, ChangeKind kind, double cel
 }
 
 }  // namespace
+
+std::array<int, 2> pixel_of(const Cloud& cloud, int i, const Intrinsics& K) {
+  if (cloud.height > 1) return {i % static_cast<int>(cloud.width), i / static_cast<int>(cloud.width)};
+  const PointT& p = cloud.points[i];
+  return {static_cast<int>(std::lround(K.fx * p.x / p.z + K.cx)), static_cast<int>(std::lround(K.fy * p.y / p.z + K.cy))};
+}
 
 Eigen::Vector3d ChangeCluster::sorted_extent() const {
   Eigen::Vector3d e = box_world.max - box_world.min;
@@ -134,7 +135,7 @@ std::vector<ChangeCluster> cluster_mismatch(const Mismatch& mm, const ClusterInp
       const PointT& p = cloud.points[i];
       ev.points.push_back(in.T_world_after * p.getVector3fMap().cast<double>());
       ev.rgb.push_back(rgb_of(p));
-      ev.pixel.push_back(pixel_of(cloud, i, in.T_world_after, in.K_after));
+      ev.pixel.push_back(pixel_of(cloud, i, in.K_after));
       ev.index.push_back(i);
       ev.gap.push_back(k < mm.added_gap_m.size() ? mm.added_gap_m[k] : 0.f);
       ev.area.push_back(static_cast<float>(p.z * p.z / (in.K_after.fx * in.K_after.fy)));
@@ -150,7 +151,7 @@ std::vector<ChangeCluster> cluster_mismatch(const Mismatch& mm, const ClusterInp
       const PointT& p = before.points[i];
       ev.points.push_back(in.T_world_before * p.getVector3fMap().cast<double>());
       ev.rgb.push_back(rgb_of(p));
-      ev.pixel.push_back(pixel_of(before, i, in.T_world_before, in.K_after));
+      ev.pixel.push_back(pixel_of(before, i, in.K_after));
       ev.index.push_back(i);
       const PointT& a = in.after_camera->points[i];
       ev.gap.push_back(a.z - p.z);
@@ -193,7 +194,11 @@ std::vector<ChangeCluster> cluster_mismatch(const Mismatch& mm, const ClusterInp
 }
 
 double move_similarity(const ChangeCluster& removed, const ChangeCluster& added, const Config& config) {
-  if ((added.centroid_world - removed.centroid_world).norm() < config.move_min_distance_m) return 0.0;
+  // Evidence clusters closer than move_min_distance_m are one object's border residue. Not so
+  // whole objects (completed): evidence that left one and entered the other shows the object
+  // moved, by however little (2 cm), or turned in place (its centroid may then stay put).
+  const bool whole = removed.completed && added.completed;
+  if (!whole && (added.centroid_world - removed.centroid_world).norm() < config.move_min_distance_m) return 0.0;
   const Eigen::Vector3d a = removed.sorted_extent(), b = added.sorted_extent();
   double size = 1.0;
   for (int i = 0; i < 2; ++i) {  // the two largest sides; the third is often a partial view
@@ -256,7 +261,8 @@ Event to_event(const ObjectChange& change) {
   const Eigen::Vector3d ext = where.sorted_extent();
   e.evidence["size_m"] = ext.x();
   e.evidence["mean_gap_m"] = where.mean_gap_m;
-  e.evidence["evidence_points"] = static_cast<double>(where.points_world.size());
+  e.evidence["evidence_points"] = static_cast<double>(where.evidence_count);
+  if (where.completed) e.evidence["object_points"] = static_cast<double>(where.indices.size());
   std::ostringstream os;
   os.precision(3);
   if (change.before) e.indices_before = change.before->indices;
@@ -276,12 +282,12 @@ Event to_event(const ObjectChange& change) {
     }
     case EventKind::kObjectAdded:
       e.score = std::min(1.0, where.mean_gap_m / 0.05);
-      os << ext.x() << " m object in space seen free, " << where.points_world.size() << " points, "
+      os << ext.x() << " m object in space seen free, " << where.evidence_count << " points, "
          << where.mean_gap_m << " m in front of the model";
       break;
     default:
       e.score = std::min(1.0, where.mean_gap_m / 0.05);
-      os << ext.x() << " m object seen through, " << where.points_world.size() << " pieces of evidence, depth "
+      os << ext.x() << " m object seen through, " << where.evidence_count << " pieces of evidence, depth "
          << where.mean_gap_m << " m behind it";
       break;
   }

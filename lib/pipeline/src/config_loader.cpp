@@ -110,7 +110,11 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("min_cluster_points", g.min_cluster_points); },
                            [&] { return s.read("move_max_size_ratio", g.move_max_size_ratio); },
                            [&] { return s.read("move_max_color_distance", g.move_max_color_distance); },
-                           [&] { return s.read("move_min_distance_m", g.move_min_distance_m); });
+                           [&] { return s.read("move_min_distance_m", g.move_min_distance_m); },
+                           [&] { return s.read("complete_objects", g.complete_objects); },
+                           [&] { return s.read("completion_evidence_share", g.completion_evidence_share); },
+                           [&] { return s.read("completion_object_share", g.completion_object_share); },
+                           [&] { return s.read("completion_stride_px", g.completion_stride_px); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

@@ -7,6 +7,7 @@
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/change/objects.h"
 #include "scenewatch/core/frame.h"
+#include "scenewatch/segmentation/tabletop.h"
 
 namespace scenewatch::change {
 
@@ -20,6 +21,9 @@ const char* to_string(DiffMethod method);
 struct DiffOptions {
   Config change;
   background::Config map;  ///< for the map path
+  /// Segmentation of each frame, in its camera frame, for whole-object completion
+  /// (change.complete_objects).
+  segmentation::Config segmentation;
   /// Force the map path even for same-camera pairs.
   bool force_map = false;
 };
@@ -30,6 +34,7 @@ struct DiffResult {
   std::vector<Event> events;  ///< one per change, ids from 1; indices_before / indices_after filled
   Mismatch mismatch;          ///< raw evidence
   double total_ms = 0;
+  double completion_ms = 0;  ///< of total_ms: segmenting both frames and completing the changes
 };
 
 /// Compares two frames (clouds in their camera frames, with optional poses and intrinsics; no

@@ -45,6 +45,20 @@ struct Config {
   double move_max_size_ratio = 2.0;
   double move_max_color_distance = 80.0;
   double move_min_distance_m = 0.03;
+  /// Whole-object completion of diffs (completion.h): each side of a change is replaced by the
+  /// segmented objects of its frame that its evidence substantially belongs to. An object joins
+  /// when it carries at least `completion_evidence_share` of the evidence (the evidence is mostly
+  /// its surface: the fringe a short move uncovers, whatever the share of the object) or when the
+  /// evidence covers at least `completion_object_share` of its points (most of it changed, though
+  /// the evidence spreads over neighbours too). Both are majorities: a minority of stray evidence
+  /// (a shadow edge, a neighbour's border) never pulls in a whole object.
+  bool complete_objects = true;
+  double completion_evidence_share = 0.5;
+  double completion_object_share = 0.5;
+  /// The segmentation for completion runs on every n-th pixel of every n-th row of organized
+  /// clouds. At tabletop range a Kinect pixel spans 1-2 mm and the segmentation's voxel 10 mm, so
+  /// every second pixel still leaves several samples across each voxel, at a quarter of the points.
+  int completion_stride_px = 2;
   /// Sequences: a change fires after this many consistent frames (1 = at once).
   int persistence_frames = 3;
   /// A candidate is re-observed when a cluster of its kind lies within this distance.

@@ -1,6 +1,7 @@
 #pragma once
 /// From mismatch pixels and voxels to object-level changes: connected clusters with a metric size
 /// filter, then vanished/appeared pairs of similar shape and colour as moves.
+#include <array>
 #include <vector>
 
 #include "scenewatch/change/mismatch.h"
@@ -22,6 +23,10 @@ struct ChangeCluster {
   Eigen::Vector3d mean_rgb = Eigen::Vector3d::Zero();
   PixelRegion region;            ///< in the observation
   double mean_gap_m = 0.0;       ///< mean depth or surface distance of the evidence
+  std::size_t evidence_count = 0;  ///< pieces of mismatch evidence (points or voxels) it grew from
+  /// True when `indices` and `points_world` are whole segmented objects of the frame
+  /// (completion.h), not the evidence itself.
+  bool completed = false;
   /// Sorted box sides, largest first.
   Eigen::Vector3d sorted_extent() const;
 };
@@ -43,6 +48,9 @@ struct ClusterInput {
   const Cloud* before_camera = nullptr;  ///< optional
   Pose T_world_before = Pose::Identity();
 };
+
+/// The pixel of point i: its place in the grid of an organized cloud, else its projection with K.
+std::array<int, 2> pixel_of(const Cloud& cloud, int i, const Intrinsics& K);
 
 /// Groups the mismatch into clusters and drops those below the size thresholds.
 std::vector<ChangeCluster> cluster_mismatch(const Mismatch& mismatch, const ClusterInput& input, const Config& config);
