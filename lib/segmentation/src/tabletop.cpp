@@ -15,6 +15,7 @@
 #include <random>
 
 #include "scenewatch/segmentation/tabletop.h"
+#include "containers.h"
 #include "convex_parts.h"
 #include "hull2d.h"
 #include "occlusion_join.h"
@@ -476,6 +477,7 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
       if (n >= cfg.min_cluster_points && n <= cfg.max_cluster_points) pieces.push_back({std::move(indices), p});
     }
   }
+  if (split) pieces = join_container_pieces(cloud, std::move(pieces), out.planes, ContainerParams{});
   if (cfg.join_occluded) pieces = join_occluded_pieces(cloud, std::move(pieces), out.planes, OcclusionParams{});
   for (Piece& piece : pieces) {
     if (static_cast<int>(piece.indices.size()) > cfg.max_cluster_points) continue;

@@ -62,9 +62,10 @@ void VoxelIndex::build(const Cloud& cloud, ForEachIndex&& for_each_index) {
   }
   member_points.resize(running);
   std::vector<int> fill(member_offsets.begin(), member_offsets.end() - 1);
-  for (std::size_t i = 0; i < point_voxel.size(); ++i) {
+  // Over the visited points only: a subset of a large cloud (one cluster) costs its own size.
+  for_each_index([&](std::size_t i) {
     if (point_voxel[i] >= 0) member_points[fill[point_voxel[i]]++] = static_cast<int>(i);
-  }
+  });
 }
 
 }  // namespace scenewatch::segmentation
