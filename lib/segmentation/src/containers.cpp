@@ -9,7 +9,6 @@
 #include <optional>
 
 #include "footprint.h"
-#include "union_find.h"
 
 namespace scenewatch::segmentation {
 namespace {
@@ -88,19 +87,7 @@ std::vector<Piece> join_container_pieces(const Cloud& cloud, std::vector<Piece> 
       }
     }
   }
-  std::vector<Piece> joined(pieces.size());
-  for (std::size_t p = 0; p < pieces.size(); ++p) {
-    Piece& into = joined[uf.find(static_cast<int>(p))];
-    into.plane = pieces[p].plane;
-    into.indices.insert(into.indices.end(), pieces[p].indices.begin(), pieces[p].indices.end());
-  }
-  std::vector<Piece> out;
-  for (Piece& p : joined) {
-    if (p.indices.empty()) continue;
-    std::sort(p.indices.begin(), p.indices.end());
-    out.push_back(std::move(p));
-  }
-  return out;
+  return join_pieces(pieces, uf);
 }
 
 }  // namespace scenewatch::segmentation

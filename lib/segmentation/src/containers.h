@@ -6,7 +6,7 @@
 // its circle are one object. (A thing standing inside a bowl joins the bowl: rare on a table.)
 #include <vector>
 
-#include "occlusion_join.h"
+#include "piece.h"
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/scene.h"
 

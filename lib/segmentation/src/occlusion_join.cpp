@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "union_find.h"
 
 namespace scenewatch::segmentation {
 namespace {
@@ -116,19 +115,7 @@ std::vector<Piece> join_occluded_pieces(const Cloud& cloud, std::vector<Piece> p
       }
     }
   }
-  std::vector<Piece> joined(pieces.size());
-  for (std::size_t p = 0; p < pieces.size(); ++p) {
-    Piece& into = joined[uf.find(static_cast<int>(p))];
-    into.plane = pieces[p].plane;
-    into.indices.insert(into.indices.end(), pieces[p].indices.begin(), pieces[p].indices.end());
-  }
-  std::vector<Piece> out;
-  for (Piece& p : joined) {
-    if (p.indices.empty()) continue;
-    std::sort(p.indices.begin(), p.indices.end());
-    out.push_back(std::move(p));
-  }
-  return out;
+  return join_pieces(pieces, uf);
 }
 
 }  // namespace scenewatch::segmentation

@@ -6,16 +6,11 @@
 // other, meets the other's depth, and both reach the same height above the support.
 #include <vector>
 
+#include "piece.h"
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/scene.h"
 
 namespace scenewatch::segmentation {
-
-/// An object hypothesis before its box is made: points and the plane it stands on.
-struct Piece {
-  std::vector<int> indices;
-  int plane = 0;
-};
 
 struct OcclusionParams {
   double max_height_difference_m = 0.02;  ///< the two pieces' tops (95th percentile heights)
