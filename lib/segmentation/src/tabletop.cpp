@@ -286,19 +286,65 @@ Status validate(const Config& c) {
   return {};
 }
 
-Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3d& sensor_origin) {
-  Segmentation out;
-  const VoxelIndex grid(cloud, cfg.voxel_size_m);
+namespace {
+
+// Least-squares refinement until the inlier set stops growing: a hypothesis a few degrees off
+// catches only a band of a large table, and the band widens a little with each round (two fixed
+// rounds left a 1.2 m table tilted by 2.4 degrees in a simulated scene).
+std::vector<int> refine_plane(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& candidates,
+                              const Config& cfg, PlaneModel& model) {
+  std::vector<int> inliers;
+  for (int refine = 0; refine < 10; ++refine) {
+    std::vector<int> next;
+    for (int v : candidates) {
+      if (std::abs(model.distance(centroids[v])) < cfg.plane_distance_m) next.push_back(v);
+    }
+    if (next.size() < 3 || (refine > 0 && next.size() <= inliers.size())) break;
+    inliers.swap(next);
+    model = fit_plane(centroids, inliers);
+  }
+  return inliers;
+}
+
+// The plane record of a support: its hull in 3D and its inlier points (the points of its voxels,
+// marked `mark` in in_plane, close to it and below object height), in one pass in index order.
+Plane make_plane(const Cloud& cloud, const VoxelIndex& grid, const std::vector<char>& in_plane, char mark,
+                 const PlaneFrame& frame, double area, const Config& cfg, const Eigen::Vector3d& sensor_origin) {
+  const PlaneModel& model = frame.model;
+  Plane plane;
+  plane.normal = model.n;
+  plane.d = model.d;
+  plane.area_m2 = area;
+  const Eigen::Vector3d origin_on_plane = -model.d * model.n;
+  for (const Vec2& h : frame.hull2d) plane.hull.push_back(origin_on_plane + h.x() * frame.u + h.y() * frame.v);
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const int v = grid.point_voxel[i];
+    if (v < 0 || in_plane[v] != mark) continue;
+    const Eigen::Vector3f q = cloud[i].getVector3fMap();
+    const double h = model.distance(q);
+    if (std::abs(h) < cfg.plane_distance_m && h < object_height_threshold(cfg, (q.cast<double>() - sensor_origin).norm())) {
+      plane.indices.push_back(static_cast<int>(i));
+      sum += q.cast<double>();
+    }
+  }
+  plane.inlier_count = plane.indices.size();
+  plane.centroid = plane.inlier_count > 0 ? Eigen::Vector3d(sum / static_cast<double>(plane.inlier_count)) : origin_on_plane;
+  return plane;
+}
+
+// Supporting planes, largest first: RANSAC on the voxel centroids, least-squares refinement,
+// the largest connected part, its hull; object faces inside an earlier support's prism are
+// skipped. Marks each plane's voxels in `in_plane` (plane id + 1) and appends to `planes`.
+std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid, const Config& cfg,
+                                      const Eigen::Vector3d& sensor_origin, std::vector<char>& in_plane,
+                                      std::vector<Plane>& planes) {
   const auto& centroids = grid.centroids;
   const std::size_t nvox = centroids.size();
-  if (nvox < 3) return out;
-
   std::optional<Eigen::Vector3d> up;
   if (cfg.up) up = cfg.up->normalized();
   std::mt19937 rng(cfg.seed);
-
-  // --- planes ---
-  std::vector<char> in_plane(nvox, 0);
+  in_plane.assign(nvox, 0);
   std::vector<PlaneFrame> frames;
   std::vector<int> remaining(nvox);
   std::iota(remaining.begin(), remaining.end(), 0);
@@ -306,19 +352,7 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     const RansacResult r = ransac_plane(centroids, remaining, cfg, up, rng);
     if (!r.found) break;
     PlaneModel model = r.model;
-    std::vector<int> inliers;
-    // Least-squares refinement until the inlier set stops growing: a hypothesis a few degrees off
-    // catches only a band of a large table, and the band widens a little with each round (two
-    // fixed rounds left a 1.2 m table tilted by 2.4 degrees in a simulated scene).
-    for (int refine = 0; refine < 10; ++refine) {
-      std::vector<int> next;
-      for (int v : remaining) {
-        if (std::abs(model.distance(centroids[v])) < cfg.plane_distance_m) next.push_back(v);
-      }
-      if (next.size() < 3 || (refine > 0 && next.size() <= inliers.size())) break;
-      inliers.swap(next);
-      model = fit_plane(centroids, inliers);
-    }
+    const std::vector<int> inliers = refine_plane(centroids, remaining, cfg, model);
     if (inliers.size() < 3) break;
     // Normals point to where objects stand: along up when given, else towards the sensor.
     const Eigen::Vector3d towards = up ? *up : (sensor_origin - centroids[inliers[0]].cast<double>());
@@ -352,31 +386,10 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
       continue;
     }
 
-    Plane plane;
-    plane.id = static_cast<int>(out.planes.size());
-    plane.normal = model.n;
-    plane.d = model.d;
-    plane.area_m2 = area;
-    const Eigen::Vector3d origin_on_plane = -model.d * model.n;
-    for (const Vec2& h : frame.hull2d) plane.hull.push_back(origin_on_plane + h.x() * frame.u + h.y() * frame.v);
-    for (int v : part) in_plane[v] = static_cast<char>(1 + out.planes.size());
-    // One pass over the points in index order: the inlier list comes out sorted.
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    const char mark = static_cast<char>(1 + out.planes.size());
-    for (std::size_t i = 0; i < cloud.size(); ++i) {
-      const int v = grid.point_voxel[i];
-      if (v < 0 || in_plane[v] != mark) continue;
-      const Eigen::Vector3f q = cloud[i].getVector3fMap();
-      const double h = model.distance(q);
-      if (std::abs(h) < cfg.plane_distance_m &&
-          h < object_height_threshold(cfg, (q.cast<double>() - sensor_origin).norm())) {
-        plane.indices.push_back(static_cast<int>(i));
-        sum += q.cast<double>();
-      }
-    }
-    plane.inlier_count = plane.indices.size();
-    plane.centroid = plane.inlier_count > 0 ? Eigen::Vector3d(sum / static_cast<double>(plane.inlier_count)) : origin_on_plane;
-    out.planes.push_back(std::move(plane));
+    const char mark = static_cast<char>(1 + planes.size());
+    for (int v : part) in_plane[v] = mark;
+    planes.push_back(make_plane(cloud, grid, in_plane, mark, frame, area, cfg, sensor_origin));
+    planes.back().id = static_cast<int>(planes.size()) - 1;
     frames.push_back(std::move(frame));
 
     std::vector<int> next;
@@ -386,9 +399,17 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     }
     remaining.swap(next);
   }
-  if (frames.empty()) return out;
+  return frames;
+}
 
-  // --- object voxels: in the prism above a hull; the lowest such plane owns the voxel ---
+// Euclidean clusters of the points standing on the supports (in their prisms, at object height),
+// each with the plane it stands on; clusters attached to a taller structure are left out.
+std::vector<Piece> euclidean_clusters(const Cloud& cloud, const VoxelIndex& grid, const std::vector<PlaneFrame>& frames,
+                                      const std::vector<char>& in_plane, const Config& cfg,
+                                      const Eigen::Vector3d& sensor_origin) {
+  const auto& centroids = grid.centroids;
+  const std::size_t nvox = centroids.size();
+  // Object voxels: in the prism above a hull; the lowest such plane owns the voxel.
   std::vector<int> owner(nvox, -1);
   std::vector<int> object_voxels;
   for (std::size_t v = 0; v < nvox; ++v) {
@@ -405,7 +426,7 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     if (owner[v] >= 0) object_voxels.push_back(static_cast<int>(v));
   }
 
-  // --- Euclidean clustering of object voxels (grid neighbours within the tolerance) ---
+  // Euclidean clustering of object voxels (grid neighbours within the tolerance).
   std::vector<int> local(nvox, -1);
   for (std::size_t i = 0; i < object_voxels.size(); ++i) local[object_voxels[i]] = static_cast<int>(i);
   UnionFind uf(object_voxels.size());
@@ -462,19 +483,35 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     if (h > cfg.max_object_height_m || h < object_height_threshold(cfg, (q.cast<double>() - sensor_origin).norm())) continue;
     group_points[voxel_group[v]].push_back(static_cast<int>(i));
   }
+  std::vector<Piece> clusters;
+  for (std::size_t g = 0; g < groups.size(); ++g) {
+    if (!group_points[g].empty()) clusters.push_back({std::move(group_points[g]), owner[groups[g].front()]});
+  }
+  return clusters;
+}
+
+}  // namespace
+
+Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3d& sensor_origin) {
+  Segmentation out;
+  const VoxelIndex grid(cloud, cfg.voxel_size_m);
+  if (grid.centroids.size() < 3) return out;
+  std::vector<char> in_plane;
+  const std::vector<PlaneFrame> frames = find_supports(cloud, grid, cfg, sensor_origin, in_plane, out.planes);
+  if (frames.empty()) return out;
+  std::vector<Piece> clusters = euclidean_clusters(cloud, grid, frames, in_plane, cfg, sensor_origin);
+
   // Only a single view orients the patch normals (towards its sensor); a merged cloud of several
   // views keeps its Euclidean clusters.
   const bool split = cfg.split_concave && cloud.height > 1;
   std::vector<Piece> pieces;
-  for (std::size_t g = 0; g < groups.size(); ++g) {
-    if (group_points[g].empty()) continue;
-    const int p = owner[groups[g].front()];
+  for (Piece& cluster : clusters) {
     std::vector<std::vector<int>> parts;
-    if (split) parts = split_at_concavities(cloud, group_points[g], sensor_origin, convexity_params(cfg));
-    else parts.push_back(std::move(group_points[g]));
+    if (split) parts = split_at_concavities(cloud, cluster.indices, sensor_origin, convexity_params(cfg));
+    else parts.push_back(std::move(cluster.indices));
     for (auto& indices : parts) {
       const int n = static_cast<int>(indices.size());
-      if (n >= cfg.min_cluster_points && n <= cfg.max_cluster_points) pieces.push_back({std::move(indices), p});
+      if (n >= cfg.min_cluster_points && n <= cfg.max_cluster_points) pieces.push_back({std::move(indices), cluster.plane});
     }
   }
   if (split) pieces = join_container_pieces(cloud, std::move(pieces), out.planes, ContainerParams{});
