@@ -169,6 +169,21 @@ TEST_F(IoTest, GarbageAndEmptyFiles) {
   r = read_cloud(ply);
   ASSERT_FALSE(r.ok());
   expect_error_mentions(r.error(), {"bad.ply"});
+  // Counts a file cannot hold are refused before anything is allocated from them (PCL's reader
+  // ended in std::bad_alloc on these).
+  const std::string props = "property float x\nproperty float y\nproperty float z\nend_header\n";
+  for (const char* count : {"-5", "1000000000000", "99999999999999999999", "3x"}) {
+    auto huge = write_text("count.ply", std::string("ply\nformat binary_little_endian 1.0\nelement vertex ") + count + "\n" + props +
+                                            std::string(36, '\0'));
+    r = read_cloud(huge);
+    ASSERT_FALSE(r.ok()) << count;
+    expect_error_mentions(r.error(), {"count.ply", "vertex"});
+  }
+  auto binary_short = write_text("short.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 100\n" + props +
+                                                  std::string(36, '\0'));
+  r = read_cloud(binary_short);
+  ASSERT_FALSE(r.ok());
+  expect_error_mentions(r.error(), {"short.ply", "more data than the file holds"});
   r = read_cloud(write_text("cloud.xyz", "1 2 3\n"));
   ASSERT_FALSE(r.ok());
   expect_error_mentions(r.error(), {"cloud.xyz", "extension"});

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <mutex>
+#include <sstream>
 #include <system_error>
 
 #include "scenewatch/core/files.h"
@@ -70,6 +71,74 @@ Status check_pcd_body(const fs::path& path, const pcl::PCLPointCloud2& header, i
   return {};
 }
 
+// PCL's PLY reader allocates from the header's element counts before it reads a byte of data: a
+// count of -5 or 10^12 ends in std::bad_alloc. Every element's count must be a whole number the
+// file can hold: at least one byte per item in ascii, the sum of its scalar properties' sizes in
+// binary (a list property takes at least its count's size).
+constexpr std::uint64_t kMaxPlyHeaderBytes = 64 * 1024;  // real headers are a few hundred bytes
+
+Status check_ply_header(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string line, format;
+  std::uint64_t header_bytes = 0, min_body = 0, item_bytes = 0, items = 0, all_items = 0;
+  auto flush = [&] {
+    min_body += items * std::max<std::uint64_t>(1, item_bytes);
+    all_items += items;
+  };
+  auto scalar_size = [](const std::string& t) -> std::uint64_t {
+    if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+    if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+    if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32") return 4;
+    if (t == "double" || t == "float64") return 8;
+    return 0;
+  };
+  bool ended = false;
+  while (std::getline(in, line)) {
+    header_bytes += line.size() + 1;
+    if (header_bytes > kMaxPlyHeaderBytes) break;
+    std::istringstream words(line);
+    std::string word;
+    words >> word;
+    if (word == "format") words >> format;
+    if (word == "element") {
+      flush();
+      std::string name, count;
+      words >> name >> count;
+      if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos || count.size() > 18) {
+        return invalid_argument(quoted(path) + ": PLY element '" + name + "' has a count that is not a whole number: '" +
+                                count + "'");
+      }
+      items = std::stoull(count);
+      item_bytes = 0;
+      if (items > fs::file_size(path)) {
+        return invalid_argument(quoted(path) + ": PLY element '" + name + "' declares " + count +
+                                " items, more than the file's " + std::to_string(fs::file_size(path)) + " bytes");
+      }
+    }
+    if (word == "property") {
+      std::string type;
+      words >> type;
+      if (type == "list") words >> type;  // the count's type: a list holds at least its count
+      item_bytes += scalar_size(type);
+    }
+    if (word == "end_header") {
+      ended = true;
+      break;
+    }
+  }
+  if (!ended) return invalid_argument(quoted(path) + ": PLY header has no end_header within its first " +
+                                      std::to_string(kMaxPlyHeaderBytes) + " bytes");
+  flush();
+  const std::uint64_t body = fs::file_size(path) - std::min<std::uint64_t>(fs::file_size(path), header_bytes);
+  // In ascii every item takes at least one character; binary items take their full size.
+  const bool ascii = format == "ascii";
+  if ((ascii ? all_items : min_body) > body) {
+    return invalid_argument(quoted(path) + ": PLY header declares more data than the file holds (" +
+                            std::to_string(body) + " bytes after the header)");
+  }
+  return {};
+}
+
 Result<pcl::PCLPointCloud2> read_blob(const fs::path& path, Eigen::Vector4f& origin, Eigen::Quaternionf& orientation) {
   quiet_pcl();
   if (auto st = check_readable_file(path); !st) return st.error();
@@ -98,6 +167,7 @@ Result<pcl::PCLPointCloud2> read_blob(const fs::path& path, Eigen::Vector4f& ori
       return invalid_argument(quoted(path) + ": PCD data could not be parsed (truncated or corrupt)");
     }
   } else if (ext == ".ply") {
+    if (auto st = check_ply_header(path); !st) return st.error();
     pcl::PLYReader reader;
     int version = 0;
     if (reader.read(path.string(), blob, origin, orientation, version) < 0) {
@@ -231,6 +301,7 @@ Result<ColoredMesh> read_mesh_ply(const fs::path& path) {
   quiet_pcl();
   if (auto st = check_readable_file(path); !st) return st.error();
   pcl::PolygonMesh in;
+  if (auto st = check_ply_header(path); !st) return st.error();
   if (pcl::io::loadPLYFile(path.string(), in) < 0) return invalid_argument(quoted(path) + ": not a readable PLY mesh");
   Cloud vertices;
   pcl::fromPCLPointCloud2(in.cloud, vertices);
