@@ -275,6 +275,28 @@ TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
   EXPECT_EQ(wm.snapshot()->objects.size(), 2u);
 }
 
+// A background.ot cut short (a full disk, a copy interrupted) is refused: OctoMap itself reads the
+// first half of the tree and says nothing. The loaded model stays, and so does the file.
+TEST(WorkingMemory, TruncatedBackgroundIsRefused) {
+  const test::TempDir dir("model");
+  {
+    WorkingMemory wm(test_config());
+    for (int i = 0; i < 3; ++i) ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, 1.0 + i)).ok());
+    ASSERT_TRUE(wm.save(dir).ok());
+  }
+  const fs::path map = dir / fs::read_symlink(dir / "current") / "background.ot";
+  const auto bytes = fs::file_size(map);
+  fs::resize_file(map, bytes / 2);
+  WorkingMemory wm(test_config());
+  ASSERT_TRUE(wm.process(make_frame({kTall}, 1.0)).ok());
+  auto st = wm.load(dir);
+  ASSERT_FALSE(st.ok()) << "half a map must not load";
+  EXPECT_NE(st.error().message.find("background.ot"), std::string::npos) << st.error().message;
+  EXPECT_NE(st.error().message.find("damaged"), std::string::npos) << st.error().message;
+  EXPECT_EQ(wm.stats().frames_processed, 1u) << "the model in memory is unchanged";
+  EXPECT_EQ(fs::file_size(map), bytes / 2) << "nothing is written over the damaged file";
+}
+
 TEST(WorkingMemory, ReadersRunWhileFramesAreProcessed) {
   WorkingMemory wm(test_config());
   std::atomic<bool> done{false};

@@ -372,17 +372,54 @@ void WorkingMemory::reset() {
   impl_->publish();
 }
 
+namespace {
+
+// Loads the background map and checks it against what scene.json recorded when it was saved (its
+// size in bytes and its leaf count): a damaged file is refused, not loaded in part and then saved
+// over the model. Models saved before the record existed are loaded unchecked.
+Status load_background(background::OccupancyMap& map, const fs::path& path, const nlohmann::json& scene) {
+  const auto record = scene.find("background");
+  if (record != scene.end()) {
+    std::error_code ec;
+    const auto bytes = fs::file_size(path, ec);
+    if (ec) return io_error("'" + path.string() + "': " + ec.message());
+    const auto expected = record->value("bytes", std::uint64_t{0});
+    if (bytes != expected) {
+      return invalid_argument("'" + path.string() + "': damaged: " + std::to_string(bytes) + " bytes, the model recorded " +
+                              std::to_string(expected) + " when it was saved");
+    }
+  }
+  if (auto st = map.load(path); !st) return st;
+  if (record != scene.end()) {
+    const auto leaves = record->value("leaf_nodes", std::uint64_t{0});
+    if (map.num_leaf_nodes() != leaves) {
+      return invalid_argument("'" + path.string() + "': damaged: " + std::to_string(map.num_leaf_nodes()) +
+                              " leaf nodes, the model recorded " + std::to_string(leaves));
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 Status WorkingMemory::save(const fs::path& model_dir) const {
   std::lock_guard<std::mutex> lock(impl_->writer);
   const Impl& m = *impl_;
   return commit_snapshot(model_dir, [&](const fs::path& dir) -> Status {
+    std::size_t map_leaves = 0;
     {
       std::shared_lock<std::shared_mutex> read(m.map_mutex);
       if (auto st = m.map.save(dir / "background.ot"); !st) return st;
+      map_leaves = m.map.num_leaf_nodes();
     }
+    // What the map file must be on load: OctoMap reads a truncated .ot without complaint.
+    std::error_code ec;
+    const auto map_bytes = fs::file_size(dir / "background.ot", ec);
+    if (ec) return io_error("'" + (dir / "background.ot").string() + "': " + ec.message());
     nlohmann::json scene = {{"format", "scenewatch-model"}, {"version", 1}, {"frames_processed", m.frames},
                             {"points_processed", m.points}, {"next_object_id", m.tracker.next_id()},
-                            {"last_stamp_s", m.last_stamp_s}};
+                            {"last_stamp_s", m.last_stamp_s},
+                            {"background", {{"bytes", map_bytes}, {"leaf_nodes", map_leaves}}}};
     scene["objects"] = nlohmann::json::array();
     for (const auto& o : m.tracker.objects()) {
       nlohmann::json j = to_json(o);
@@ -415,8 +452,6 @@ Status WorkingMemory::load(const fs::path& model_dir) {
   auto dir = current_snapshot(model_dir);
   if (!dir) return dir.error();
   // Build everything aside first: a bad file leaves the model as it was.
-  background::OccupancyMap map(config_.background);
-  if (auto st = map.load(*dir / "background.ot"); !st) return st;
   std::ifstream in(*dir / "scene.json");
   if (!in) return io_error("'" + (*dir / "scene.json").string() + "': cannot open");
   nlohmann::json scene;
@@ -425,6 +460,8 @@ Status WorkingMemory::load(const fs::path& model_dir) {
   } catch (const std::exception& e) {
     return invalid_argument("'" + (*dir / "scene.json").string() + "': " + e.what());
   }
+  background::OccupancyMap map(config_.background);
+  if (auto st = load_background(map, *dir / "background.ot", scene); !st) return st;
   std::vector<TrackedObject> objects;
   std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples;
   std::vector<Plane> planes;
