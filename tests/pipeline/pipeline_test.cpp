@@ -205,6 +205,19 @@ TEST(WorkingMemory, BadFramesChangeNothing) {
   wrong_k.intrinsics = Intrinsics{500, 500, 320, 240, 640, 480};
   EXPECT_FALSE(wm.process(wrong_k).ok()) << "intrinsics for 640x480, cloud is 160x120";
 
+  Frame huge = make_frame({kCube}, 2.0);
+  auto far_cloud = std::make_shared<Cloud>(*huge.cloud);
+  std::vector<PointT*> valid;
+  for (auto& p : far_cloud->points)
+    if (is_valid(p)) valid.push_back(&p);
+  ASSERT_GE(valid.size(), 2u);
+  valid[0]->x = 3e38f;
+  valid[1]->z = -3e38f;
+  huge.cloud = far_cloud;
+  r = wm.process(huge);
+  ASSERT_FALSE(r.ok()) << "finite but absurd coordinates";
+  EXPECT_NE(r.error().message.find("2 points lie farther than 1000 m"), std::string::npos) << r.error().message;
+
   EXPECT_EQ(wm.snapshot(), before) << "the snapshot was not replaced";
   const Stats after = wm.stats();
   EXPECT_EQ(after.frames_processed, stats_before.frames_processed);

@@ -24,6 +24,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// Farther than any depth sensor sees (lidars reach a few hundred metres).
+constexpr float kMaxPointRangeM = 1000.0f;
+
 Status validate_frame(const Frame& f) {
   const std::string where = f.source.empty() ? std::string("frame") : "frame from '" + f.source + "'";
   if (!f.cloud || f.cloud->empty()) return invalid_argument(where + ": cloud is empty");
@@ -32,6 +35,20 @@ Status validate_frame(const Frame& f) {
                             std::to_string(f.cloud->height) + ") does not match its " + std::to_string(f.cloud->size()) + " points");
   }
   if (count_valid(*f.cloud) == 0) return invalid_argument(where + ": no valid points (all NaN or non-finite)");
+  // Finite is not enough: a point at 3e38 m would be ray-cast through the map. No depth sensor
+  // sees that far; such coordinates are not metres (wrong units, garbage).
+  std::size_t far = 0;
+  const PointT* first_far = nullptr;
+  for (const auto& p : f.cloud->points) {
+    if (!is_valid(p) || p.getVector3fMap().squaredNorm() <= kMaxPointRangeM * kMaxPointRangeM) continue;
+    if (far++ == 0) first_far = &p;
+  }
+  if (far > 0) {
+    return invalid_argument(where + ": " + std::to_string(far) + " points lie farther than " +
+                            std::to_string(static_cast<int>(kMaxPointRangeM)) + " m from the sensor (the first at " +
+                            std::to_string(first_far->x) + " " + std::to_string(first_far->y) + " " +
+                            std::to_string(first_far->z) + "): coordinates must be metres in the camera frame");
+  }
   if (!std::isfinite(f.stamp_s)) return invalid_argument(where + ": stamp is not finite");
   if (f.T_world_camera) {
     if (auto st = validate_rigid(f.T_world_camera->matrix()); !st) return invalid_argument(where + ": " + st.error().message);
