@@ -227,6 +227,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   const Pose T = frame.pose_or_identity();
   FrameResult result;
   result.frame_index = m.frames;
+  result.points = count_valid(*frame.cloud);
 
   // Two independent halves on the two cores: the image surprise and the geometric change detection
   // (both against the memory as it stands before this frame) beside the segmentation of the frame.
@@ -317,7 +318,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   for (auto& p : m.planes) p.indices.clear();
   ++m.frames;
   m.last_stamp_s = frame.stamp_s;
-  m.points += result.insert_stats.points;
+  m.points += result.points;
   result.total_ms = ms_since(t0);
   m.last_ms = result.total_ms;
   m.total_ms += result.total_ms;

@@ -316,7 +316,7 @@ struct RequestHandler::Impl {
     if (!result) return result.error();
     auto* out = response.mutable_ingest();
     out->set_frame_index(result->frame_index);
-    out->set_points(result->insert_stats.points);
+    out->set_points(result->points);
     for (const auto& plane : result->planes) convert::to_proto(plane, out->add_planes());
     for (const auto& cluster : result->objects) convert::to_proto(cluster, out->add_clusters());
     for (const auto& event : result->events) convert::to_proto(event, out->add_events());

@@ -63,9 +63,12 @@ Status validate(const Config& config);
 /// What one frame produced.
 struct FrameResult {
   std::uint64_t frame_index = 0;
+  std::size_t points = 0;               ///< valid points in the frame (all of them, whatever was inserted)
   std::vector<Plane> planes;            ///< world frame
   std::vector<ObjectCluster> objects;   ///< world frame, indices into the frame's cloud
   std::vector<Event> events;
+  /// What went into the map: fewer points than the frame's while a change is pending (its points
+  /// wait until it is confirmed or dropped).
   background::InsertStats insert_stats;
   std::shared_ptr<const SurpriseResult> surprise;  ///< null: the frame had no pose or no keyframes existed yet
   double segment_ms = 0, insert_ms = 0, surprise_ms = 0, change_ms = 0, total_ms = 0;
