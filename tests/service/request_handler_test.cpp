@@ -339,6 +339,18 @@ TEST_F(RequestHandlerTest, IngestFileReadsACloudUnderARoot) {
   EXPECT_EQ(frames_processed(), 1u);
 }
 
+TEST_F(RequestHandlerTest, IngestFileRefusesFilesOverTheSizeLimitUnread) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  const fs::path mug = test::data_dir() / kMug;
+  RequestHandler handler(memory_, HandlerConfig{{test::data_dir() / "pcl"}, {}, fs::file_size(mug) - 1});
+  const auto response = ingest_file(handler, mug.string());
+  EXPECT_EQ(response.status().code(), proto::Status::INVALID_ARGUMENT);
+  EXPECT_NE(response.status().message().find("max_file_bytes"), std::string::npos) << response.status().message();
+  EXPECT_EQ(frames_processed(), 0u);
+  RequestHandler roomy(memory_, HandlerConfig{{test::data_dir() / "pcl"}, {}, fs::file_size(mug)});
+  EXPECT_EQ(ingest_file(roomy, mug.string()).status().code(), proto::Status::OK) << "a file at the limit is read";
+}
+
 TEST_F(RequestHandlerTest, OccupancyQueriesAreValidated) {
   RequestHandler handler(memory_, {});
   proto::Request request;

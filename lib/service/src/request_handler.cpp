@@ -299,6 +299,12 @@ struct RequestHandler::Impl {
     if (!requested.is_absolute()) return invalid_argument("path must be absolute, got '" + msg.path() + "'");
     auto resolved = resolve_under_roots(requested);
     if (!resolved) return resolved.error();
+    std::error_code ec;
+    const auto bytes = fs::file_size(*resolved, ec);
+    if (!ec && bytes > config.max_file_bytes) {
+      return invalid_argument("'" + msg.path() + "' is " + std::to_string(bytes) + " bytes, more than server.max_file_bytes (" +
+                              std::to_string(config.max_file_bytes) + ")");
+    }
     auto frame = io::load_cloud_frame(*resolved);
     if (!frame) return frame.error();
     if (msg.has_pose()) {

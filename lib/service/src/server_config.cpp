@@ -92,6 +92,10 @@ Status read_server_config(const YAML::Node& root, const fs::path& base_dir, Serv
     return s;
   }
   if (Status s = read_integer(section, "max_connections", 1, 100000, config.max_connections); !s) return s;
+  if (Status s = read_integer(section, "max_file_bytes", 1, std::numeric_limits<long long>::max(), config.max_file_bytes);
+      !s) {
+    return s;
+  }
   if (Status s = read_integer(section, "io_threads", 1, kMaxIoThreads, config.io_threads); !s) return s;
 
   std::vector<std::string> roots;

@@ -25,6 +25,7 @@ struct ServerConfig {
   std::size_t max_connections = 64;             ///< further clients get UNAVAILABLE and are closed
   int io_threads = 2;                           ///< threads running the sockets
   std::vector<std::filesystem::path> data_roots;  ///< IngestFile only reads below these (none: disabled)
+  std::uint64_t max_file_bytes = 512ull << 20;  ///< larger files under the data roots are refused unread
   std::filesystem::path model_dir;              ///< loaded at start, saved by SaveModel and at exit (empty: none)
 };
 
