@@ -330,6 +330,31 @@ TEST_F(RequestHandlerTest, IngestFileStaysInsideTheDataRoots) {
   EXPECT_EQ(frames_processed(), 0u);
 }
 
+// The file is opened beneath its root by the kernel, after any check: a folder inside the root
+// that is (or is swapped for) a symlink to the outside leads nowhere, while a symlink that stays
+// inside the root is followed.
+TEST_F(RequestHandlerTest, IngestFileOpensBeneathTheRoot) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  const fs::path root = tmp_ / "root";
+  const fs::path outside = tmp_ / "elsewhere";
+  fs::create_directories(root / "real");
+  fs::create_directories(outside);
+  fs::copy_file(test::data_dir() / kMug, outside / "mug.pcd");
+  fs::copy_file(test::data_dir() / kMug, root / "real" / "mug.pcd");
+  fs::create_directory_symlink(outside, root / "swapped");         // a folder swapped for a link out
+  fs::create_directory_symlink(root / "real", root / "inside");     // a link that stays inside
+  RequestHandler handler(memory_, HandlerConfig{{root}, {}});
+  const auto escaped = ingest_file(handler, (root / "swapped" / "mug.pcd").string());
+  EXPECT_EQ(escaped.status().code(), proto::Status::PERMISSION_DENIED) << escaped.status().message();
+  EXPECT_EQ(frames_processed(), 0u);
+  const auto inside = ingest_file(handler, (root / "inside" / "mug.pcd").string());
+  ASSERT_EQ(inside.status().code(), proto::Status::OK) << inside.status().message();
+  EXPECT_EQ(frames_processed(), 1u);
+  const auto folder = ingest_file(handler, (root / "real").string());
+  EXPECT_EQ(folder.status().code(), proto::Status::INVALID_ARGUMENT);
+  EXPECT_NE(folder.status().message().find("not a regular file"), std::string::npos) << folder.status().message();
+}
+
 TEST_F(RequestHandlerTest, IngestFileReadsACloudUnderARoot) {
   SCENEWATCH_REQUIRE_DATA(kMug);
   RequestHandler handler(memory_, HandlerConfig{{test::data_dir() / "pcl"}, {}});

@@ -1,5 +1,14 @@
 #include "scenewatch/core/files.h"
 
+#include <fcntl.h>
+#include <linux/openat2.h>
+#include <sys/stat.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include <fstream>
 #include <system_error>
 
@@ -15,6 +24,51 @@ Status check_readable_file(const fs::path& path) {
   std::ifstream probe(path, std::ios::binary);
   if (!probe) return io_error(quoted(path) + ": cannot open for reading");
   return {};
+}
+
+FileBeneath::FileBeneath(FileBeneath&& other) noexcept
+    : fd_(other.fd_), size_(other.size_), dir_(std::move(other.dir_)), alias_(std::move(other.alias_)) {
+  other.fd_ = -1;
+  other.dir_.clear();
+  other.alias_.clear();
+}
+
+FileBeneath::~FileBeneath() {
+  std::error_code ec;
+  if (!dir_.empty()) fs::remove_all(dir_, ec);
+  if (fd_ >= 0) ::close(fd_);
+}
+
+Result<FileBeneath> open_beneath(const fs::path& root, const fs::path& relative) {
+  const int dir = ::open(root.c_str(), O_PATH | O_DIRECTORY | O_CLOEXEC);
+  if (dir < 0) return io_error(quoted(root) + ": cannot open: " + std::strerror(errno));
+  struct open_how how {};
+  how.flags = O_RDONLY | O_CLOEXEC | O_NOCTTY | O_NONBLOCK;  // NONBLOCK: a FIFO must not hang the open
+  how.resolve = RESOLVE_BENEATH | RESOLVE_NO_MAGICLINKS;
+  const int fd = static_cast<int>(::syscall(SYS_openat2, dir, relative.c_str(), &how, sizeof(how)));
+  const int open_errno = errno;
+  ::close(dir);
+  const fs::path full = root / relative;
+  if (fd < 0) {
+    if (open_errno == EXDEV || open_errno == ELOOP) {
+      return Error{ErrorCode::kPermissionDenied, quoted(full) + " leads outside " + quoted(root)};
+    }
+    if (open_errno == ENOENT) return Error{ErrorCode::kNotFound, quoted(full) + ": no such file"};
+    return io_error(quoted(full) + ": cannot open: " + std::strerror(open_errno));
+  }
+  FileBeneath file;
+  file.fd_ = fd;
+  struct stat st {};
+  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return invalid_argument(quoted(full) + ": not a regular file");
+  file.size_ = static_cast<std::uintmax_t>(st.st_size);
+  std::string dir_template = (fs::temp_directory_path() / "scenewatch-open-XXXXXX").string();
+  if (::mkdtemp(dir_template.data()) == nullptr) return io_error("cannot make a private folder: " + std::string(std::strerror(errno)));
+  file.dir_ = dir_template;
+  file.alias_ = file.dir_ / ("file" + relative.extension().string());
+  std::error_code ec;
+  fs::create_symlink("/proc/self/fd/" + std::to_string(fd), file.alias_, ec);
+  if (ec) return io_error(quoted(file.alias_) + ": " + ec.message());
+  return file;
 }
 
 }  // namespace scenewatch

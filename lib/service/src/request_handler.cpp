@@ -5,9 +5,11 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <optional>
 
 #include "proto_convert.h"
 #include "scenewatch.pb.h"
+#include "scenewatch/core/files.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/pipeline/working_memory.h"
 
@@ -277,36 +279,52 @@ struct RequestHandler::Impl {
     return {};
   }
 
-  Result<fs::path> resolve_under_roots(const fs::path& requested) const {
+  // Opens a client's path beneath the data root it names. The path is matched to a root as
+  // written (`..` folded) and, failing that or when it crosses a symlink the kernel will not follow
+  // beneath a root (an absolute one), with its symlinks resolved. Either way the kernel opens it
+  // beneath the root (open_beneath): a symlink swapped in after the match cannot lead out.
+  Result<FileBeneath> open_under_roots(const fs::path& requested) const {
     if (config.data_roots.empty()) {
       return permission_denied("reading files on the server is disabled: no data roots are configured "
                                "(server.data_roots)");
     }
-    std::error_code ec;
-    fs::path resolved = fs::weakly_canonical(requested, ec);
-    if (ec) return io_error("cannot resolve '" + requested.string() + "': " + ec.message());
-    for (const auto& root : config.data_roots) {
-      if (is_within(resolved, root)) return resolved;
-    }
     std::string roots;
     for (const auto& root : config.data_roots) roots += (roots.empty() ? "" : ", ") + root.string();
-    return permission_denied("'" + requested.string() + "' is outside the data roots (" + roots + ")");
+    std::error_code ec;
+    std::optional<Error> refused;
+    for (const fs::path& candidate : {requested.lexically_normal(), fs::weakly_canonical(requested, ec)}) {
+      for (const auto& root : config.data_roots) {
+        if (candidate.empty() || !is_within(candidate, root)) continue;
+        auto file = open_beneath(root, candidate.lexically_relative(root));
+        if (file || file.error().code != ErrorCode::kPermissionDenied) return file;
+        refused = file.error();
+      }
+    }
+    return permission_denied("'" + requested.string() + "' is outside the data roots (" + roots + ")" +
+                             (refused ? ": " + refused->message : std::string()));
   }
 
   Status ingest_file(const proto::IngestFile& msg, proto::Response& response) {
     if (msg.path().empty()) return invalid_argument("path is empty");
     const fs::path requested(msg.path());
     if (!requested.is_absolute()) return invalid_argument("path must be absolute, got '" + msg.path() + "'");
-    auto resolved = resolve_under_roots(requested);
-    if (!resolved) return resolved.error();
-    std::error_code ec;
-    const auto bytes = fs::file_size(*resolved, ec);
-    if (!ec && bytes > config.max_file_bytes) {
-      return invalid_argument("'" + msg.path() + "' is " + std::to_string(bytes) + " bytes, more than server.max_file_bytes (" +
-                              std::to_string(config.max_file_bytes) + ")");
+    auto file = open_under_roots(requested);
+    if (!file) return file.error();
+    if (file->size() > config.max_file_bytes) {
+      return invalid_argument("'" + msg.path() + "' is " + std::to_string(file->size()) +
+                              " bytes, more than server.max_file_bytes (" + std::to_string(config.max_file_bytes) + ")");
     }
-    auto frame = io::load_cloud_frame(*resolved);
-    if (!frame) return frame.error();
+    auto frame = io::load_cloud_frame(file->alias());
+    if (!frame) {
+      // Name the file the client asked for, not the private alias it was read through.
+      Error e = frame.error();
+      const std::string alias = file->alias().string();
+      for (auto at = e.message.find(alias); at != std::string::npos; at = e.message.find(alias)) {
+        e.message.replace(at, alias.size(), msg.path());
+      }
+      return e;
+    }
+    frame->source = msg.path();
     if (msg.has_pose()) {
       auto pose = convert::decode_pose(msg.pose(), "pose");
       if (!pose) return pose.error();

@@ -2,6 +2,7 @@
 /// Small file helpers shared by the modules that read files, so that every reader reports a
 /// missing or unreadable file the same way.
 #include <filesystem>
+#include <cstdint>
 #include <string>
 
 #include "scenewatch/core/result.h"
@@ -14,5 +15,31 @@ std::string quoted(const std::filesystem::path& path);
 /// OK when `path` is a regular file that can be opened for reading; otherwise kNotFound
 /// ("'path': no such file"), or an error saying it is not a regular file or cannot be opened.
 Status check_readable_file(const std::filesystem::path& path);
+
+/// A regular file opened for reading beneath a directory: the kernel resolves the path at open
+/// time (openat2 with RESOLVE_BENEATH), so no `..`, absolute symlink or symlink swapped in after a
+/// check can lead outside it. Readers that take a path read it through `alias()`, a link with the
+/// file's extension to /proc/self/fd/N in a private folder: the opened file, whatever the path
+/// names by then. Closes and removes the alias on destruction.
+class FileBeneath {
+ public:
+  FileBeneath(FileBeneath&& other) noexcept;
+  FileBeneath& operator=(FileBeneath&&) = delete;
+  FileBeneath(const FileBeneath&) = delete;
+  ~FileBeneath();
+  const std::filesystem::path& alias() const { return alias_; }
+  std::uintmax_t size() const { return size_; }
+
+ private:
+  friend Result<FileBeneath> open_beneath(const std::filesystem::path&, const std::filesystem::path&);
+  FileBeneath() = default;
+  int fd_ = -1;
+  std::uintmax_t size_ = 0;
+  std::filesystem::path dir_, alias_;
+};
+
+/// Opens `relative` beneath `root`. kPermissionDenied when the path leaves the root (`..`, a
+/// symlink out), kNotFound when it does not exist, kInvalidArgument when it is not a regular file.
+Result<FileBeneath> open_beneath(const std::filesystem::path& root, const std::filesystem::path& relative);
 
 }  // namespace scenewatch
