@@ -4,6 +4,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <chrono>
 #include <thread>
 
 #include "daemon_harness.h"
@@ -246,7 +247,7 @@ TEST_F(DaemonTest, SimulatedChangesReachTheSubscriberOnceEach) {
 
 TEST_F(DaemonTest, BadClientsNeitherChangeTheModelNorStopTheDaemon) {
   SCENEWATCH_REQUIRE_DATA(kMug);
-  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml("  read_timeout_s: 0.3\n")));
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml("  read_timeout_s: 0.3\n  frame_timeout_s: 1.0\n")));
   Client setup = daemon_.connect();
   ASSERT_EQ(call(setup, ingest_mug()).status().code(), proto::Status::OK);
   const auto baseline = call(setup, get_objects());
@@ -363,11 +364,30 @@ TEST_F(DaemonTest, BadClientsNeitherChangeTheModelNorStopTheDaemon) {
     expect_closed(client);
     expect_unchanged("stalled mid-frame");
   }
+  {  // A client that drips a byte of its frame every 0.2 s: no single stall reaches the read
+     // timeout (0.3 s), the frame deadline (1 s) closes it all the same.
+    Client client = daemon_.connect();
+    ASSERT_TRUE(client.send_raw(std::string("\x00\x00\x03\xe8", 4)).ok());
+    const auto started = std::chrono::steady_clock::now();
+    Result<proto::Response> reply = invalid_argument("no reply yet");
+    for (int i = 0; i < 25 && !reply.ok(); ++i) {
+      reply = client.receive(0.2);  // waits up to 0.2 s for the daemon's answer
+      if (!reply.ok()) ASSERT_TRUE(client.send_raw("x").ok());
+    }
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    ASSERT_TRUE(reply.ok()) << "no answer while dripping for 5 s: " << reply.error().message;
+    EXPECT_EQ(reply->status().code(), proto::Status::UNAVAILABLE);
+    EXPECT_NE(reply->status().message().find("frame timeout"), std::string::npos) << reply->status().message();
+    EXPECT_LT(elapsed, 2.0) << "the deadline is 1 s after the first byte";
+    expect_closed(client);
+    expect_unchanged("dripping a frame");
+  }
   EXPECT_TRUE(daemon_.running());
   EXPECT_EQ(daemon_.terminate(), std::optional<int>(0));
   const std::string log = daemon_.log();
   EXPECT_NE(log.find("connected"), std::string::npos);
   EXPECT_NE(log.find("read timeout"), std::string::npos);
+  EXPECT_NE(log.find("frame timeout"), std::string::npos);
 }
 
 TEST_F(DaemonTest, ManyClientsAreServedWhileFramesAreProcessed) {

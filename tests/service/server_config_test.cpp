@@ -33,6 +33,8 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
   EXPECT_EQ(s.port, kDefaultPort);
   EXPECT_EQ(s.max_message_bytes, defaults.max_message_bytes);
   EXPECT_DOUBLE_EQ(s.read_timeout_s, defaults.read_timeout_s);
+  EXPECT_DOUBLE_EQ(s.frame_timeout_s, defaults.frame_timeout_s);
+  EXPECT_EQ(s.max_file_bytes, defaults.max_file_bytes);
   EXPECT_EQ(s.max_queued_bytes, defaults.max_queued_bytes);
   EXPECT_EQ(s.max_connections, defaults.max_connections);
   EXPECT_EQ(s.io_threads, defaults.io_threads);
@@ -62,6 +64,7 @@ TEST_F(ServerConfigTest, ErrorsNameTheKey) {
       {"server:\n  port: -1\n", "server.port"},
       {"server:\n  port: seven\n", "server.port"},
       {"server:\n  read_timeout_s: 0\n", "server.read_timeout_s"},
+      {"server:\n  frame_timeout_s: -1\n", "server.frame_timeout_s"},
       {"server:\n  max_message_bytes: 10\n", "server.max_message_bytes"},
       {"server:\n  max_queued_bytes: 100\n", "server.max_queued_bytes"},
       {"server:\n  io_threads: 0\n", "server.io_threads"},

@@ -88,7 +88,8 @@ struct Server::Impl {
   void on_accept(tcp::socket socket) {
     boost::system::error_code ignored;
     socket.set_option(tcp::no_delay(true), ignored);
-    const SessionOptions options{config.max_message_bytes, config.read_timeout_s, config.max_queued_bytes};
+    const SessionOptions options{config.max_message_bytes, config.read_timeout_s, config.max_queued_bytes,
+                                 config.frame_timeout_s};
     auto session = std::make_shared<Session>(std::move(socket), options, handler, registry, log, next_number++);
     const std::size_t count = registry.add(session);
     if (count == 0) return;  // stopping: the socket closes with the session

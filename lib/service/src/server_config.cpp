@@ -52,6 +52,9 @@ Status validate(const ServerConfig& config) {
                             std::to_string(kMaxEncodableFrameBytes) + "], got " +
                             std::to_string(config.max_message_bytes));
   }
+  if (!std::isfinite(config.frame_timeout_s) || config.frame_timeout_s <= 0) {
+    return invalid_argument("server.frame_timeout_s: must be > 0, got " + str(config.frame_timeout_s));
+  }
   if (!std::isfinite(config.read_timeout_s) || config.read_timeout_s <= 0) {
     return invalid_argument("server.read_timeout_s: must be > 0, got " + str(config.read_timeout_s));
   }
@@ -86,6 +89,7 @@ Status read_server_config(const YAML::Node& root, const fs::path& base_dir, Serv
     return s;
   }
   if (Status s = section.read("read_timeout_s", config.read_timeout_s); !s) return s;
+  if (Status s = section.read("frame_timeout_s", config.frame_timeout_s); !s) return s;
   if (Status s = read_integer(section, "max_queued_bytes", 1, std::numeric_limits<long long>::max(),
                               config.max_queued_bytes);
       !s) {

@@ -111,10 +111,19 @@ void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
     return;
   }
   cancel_timer();  // progress: the stall clock restarts
+  const bool was_partial = parser_.has_partial();
   const Status fed = parser_.feed(std::string_view(read_buffer_.data(), n));
+  bool completed = false;
   while (auto frame = parser_.next()) {
     pending_bytes_ += frame->size();
     pending_.push_back(std::move(*frame));
+    completed = true;
+  }
+  // The whole-frame clock: from the first byte of a frame until it is complete.
+  if (!parser_.has_partial()) {
+    frame_started_.reset();
+  } else if (!was_partial || completed || !frame_started_) {
+    frame_started_ = std::chrono::steady_clock::now();
   }
   if (!fed) {
     fail_and_close(ErrorCode::kInvalidArgument, "broken framing: " + fed.error().message);
@@ -143,7 +152,14 @@ void Session::maybe_resume_reading() {
     }
     do_read();
     if (parser_.has_partial()) {
-      arm_timer(options_.read_timeout_s, &Session::on_stall_timeout);
+      // The stall clock, but never past the frame's own deadline: a client that drips a byte
+      // now and then keeps no frame open for ever.
+      double wait = options_.read_timeout_s;
+      if (frame_started_) {
+        const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - *frame_started_).count();
+        wait = std::max(0.0, std::min(wait, options_.frame_timeout_s - elapsed));
+      }
+      arm_timer(wait, &Session::on_stall_timeout);
     } else {
       cancel_timer();
     }
@@ -244,6 +260,13 @@ void Session::cancel_timer() {
 }
 
 void Session::on_stall_timeout() {
+  if (frame_started_ &&
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - *frame_started_).count() >= options_.frame_timeout_s) {
+    fail_and_close(ErrorCode::kUnavailable, "frame timeout: " + std::to_string(parser_.buffered_bytes()) +
+                                                " bytes of a frame in " + seconds(options_.frame_timeout_s) +
+                                                ", not the whole of it (server.frame_timeout_s)");
+    return;
+  }
   fail_and_close(ErrorCode::kUnavailable,
                  "read timeout: " + std::to_string(parser_.buffered_bytes()) + " bytes of a frame arrived, then nothing for " +
                      seconds(options_.read_timeout_s) + " (server.read_timeout_s)");

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
+#include <chrono>
+#include <optional>
 #include <string>
 
 #include "connection_registry.h"
@@ -24,6 +26,7 @@ struct SessionOptions {
   std::size_t max_message_bytes = 0;
   double read_timeout_s = 10.0;
   std::size_t max_queued_bytes = 0;
+  double frame_timeout_s = 30.0;  ///< a frame must arrive whole within this from its first byte
 };
 
 /// Owned by shared_ptrs (the registry, pending operations, queued replies). The socket's
@@ -83,6 +86,8 @@ class Session : public std::enable_shared_from_this<Session> {
   std::string peer_;
 
   FrameParser parser_;
+  /// When the unfinished frame began: each byte restarts the stall clock, not this one.
+  std::optional<std::chrono::steady_clock::time_point> frame_started_;
   std::array<char, 64 * 1024> read_buffer_{};
   bool reading_ = false;        ///< a read is outstanding
   std::deque<std::string> pending_;  ///< requests received, not yet started

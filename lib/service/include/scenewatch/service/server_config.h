@@ -21,6 +21,7 @@ struct ServerConfig {
   std::uint16_t port = kDefaultPort;            ///< 0: pick a free port (the daemon prints it)
   std::size_t max_message_bytes = 64u << 20;    ///< largest accepted frame payload (64 MiB)
   double read_timeout_s = 10.0;                 ///< a frame stalled this long mid-way closes the connection
+  double frame_timeout_s = 30.0;                ///< a frame not whole this long after its first byte closes it
   std::size_t max_queued_bytes = 16u << 20;     ///< outgoing bytes queued per client before a subscriber is dropped
   std::size_t max_connections = 64;             ///< further clients get UNAVAILABLE and are closed
   int io_threads = 2;                           ///< threads running the sockets
