@@ -429,27 +429,49 @@ TEST_F(DaemonTest, ManyClientsAreServedWhileFramesAreProcessed) {
   EXPECT_EQ(call(client, health()).health().frames_processed(), 3u);
 }
 
-TEST_F(DaemonTest, ConnectionsBeyondTheLimitAreTurnedAway) {
+// Idle clients cannot lock the others out: at the limit, the connection quiet for longest makes
+// room. Subscribers wait for events by design and are never made to; when every connection is a
+// subscriber (or busy), a newcomer is turned away.
+TEST_F(DaemonTest, AtTheConnectionLimitTheQuietestMakesRoom) {
   ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml("  max_connections: 2\n")));
   Client first = daemon_.connect();
-  Client second = daemon_.connect();
   ASSERT_EQ(call(first, health()).status().code(), proto::Status::OK);
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // first is the quieter
+  Client second = daemon_.connect();
   ASSERT_EQ(call(second, health()).status().code(), proto::Status::OK);
   Client third = daemon_.connect();
-  auto reply = third.receive(kCallTimeoutS);
+  auto served = third.call(health(), kCallTimeoutS);
+  ASSERT_TRUE(served.ok()) << served.error().message;
+  EXPECT_EQ(served->status().code(), proto::Status::OK) << "the newcomer is served";
+  auto evicted = first.receive(kCallTimeoutS);
+  ASSERT_TRUE(evicted.ok()) << evicted.error().message;
+  EXPECT_EQ(evicted->status().code(), proto::Status::UNAVAILABLE);
+  EXPECT_NE(evicted->status().message().find("make room"), std::string::npos) << evicted->status().message();
+  auto next = first.receive(kCallTimeoutS);
+  EXPECT_FALSE(next.ok()) << "the quietest connection is closed after its error reply";
+  EXPECT_EQ(call(second, health()).status().code(), proto::Status::OK) << "the other one is untouched";
+  second.close();
+  third.close();
+
+  // Two subscribers hold both slots: a third client is turned away, and they keep their events.
+  auto subscribe = [] { return request([](proto::Request& r) { r.mutable_subscribe(); }); };
+  std::vector<Client> subscribers;
+  for (int attempt = 0; attempt < 200 && subscribers.size() < 2; ++attempt) {
+    Client c = daemon_.connect();
+    auto r = c.call(subscribe(), kCallTimeoutS);
+    if (r.ok() && r->status().code() == proto::Status::OK) {
+      subscribers.push_back(std::move(c));
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the closes above not yet seen
+    }
+  }
+  ASSERT_EQ(subscribers.size(), 2u);
+  Client turned_away = daemon_.connect();
+  auto reply = turned_away.receive(kCallTimeoutS);
   ASSERT_TRUE(reply.ok()) << reply.error().message;
   EXPECT_EQ(reply->status().code(), proto::Status::UNAVAILABLE);
-  EXPECT_NE(reply->status().message().find("too many connections"), std::string::npos);
-  first.close();
-  third.close();
-  // Once a slot is free, new clients are served again (the server notices the close shortly).
-  for (int attempt = 0; attempt < 200; ++attempt) {
-    Client retry = daemon_.connect();
-    auto r = retry.call(health(), kCallTimeoutS);
-    if (r.ok() && r->status().code() == proto::Status::OK) return;
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  ADD_FAILURE() << "no slot became free after a client left";
+  EXPECT_NE(reply->status().message().find("too many connections"), std::string::npos) << reply->status().message();
+  for (auto& s : subscribers) EXPECT_EQ(call(s, health()).status().code(), proto::Status::OK);
 }
 
 TEST_F(DaemonTest, StartsEmptyWithoutAModelAndRefusesABadConfig) {

@@ -28,6 +28,21 @@ void ConnectionRegistry::stop_all() {
   for (const auto& session : sessions) session->stop();
 }
 
+std::shared_ptr<Session> ConnectionRegistry::quietest(const std::shared_ptr<Session>& except) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  std::shared_ptr<Session> best;
+  std::int64_t best_since = -1;
+  for (const auto& s : sessions_) {
+    const std::int64_t since = s->quiet_since_ns();
+    if (s == except || since < 0) continue;
+    if (!best || since < best_since) {
+      best = s;
+      best_since = since;
+    }
+  }
+  return best;
+}
+
 std::size_t ConnectionRegistry::size() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return sessions_.size();

@@ -19,6 +19,9 @@ class ConnectionRegistry {
   /// Asks every session to close; later add() calls are refused.
   void stop_all();
   std::size_t size() const;
+  /// The session quiet for longest (Session::quiet_since_ns), other than `except`; null when none
+  /// is quiet.
+  std::shared_ptr<Session> quietest(const std::shared_ptr<Session>& except) const;
 
  private:
   mutable std::mutex mutex_;

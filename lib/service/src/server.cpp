@@ -93,7 +93,15 @@ struct Server::Impl {
     auto session = std::make_shared<Session>(std::move(socket), options, handler, registry, log, next_number++);
     const std::size_t count = registry.add(session);
     if (count == 0) return;  // stopping: the socket closes with the session
-    if (count > config.max_connections) {
+    // At the limit, the connection quiet for longest makes room (idle clients cannot lock others
+    // out); only when every connection is busy or subscribed is the newcomer turned away.
+    std::shared_ptr<Session> room;
+    if (count > config.max_connections) room = registry.quietest(session);
+    if (room) {
+      room->evict("closed to make room for a new connection: this one was the quietest (server.max_connections " +
+                  std::to_string(config.max_connections) + ")");
+      asio::post(session->executor(), [session] { session->start(); });
+    } else if (count > config.max_connections) {
       asio::post(session->executor(), [session, limit = config.max_connections] {
         session->start_rejected(ErrorCode::kUnavailable,
                                 "too many connections (limit " + std::to_string(limit) + ", server.max_connections)");

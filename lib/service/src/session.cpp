@@ -111,6 +111,7 @@ void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
     return;
   }
   cancel_timer();  // progress: the stall clock restarts
+  quiet_since_ns_ = -1;  // and the client is not quiet
   const bool was_partial = parser_.has_partial();
   const Status fed = parser_.feed(std::string_view(read_buffer_.data(), n));
   bool completed = false;
@@ -136,6 +137,28 @@ void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
 bool Session::idle() const { return !in_flight_ && pending_.empty() && outgoing_.empty(); }
 
 void Session::maybe_resume_reading() {
+  resume_reading();
+  update_quiet();
+}
+
+void Session::update_quiet() {
+  const bool quiet = idle() && !parser_.has_partial() && context_.subscription < 0 && !closing_ && !closed_ && !lingering_;
+  if (!quiet) {
+    quiet_since_ns_ = -1;
+  } else if (quiet_since_ns_.load() < 0) {
+    quiet_since_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                          std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
+}
+
+void Session::evict(std::string reason) {
+  asio::post(executor_, [self = shared_from_this(), reason = std::move(reason)] {
+    if (self->quiet_since_ns_.load() < 0 || self->closing_ || self->closed_) return;
+    self->fail_and_close(ErrorCode::kUnavailable, reason);
+  });
+}
+
+void Session::resume_reading() {
   if (closing_ || closed_ || lingering_) return;
   if (peer_done_) {
     if (idle()) close("client disconnected");

@@ -5,6 +5,7 @@
 #include <boost/asio/steady_timer.hpp>
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <deque>
 #include <memory>
@@ -45,6 +46,12 @@ class Session : public std::enable_shared_from_this<Session> {
   void start_rejected(ErrorCode code, const std::string& message);
   /// Closes the connection. Thread safe.
   void stop();
+  /// Since when (steady clock, ns) the connection has been quiet: nothing asked, nothing being
+  /// answered or sent, no unfinished frame, no subscription. -1 while it is not. Thread safe.
+  std::int64_t quiet_since_ns() const { return quiet_since_ns_.load(); }
+  /// Closes the connection with `reason` if it is still quiet when the strand gets to it (it may
+  /// have become busy since it was picked). Thread safe.
+  void evict(std::string reason);
   /// The strand the session runs on.
   const Executor& executor() const { return executor_; }
 
@@ -58,6 +65,8 @@ class Session : public std::enable_shared_from_this<Session> {
   void do_read();
   void on_read(const boost::system::error_code& ec, std::size_t n);
   void maybe_resume_reading();
+  void resume_reading();
+  void update_quiet();
   /// No request waiting or running and nothing left to send.
   bool idle() const;
   void dispatch_next();
@@ -104,6 +113,7 @@ class Session : public std::enable_shared_from_this<Session> {
   bool lingering_ = false;      ///< our side is shut down; draining the client's bytes
   bool closed_ = false;
   std::string close_reason_;
+  std::atomic<std::int64_t> quiet_since_ns_{-1};
 };
 
 }  // namespace scenewatch::service
