@@ -474,6 +474,47 @@ TEST_F(DaemonTest, AtTheConnectionLimitTheQuietestMakesRoom) {
   for (auto& s : subscribers) EXPECT_EQ(call(s, health()).status().code(), proto::Status::OK);
 }
 
+// Unfinished frames are held within one budget for all clients: several clients each holding
+// most of a large frame cannot fill the memory. The one that goes over is closed; the others and
+// new clients are served.
+TEST_F(DaemonTest, UnfinishedFramesShareOneMemoryBudget) {
+  ASSERT_NO_FATAL_FAILURE(
+      daemon_.start(tmp_, server_yaml("  max_message_bytes: 1000000\n  max_buffered_bytes: 1500000\n")));
+  const std::string header("\x00\x0f\x42\x40", 4);  // 1,000,000 bytes follow
+  std::vector<Client> holders;
+  holders.push_back(daemon_.connect());
+  ASSERT_TRUE(holders[0].send_raw(header + std::string(800000, 'x')).ok());
+  holders.push_back(daemon_.connect());
+  ASSERT_TRUE(holders[1].send_raw(header + std::string(800000, 'y')).ok());
+  // Whichever the daemon read second goes over the budget (usually the second client).
+  int refused = -1;
+  for (int attempt = 0; attempt < 20 && refused < 0; ++attempt) {
+    for (int i = 0; i < 2 && refused < 0; ++i) {
+      auto reply = holders[i].receive(0.25);
+      if (!reply.ok()) continue;
+      EXPECT_EQ(reply->status().code(), proto::Status::UNAVAILABLE);
+      EXPECT_NE(reply->status().message().find("server.max_buffered_bytes"), std::string::npos) << reply->status().message();
+      refused = i;
+    }
+  }
+  ASSERT_GE(refused, 0) << "one of the two must be refused";
+  Client probe = daemon_.connect();
+  EXPECT_EQ(call(probe, health()).status().code(), proto::Status::OK) << "new clients are served";
+  holders[1 - refused].close();  // its share is given back: a large frame fits again
+  // (retried while the daemon has not yet seen the close)
+  Result<proto::Response> parsed = invalid_argument("not tried");
+  for (int attempt = 0; attempt < 50; ++attempt) {
+    Client third = daemon_.connect();
+    ASSERT_TRUE(third.send_raw(header + std::string(1000000, 'z')).ok());
+    parsed = third.receive(kCallTimeoutS);
+    if (parsed.ok() && parsed->status().code() != proto::Status::UNAVAILABLE) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  ASSERT_TRUE(parsed.ok()) << parsed.error().message;
+  EXPECT_EQ(parsed->status().code(), proto::Status::INVALID_ARGUMENT) << "read whole, then refused as no request: "
+                                                                       << parsed->status().message();
+}
+
 TEST_F(DaemonTest, StartsEmptyWithoutAModelAndRefusesABadConfig) {
   ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
   Client client = daemon_.connect();

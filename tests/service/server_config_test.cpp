@@ -36,6 +36,7 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
   EXPECT_DOUBLE_EQ(s.frame_timeout_s, defaults.frame_timeout_s);
   EXPECT_EQ(s.max_file_bytes, defaults.max_file_bytes);
   EXPECT_EQ(s.max_queued_bytes, defaults.max_queued_bytes);
+  EXPECT_EQ(s.max_buffered_bytes, defaults.max_buffered_bytes);
   EXPECT_EQ(s.max_connections, defaults.max_connections);
   EXPECT_EQ(s.io_threads, defaults.io_threads);
   EXPECT_TRUE(s.data_roots.empty());
@@ -65,6 +66,7 @@ TEST_F(ServerConfigTest, ErrorsNameTheKey) {
       {"server:\n  port: seven\n", "server.port"},
       {"server:\n  read_timeout_s: 0\n", "server.read_timeout_s"},
       {"server:\n  frame_timeout_s: -1\n", "server.frame_timeout_s"},
+      {"server:\n  max_buffered_bytes: 1000\n", "server.max_buffered_bytes"},
       {"server:\n  max_message_bytes: 10\n", "server.max_message_bytes"},
       {"server:\n  max_queued_bytes: 100\n", "server.max_queued_bytes"},
       {"server:\n  io_threads: 0\n", "server.io_threads"},

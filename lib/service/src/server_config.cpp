@@ -52,6 +52,10 @@ Status validate(const ServerConfig& config) {
                             std::to_string(kMaxEncodableFrameBytes) + "], got " +
                             std::to_string(config.max_message_bytes));
   }
+  if (config.max_buffered_bytes < config.max_message_bytes) {
+    return invalid_argument("server.max_buffered_bytes: must be >= max_message_bytes (" +
+                            std::to_string(config.max_message_bytes) + "), got " + std::to_string(config.max_buffered_bytes));
+  }
   if (!std::isfinite(config.frame_timeout_s) || config.frame_timeout_s <= 0) {
     return invalid_argument("server.frame_timeout_s: must be > 0, got " + str(config.frame_timeout_s));
   }
@@ -96,6 +100,11 @@ Status read_server_config(const YAML::Node& root, const fs::path& base_dir, Serv
     return s;
   }
   if (Status s = read_integer(section, "max_connections", 1, 100000, config.max_connections); !s) return s;
+  if (Status s = read_integer(section, "max_buffered_bytes", 1, std::numeric_limits<long long>::max(),
+                              config.max_buffered_bytes);
+      !s) {
+    return s;
+  }
   if (Status s = read_integer(section, "max_file_bytes", 1, std::numeric_limits<long long>::max(), config.max_file_bytes);
       !s) {
     return s;

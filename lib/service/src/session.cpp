@@ -120,6 +120,12 @@ void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
     pending_.push_back(std::move(*frame));
     completed = true;
   }
+  if (!account_buffered()) {
+    fail_and_close(ErrorCode::kUnavailable,
+                   "server busy: unfinished frames of all clients would hold more than " +
+                       std::to_string(options_.max_buffered_bytes) + " bytes (server.max_buffered_bytes); send again later");
+    return;
+  }
   // The whole-frame clock: from the first byte of a frame until it is complete.
   if (!parser_.has_partial()) {
     frame_started_.reset();
@@ -304,6 +310,10 @@ void Session::fail_and_close(ErrorCode code, const std::string& message) {
   close_reason_ = message;
   pending_.clear();
   pending_bytes_ = 0;
+  // No more of its bytes are read: the unfinished frame is dropped, and its share of the budget
+  // given back, now rather than when the client finally goes.
+  parser_ = FrameParser(parser_.max_payload_bytes());
+  account_buffered();
   enqueue(handler_.error_payload(code, message));
   // The client may not read the error either: give the write as long as a stalled read.
   arm_timer(options_.read_timeout_s, &Session::on_linger_timeout);
@@ -319,9 +329,23 @@ void Session::begin_linger() {
   do_read();
 }
 
+bool Session::account_buffered() {
+  if (!options_.buffered_total) return true;
+  const std::size_t now = closed_ ? 0 : parser_.buffered_bytes();
+  if (now >= accounted_bytes_) {
+    const std::size_t total = options_.buffered_total->fetch_add(now - accounted_bytes_) + (now - accounted_bytes_);
+    accounted_bytes_ = now;
+    return total <= options_.max_buffered_bytes || now == 0;
+  }
+  options_.buffered_total->fetch_sub(accounted_bytes_ - now);
+  accounted_bytes_ = now;
+  return true;
+}
+
 void Session::close(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
+  account_buffered();  // gives this session's share back
   cancel_timer();
   handler_.unsubscribe(context_);
   boost::system::error_code ignored;

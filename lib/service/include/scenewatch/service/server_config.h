@@ -23,6 +23,7 @@ struct ServerConfig {
   double read_timeout_s = 10.0;                 ///< a frame stalled this long mid-way closes the connection
   double frame_timeout_s = 30.0;                ///< a frame not whole this long after its first byte closes it
   std::size_t max_queued_bytes = 16u << 20;     ///< outgoing bytes queued per client before a subscriber is dropped
+  std::size_t max_buffered_bytes = 256u << 20;  ///< bytes of unfinished frames held across all clients
   std::size_t max_connections = 64;             ///< further clients get UNAVAILABLE and are closed
   int io_threads = 2;                           ///< threads running the sockets
   std::vector<std::filesystem::path> data_roots;  ///< IngestFile only reads below these (none: disabled)
