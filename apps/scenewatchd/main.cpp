@@ -132,7 +132,7 @@ int main(int argc, char** argv) {
 
   int rc = 0;
   if (!model.empty()) {
-    if (auto s = memory.save(model); s) {
+    if (auto s = memory.save(model, config.server.keep_snapshots); s) {
       log(LogLevel::kInfo, "saved the model to " + model.string());
     } else {
       log(LogLevel::kError, "cannot save the model to " + model.string() + ": " + s.error().message);

@@ -288,6 +288,35 @@ TEST(WorkingMemory, SaveAndLoadTheModelDirectory) {
   EXPECT_EQ(wm.snapshot()->objects.size(), 2u);
 }
 
+// The newest snapshots stay: a model saved over by mistake (a Reset, then a save) is still on disk,
+// and pointing `current` back at it brings it back.
+TEST(WorkingMemory, OlderSnapshotsAreKeptToUndoASave) {
+  const test::TempDir dir("model");
+  WorkingMemory wm(test_config());
+  ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, 1.0)).ok());
+  ASSERT_TRUE(wm.save(dir, 3).ok());
+  for (int i = 0; i < 3; ++i) ASSERT_TRUE(wm.save(dir, 3).ok());
+  wm.reset();
+  ASSERT_TRUE(wm.save(dir, 3).ok()) << "the wiped model saved over the good one";
+  std::vector<std::string> snapshots;
+  for (const auto& e : fs::directory_iterator(dir.path())) {
+    const std::string n = e.path().filename().string();
+    if (n.rfind("snap-", 0) == 0) snapshots.push_back(n);
+  }
+  std::sort(snapshots.begin(), snapshots.end());
+  ASSERT_EQ(snapshots, (std::vector<std::string>{"snap-000003", "snap-000004", "snap-000005"}));
+  EXPECT_EQ(fs::read_symlink(dir / "current"), "snap-000005");
+  WorkingMemory wiped(test_config());
+  ASSERT_TRUE(wiped.load(dir).ok());
+  EXPECT_EQ(wiped.stats().frames_processed, 0u);
+  fs::remove(dir / "current");
+  fs::create_directory_symlink("snap-000004", dir / "current");
+  WorkingMemory restored(test_config());
+  ASSERT_TRUE(restored.load(dir).ok());
+  EXPECT_EQ(restored.stats().frames_processed, 1u) << "the model before the wipe";
+  EXPECT_EQ(restored.snapshot()->objects.size(), 2u);
+}
+
 // A background.ot cut short (a full disk, a copy interrupted) is refused: OctoMap itself reads the
 // first half of the tree and says nothing. The loaded model stays, and so does the file.
 TEST(WorkingMemory, TruncatedBackgroundIsRefused) {

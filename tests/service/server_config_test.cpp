@@ -37,6 +37,7 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
   EXPECT_EQ(s.max_file_bytes, defaults.max_file_bytes);
   EXPECT_EQ(s.max_queued_bytes, defaults.max_queued_bytes);
   EXPECT_EQ(s.max_buffered_bytes, defaults.max_buffered_bytes);
+  EXPECT_EQ(s.keep_snapshots, defaults.keep_snapshots);
   EXPECT_EQ(s.max_connections, defaults.max_connections);
   EXPECT_EQ(s.io_threads, defaults.io_threads);
   EXPECT_TRUE(s.data_roots.empty());

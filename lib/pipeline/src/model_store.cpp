@@ -117,7 +117,8 @@ Result<fs::path> current_snapshot(const fs::path& model_dir) {
   return target;
 }
 
-Status commit_snapshot(const fs::path& model_dir, const std::function<Status(const fs::path&)>& write_files) {
+Status commit_snapshot(const fs::path& model_dir, const std::function<Status(const fs::path&)>& write_files,
+                       std::size_t keep) {
   std::error_code ec;
   fs::create_directories(model_dir, ec);
   if (ec) return io_error("'" + model_dir.string() + "': cannot create model directory: " + ec.message());
@@ -151,10 +152,15 @@ Status commit_snapshot(const fs::path& model_dir, const std::function<Status(con
   fs::rename(link_tmp, model_dir / "current", ec);  // atomic replacement of the link
   if (ec) return io_error("'" + (model_dir / "current").string() + "': cannot replace link: " + ec.message());
   if (auto st = fsync_path(model_dir, true); !st) return st;
-  // Older snapshots are no longer referenced.
+  // Snapshots beyond the newest `keep` are no longer kept (names sort by number: snap-%06d).
+  std::vector<std::string> snapshots;
   for (const auto& entry : fs::directory_iterator(model_dir, ec)) {
     const std::string n = entry.path().filename().string();
-    if (n.rfind("snap-", 0) == 0 && n != name) fs::remove_all(entry.path(), ec);
+    if (n.rfind("snap-", 0) == 0 && n.find(".tmp") == std::string::npos) snapshots.push_back(n);
+  }
+  std::sort(snapshots.begin(), snapshots.end(), std::greater<>());
+  for (std::size_t i = std::max<std::size_t>(1, keep); i < snapshots.size(); ++i) {
+    if (snapshots[i] != name) fs::remove_all(model_dir / snapshots[i], ec);
   }
   return {};
 }

@@ -21,9 +21,9 @@ Result<Plane> plane_from_json(const nlohmann::json& j);
 Result<TrackedObject> object_from_json(const nlohmann::json& j);
 
 /// Writes a new snapshot folder with `write_files(dir)`, fsyncs it, then points `current` at it
-/// and removes older snapshots.
+/// and removes the snapshots older than the newest `keep` (at least the new one stays).
 Status commit_snapshot(const std::filesystem::path& model_dir,
-                       const std::function<Status(const std::filesystem::path&)>& write_files);
+                       const std::function<Status(const std::filesystem::path&)>& write_files, std::size_t keep = 1);
 
 /// The folder `current` points at; kNotFound when there is no saved model.
 Result<std::filesystem::path> current_snapshot(const std::filesystem::path& model_dir);

@@ -420,7 +420,7 @@ Status load_background(background::OccupancyMap& map, const fs::path& path, cons
 
 }  // namespace
 
-Status WorkingMemory::save(const fs::path& model_dir) const {
+Status WorkingMemory::save(const fs::path& model_dir, std::size_t keep_snapshots) const {
   std::lock_guard<std::mutex> lock(impl_->writer);
   const Impl& m = *impl_;
   return commit_snapshot(model_dir, [&](const fs::path& dir) -> Status {
@@ -463,7 +463,7 @@ Status WorkingMemory::save(const fs::path& model_dir) const {
     if (auto st = m.appearance.save(dir); !st) return st;
     if (auto st = write_file_synced(dir / "scene.json", scene.dump(2)); !st) return st;
     return write_file_synced(dir / "events.jsonl", log);
-  });
+  }, keep_snapshots);
 }
 
 Status WorkingMemory::load(const fs::path& model_dir) {

@@ -421,7 +421,7 @@ struct RequestHandler::Impl {
 
   Status save_model(proto::Response& response) {
     if (Status s = require_model_dir(); !s) return s;
-    if (Status s = memory.save(config.model_dir); !s) return s;
+    if (Status s = memory.save(config.model_dir, config.keep_snapshots); !s) return s;
     response.mutable_save_model()->set_model_dir(config.model_dir.string());
     return {};
   }

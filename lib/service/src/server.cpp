@@ -54,7 +54,7 @@ struct Server::Impl {
       : config(std::move(c)),
         memory(m),
         log(std::move(l)),
-        handler(m, HandlerConfig{config.data_roots, config.model_dir, config.max_file_bytes},
+        handler(m, HandlerConfig{config.data_roots, config.model_dir, config.max_file_bytes, config.keep_snapshots},
                 [this](std::function<void()> task) { asio::post(model_strand, std::move(task)); },
                 [this](std::function<void()> task) { asio::post(workers, std::move(task)); }) {
     handler.set_connection_counter([this] { return registry.size(); });

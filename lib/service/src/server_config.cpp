@@ -110,6 +110,7 @@ Status read_server_config(const YAML::Node& root, const fs::path& base_dir, Serv
     return s;
   }
   if (Status s = read_integer(section, "io_threads", 1, kMaxIoThreads, config.io_threads); !s) return s;
+  if (Status s = read_integer(section, "keep_snapshots", 1, 1000, config.keep_snapshots); !s) return s;
 
   std::vector<std::string> roots;
   for (const auto& r : config.data_roots) roots.push_back(r.string());

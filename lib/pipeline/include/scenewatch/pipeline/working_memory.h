@@ -115,8 +115,10 @@ class WorkingMemory {
   void reset();
 
   /// Model directory: written to a new snapshot folder (write, fsync, rename of a `current`
-  /// link), so a crash never leaves a half-written model.
-  Status save(const std::filesystem::path& model_dir) const;
+  /// link), so a crash never leaves a half-written model. The newest `keep_snapshots` snapshots
+  /// stay (older ones are removed): a model saved over by mistake (a Reset, then SaveModel) can
+  /// be brought back by pointing `current` at the one before.
+  Status save(const std::filesystem::path& model_dir, std::size_t keep_snapshots = 1) const;
   /// Loads the model that `current` points at. A missing directory is an error of kind kNotFound.
   Status load(const std::filesystem::path& model_dir);
 

@@ -22,6 +22,7 @@ struct HandlerConfig {
   std::vector<std::filesystem::path> data_roots;  ///< IngestFile reads only below these
   std::filesystem::path model_dir;                ///< SaveModel / LoadModel target (empty: none)
   std::uint64_t max_file_bytes = 512ull << 20;    ///< IngestFile refuses larger files unread
+  std::size_t keep_snapshots = 3;                 ///< SaveModel keeps this many snapshots
 };
 
 /// The answer to one request.

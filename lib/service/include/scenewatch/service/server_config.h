@@ -29,6 +29,7 @@ struct ServerConfig {
   std::vector<std::filesystem::path> data_roots;  ///< IngestFile only reads below these (none: disabled)
   std::uint64_t max_file_bytes = 512ull << 20;  ///< larger files under the data roots are refused unread
   std::filesystem::path model_dir;              ///< loaded at start, saved by SaveModel and at exit (empty: none)
+  std::size_t keep_snapshots = 3;               ///< saved models kept in model_dir (the newest is `current`)
 };
 
 /// Checks ranges; the message names the key ("server.read_timeout_s: must be > 0, got 0").
