@@ -1,12 +1,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
+#include <iterator>
 #include <limits>
 
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/event.h"
+#include "scenewatch/core/files.h"
 #include "scenewatch/core/geometry.h"
 #include "scenewatch/core/result.h"
+#include "test_data.h"
 
 namespace scenewatch {
 namespace {
@@ -75,6 +79,36 @@ TEST(Result, ValueAndError) {
   EXPECT_STREQ(to_string(ErrorCode::kNotFound), "not_found");
   EXPECT_STREQ(to_string(EventKind::kObjectGone), "OBJECT_GONE");
   EXPECT_STREQ(to_string(EventLevel::kImplausibility), "IMPLAUSIBILITY");
+}
+
+// Every writer of the project goes through write_atomically: a failed write leaves the old file
+// as it was and no temporary file behind; a good one replaces it whole.
+TEST(Files, WriteAtomicallyReplacesWholeOrNotAtAll) {
+  const test::TempDir dir("atomic");
+  const std::filesystem::path path = dir / "sub" / "a.txt";
+  auto write_text = [](const std::string& text) {
+    return [text](const std::filesystem::path& tmp) -> Status {
+      std::ofstream(tmp) << text;
+      return {};
+    };
+  };
+  auto read_text = [](const std::filesystem::path& p) {
+    std::ifstream in(p);
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  };
+  ASSERT_TRUE(write_atomically(path, write_text("first")).ok()) << "the folder is created";
+  EXPECT_EQ(read_text(path), "first");
+  const Status failed = write_atomically(path, [](const std::filesystem::path& tmp) -> Status {
+    std::ofstream(tmp) << "half of";
+    return io_error("disk full");
+  });
+  ASSERT_FALSE(failed.ok());
+  EXPECT_EQ(failed.error().message, "disk full");
+  EXPECT_EQ(read_text(path), "first") << "the old file stays";
+  EXPECT_FALSE(std::filesystem::exists(path.string() + ".tmp")) << "no temporary file is left";
+  ASSERT_TRUE(write_atomically(path, write_text("second"), ".tmp.txt").ok());
+  EXPECT_EQ(read_text(path), "second");
+  EXPECT_FALSE(std::filesystem::exists(path.string() + ".tmp.txt"));
 }
 
 }  // namespace

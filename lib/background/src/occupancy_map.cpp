@@ -418,24 +418,15 @@ void OccupancyMap::reset() {
 Status OccupancyMap::save(const fs::path& path) const {
   std::string ext = path.extension().string();
   if (ext != ".ot" && ext != ".bt") return invalid_argument(quoted(path) + ": map files end in .ot or .bt");
-  std::error_code ec;
-  if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
-  const fs::path tmp = path.string() + ".tmp";
-  bool ok = false;
-  {
+  return write_atomically(path, [&](const fs::path& tmp) -> Status {
     std::ofstream out(tmp, std::ios::binary);
     if (!out) return io_error(quoted(tmp) + ": cannot open for writing");
-    ok = ext == ".ot" ? impl_->tree.write(out) : impl_->tree.writeBinaryConst(out);
+    bool ok = ext == ".ot" ? impl_->tree.write(out) : impl_->tree.writeBinaryConst(out);
     out.flush();
     ok = ok && static_cast<bool>(out);
-  }
-  if (!ok) {
-    fs::remove(tmp, ec);
-    return io_error(quoted(path) + ": writing the map failed");
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) return io_error(quoted(path) + ": cannot rename into place: " + ec.message());
-  return {};
+    if (!ok) return io_error(quoted(path) + ": writing the map failed");
+    return {};
+  });
 }
 
 Status OccupancyMap::load(const fs::path& path) {

@@ -39,6 +39,38 @@ FileBeneath::~FileBeneath() {
   if (fd_ >= 0) ::close(fd_);
 }
 
+Status fsync_path(const fs::path& path, bool directory) {
+  const int fd = ::open(path.c_str(), (directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY) | O_CLOEXEC);
+  if (fd < 0) return io_error(quoted(path) + ": cannot open to sync: " + std::strerror(errno));
+  const int rc = ::fsync(fd);
+  const int sync_errno = errno;
+  ::close(fd);
+  if (rc != 0) return io_error(quoted(path) + ": fsync failed: " + std::strerror(sync_errno));
+  return {};
+}
+
+Status write_atomically(const fs::path& path, const std::function<Status(const fs::path& tmp)>& write,
+                        const std::string& tmp_suffix) {
+  std::error_code ec;
+  const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  fs::create_directories(folder, ec);
+  const fs::path tmp = path.string() + tmp_suffix;
+  if (auto st = write(tmp); !st) {
+    fs::remove(tmp, ec);
+    return st;
+  }
+  if (auto st = fsync_path(tmp, false); !st) {
+    fs::remove(tmp, ec);
+    return st;
+  }
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    return io_error(quoted(path) + ": cannot rename into place: " + ec.message());
+  }
+  return fsync_path(folder, true);
+}
+
 Result<FileBeneath> open_beneath(const fs::path& root, const fs::path& relative) {
   const int dir = ::open(root.c_str(), O_PATH | O_DIRECTORY | O_CLOEXEC);
   if (dir < 0) return io_error(quoted(root) + ": cannot open: " + std::strerror(errno));

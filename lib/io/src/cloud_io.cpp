@@ -251,17 +251,11 @@ Result<std::vector<std::uint32_t>> read_pcd_labels(const fs::path& path) {
 Status write_pcd(const fs::path& path, const Cloud& cloud) {
   quiet_pcl();
   if (cloud.empty()) return invalid_argument(quoted(path) + ": refusing to write an empty cloud");
-  std::error_code ec;
-  if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
-  const fs::path tmp = path.string() + ".tmp";
-  pcl::PCDWriter writer;
-  if (writer.writeBinary(tmp.string(), cloud) < 0) {
-    fs::remove(tmp, ec);
-    return io_error(quoted(path) + ": cannot write");
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) return io_error(quoted(path) + ": cannot rename into place: " + ec.message());
-  return {};
+  return write_atomically(path, [&](const fs::path& tmp) -> Status {
+    pcl::PCDWriter writer;
+    if (writer.writeBinary(tmp.string(), cloud) < 0) return io_error(quoted(path) + ": cannot write");
+    return {};
+  });
 }
 
 Status write_mesh_ply(const fs::path& path, const ColoredMesh& mesh) {
@@ -285,16 +279,10 @@ Status write_mesh_ply(const fs::path& path, const ColoredMesh& mesh) {
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
     for (std::uint32_t v : mesh.triangles[i]) out.polygons[i].vertices.push_back(static_cast<pcl::index_t>(v));
   }
-  std::error_code ec;
-  if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
-  const fs::path tmp = path.string() + ".tmp";
-  if (pcl::io::savePLYFileBinary(tmp.string(), out) < 0) {
-    fs::remove(tmp, ec);
-    return io_error(quoted(path) + ": cannot write");
-  }
-  fs::rename(tmp, path, ec);
-  if (ec) return io_error(quoted(path) + ": cannot rename into place: " + ec.message());
-  return {};
+  return write_atomically(path, [&](const fs::path& tmp) -> Status {
+    if (pcl::io::savePLYFileBinary(tmp.string(), out) < 0) return io_error(quoted(path) + ": cannot write");
+    return {};
+  });
 }
 
 Result<ColoredMesh> read_mesh_ply(const fs::path& path) {

@@ -1,5 +1,7 @@
 #include "model_store.h"
 
+#include "scenewatch/core/files.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -85,15 +87,6 @@ Result<TrackedObject> object_from_json(const json& j) {
   });
 }
 
-
-Status fsync_path(const fs::path& path, bool directory) {
-  const int fd = ::open(path.c_str(), directory ? (O_RDONLY | O_DIRECTORY) : O_RDONLY);
-  if (fd < 0) return io_error("'" + path.string() + "': cannot open to sync");
-  const int rc = ::fsync(fd);
-  ::close(fd);
-  if (rc != 0) return io_error("'" + path.string() + "': fsync failed");
-  return {};
-}
 
 Status write_file_synced(const fs::path& path, const std::string& text) {
   {

@@ -30,7 +30,5 @@ Result<std::filesystem::path> current_snapshot(const std::filesystem::path& mode
 
 /// Writes text to a file and fsyncs it.
 Status write_file_synced(const std::filesystem::path& path, const std::string& text);
-/// fsyncs a file or directory that is already written.
-Status fsync_path(const std::filesystem::path& path, bool directory);
 
 }  // namespace scenewatch::pipeline

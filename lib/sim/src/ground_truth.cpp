@@ -1,5 +1,7 @@
 #include "scenewatch/sim/ground_truth.h"
 
+#include "scenewatch/core/files.h"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -219,19 +221,16 @@ void pretty(const json& j, int indent, std::string* out) {
 }
 
 Status write_json_atomically(const std::filesystem::path& path, const json& j) {
-  const std::filesystem::path tmp = path.string() + ".tmp";
-  {
+  return write_atomically(path, [&](const std::filesystem::path& tmp) -> Status {
     std::ofstream out(tmp);
     if (!out) return io_error(path.string() + ": cannot open for writing");
     std::string text;
     pretty(j, 0, &text);
     out << text << '\n';
+    out.flush();
     if (!out) return io_error(path.string() + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) return io_error(path.string() + ": rename failed: " + ec.message());
-  return {};
+    return {};
+  });
 }
 
 Result<json> read_json(const std::filesystem::path& path) {

@@ -1,5 +1,7 @@
 #include "scenewatch/surprise/surprise_map.h"
 
+#include "scenewatch/core/files.h"
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -275,21 +277,18 @@ ColorImage heatmap_overlay(const SurpriseMap& map, const ColorImage& observed, d
 Status write_surprise_tiff(const std::filesystem::path& path, const SurpriseMap& map) {
   if (map.width == 0 || map.height == 0) return invalid_argument("'" + path.string() + "': empty surprise map");
   cv::Mat m(map.height, map.width, CV_32F, const_cast<float*>(map.total.data()));
-  const std::filesystem::path tmp = path.string() + ".tmp.tiff";
-  bool ok = false;
-  try {
-    ok = cv::imwrite(tmp.string(), m);
-  } catch (const cv::Exception& e) {
-    return io_error("'" + path.string() + "': cannot write TIFF: " + e.what());
-  }
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(tmp, ec);
-    return io_error("'" + path.string() + "': cannot write TIFF");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) return io_error("'" + path.string() + "': cannot rename into place: " + ec.message());
-  return {};
+  // OpenCV picks the format by the extension: the temporary file keeps ".tiff".
+  return write_atomically(
+      path,
+      [&](const std::filesystem::path& tmp) -> Status {
+        try {
+          if (!cv::imwrite(tmp.string(), m)) return io_error("'" + path.string() + "': cannot write TIFF");
+        } catch (const cv::Exception& e) {
+          return io_error("'" + path.string() + "': cannot write TIFF: " + e.what());
+        }
+        return {};
+      },
+      ".tmp.tiff");
 }
 
 }  // namespace scenewatch::surprise

@@ -2,6 +2,7 @@
 /// Small file helpers shared by the modules that read files, so that every reader reports a
 /// missing or unreadable file the same way.
 #include <filesystem>
+#include <functional>
 #include <cstdint>
 #include <string>
 
@@ -15,6 +16,17 @@ std::string quoted(const std::filesystem::path& path);
 /// OK when `path` is a regular file that can be opened for reading; otherwise kNotFound
 /// ("'path': no such file"), or an error saying it is not a regular file or cannot be opened.
 Status check_readable_file(const std::filesystem::path& path);
+
+/// fsync of a file, or of a folder (so that a rename in it is on disk).
+Status fsync_path(const std::filesystem::path& path, bool directory);
+
+/// Writes `path` so that a crash leaves either the old file or the new one, never a part: creates
+/// the parent folder, lets `write` fill a temporary file beside it (`path` + `tmp_suffix`; a
+/// writer that picks its format by the extension needs it kept), fsyncs it, renames it into
+/// place and fsyncs the folder. The temporary file is removed when `write` fails.
+Status write_atomically(const std::filesystem::path& path,
+                        const std::function<Status(const std::filesystem::path& tmp)>& write,
+                        const std::string& tmp_suffix = ".tmp");
 
 /// A regular file opened for reading beneath a directory: the kernel resolves the path at open
 /// time (openat2 with RESOLVE_BENEATH), so no `..`, absolute symlink or symlink swapped in after a
