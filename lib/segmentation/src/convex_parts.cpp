@@ -78,14 +78,17 @@ Link classify(const Patch& a, const Patch& b, const ConvexityParams& params) {
 }
 
 // The 13 forward offsets of the 26-neighbourhood: each unordered pair of patches once.
-std::vector<std::array<int, 3>> forward_offsets() {
-  std::vector<std::array<int, 3>> out;
-  for (int dx = -1; dx <= 1; ++dx)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dz = -1; dz <= 1; ++dz) {
-        if (dx > 0 || (dx == 0 && (dy > 0 || (dy == 0 && dz > 0)))) out.push_back({dx, dy, dz});
-      }
-  return out;
+const std::vector<std::array<int, 3>>& forward_offsets() {
+  static const std::vector<std::array<int, 3>> offsets = [] {
+    std::vector<std::array<int, 3>> out;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          if (dx > 0 || (dx == 0 && (dy > 0 || (dy == 0 && dz > 0)))) out.push_back({dx, dy, dz});
+        }
+    return out;
+  }();
+  return offsets;
 }
 
 // Point statistics of a part: its width is the extent across its second principal axis
@@ -194,9 +197,11 @@ std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std
   for (int v = 0; v < n; ++v) {
     for (const int* i = grid.members_begin(v); i != grid.members_end(v); ++i) shapes[label[v]].add(cloud[*i].getVector3fMap().cast<double>());
   }
+  std::map<int, bool> wide;  // per part, one eigen-solve
+  for (const auto& [part, shape] : shapes) wide[part] = shape.width() >= params.min_part_size_m;
   std::vector<int> owner(n, -1);
   for (int v = 0; v < n; ++v) {
-    if (shapes[label[v]].width() >= params.min_part_size_m) owner[v] = label[v];
+    if (wide[label[v]]) owner[v] = label[v];
   }
   std::vector<std::vector<int>> neighbours(n);
   for (const auto& [a, b] : adjacent) {
