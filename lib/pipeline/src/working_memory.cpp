@@ -27,22 +27,25 @@ namespace {
 // Farther than any depth sensor sees (lidars reach a few hundred metres).
 constexpr float kMaxPointRangeM = 1000.0f;
 
-Status validate_frame(const Frame& f) {
+// Checks a frame; returns its number of valid points (one pass over the cloud serves both).
+Result<std::size_t> validate_frame(const Frame& f) {
   const std::string where = f.source.empty() ? std::string("frame") : "frame from '" + f.source + "'";
   if (!f.cloud || f.cloud->empty()) return invalid_argument(where + ": cloud is empty");
   if (f.cloud->width * f.cloud->height != f.cloud->size()) {
     return invalid_argument(where + ": cloud width x height (" + std::to_string(f.cloud->width) + "x" +
                             std::to_string(f.cloud->height) + ") does not match its " + std::to_string(f.cloud->size()) + " points");
   }
-  if (count_valid(*f.cloud) == 0) return invalid_argument(where + ": no valid points (all NaN or non-finite)");
   // Finite is not enough: a point at 3e38 m would be ray-cast through the map. No depth sensor
   // sees that far; such coordinates are not metres (wrong units, garbage).
-  std::size_t far = 0;
+  std::size_t valid = 0, far = 0;
   const PointT* first_far = nullptr;
   for (const auto& p : f.cloud->points) {
-    if (!is_valid(p) || p.getVector3fMap().squaredNorm() <= kMaxPointRangeM * kMaxPointRangeM) continue;
+    if (!is_valid(p)) continue;
+    ++valid;
+    if (p.getVector3fMap().squaredNorm() <= kMaxPointRangeM * kMaxPointRangeM) continue;
     if (far++ == 0) first_far = &p;
   }
+  if (valid == 0) return invalid_argument(where + ": no valid points (all NaN or non-finite)");
   if (far > 0) {
     return invalid_argument(where + ": " + std::to_string(far) + " points lie farther than " +
                             std::to_string(static_cast<int>(kMaxPointRangeM)) + " m from the sensor (the first at " +
@@ -61,7 +64,7 @@ Status validate_frame(const Frame& f) {
                               ", the organized cloud is " + std::to_string(f.cloud->width) + "x" + std::to_string(f.cloud->height));
     }
   }
-  return {};
+  return valid;
 }
 
 Plane to_world(Plane p, const Pose& T) {
@@ -220,14 +223,15 @@ WorkingMemory::WorkingMemory(Config config) : config_(std::move(config)), impl_(
 WorkingMemory::~WorkingMemory() = default;
 
 Result<FrameResult> WorkingMemory::process(const Frame& frame) {
-  if (auto st = validate_frame(frame); !st) return st.error();
+  const auto valid_points = validate_frame(frame);
+  if (!valid_points) return valid_points.error();
   const auto t0 = Clock::now();
   std::lock_guard<std::mutex> lock(impl_->writer);
   Impl& m = *impl_;
   const Pose T = frame.pose_or_identity();
   FrameResult result;
   result.frame_index = m.frames;
-  result.points = count_valid(*frame.cloud);
+  result.points = *valid_points;
 
   // Two independent halves on the two cores: the image surprise and the geometric change detection
   // (both against the memory as it stands before this frame) beside the segmentation of the frame.
@@ -567,7 +571,7 @@ std::vector<Event> WorkingMemory::events_since(std::uint64_t since, std::size_t 
 }
 
 Result<std::shared_ptr<const SurpriseResult>> WorkingMemory::surprise(const Frame& observation) const {
-  if (auto st = validate_frame(observation); !st) return st.error();
+  if (auto valid = validate_frame(observation); !valid) return valid.error();
   return impl_->appearance.evaluate(observation);
 }
 
