@@ -288,18 +288,21 @@ struct RequestHandler::Impl {
       return permission_denied("reading files on the server is disabled: no data roots are configured "
                                "(server.data_roots)");
     }
-    std::string roots;
-    for (const auto& root : config.data_roots) roots += (roots.empty() ? "" : ", ") + root.string();
-    std::error_code ec;
     std::optional<Error> refused;
-    for (const fs::path& candidate : {requested.lexically_normal(), fs::weakly_canonical(requested, ec)}) {
+    auto open_as = [&](const fs::path& candidate) -> std::optional<Result<FileBeneath>> {
       for (const auto& root : config.data_roots) {
         if (candidate.empty() || !is_within(candidate, root)) continue;
         auto file = open_beneath(root, candidate.lexically_relative(root));
         if (file || file.error().code != ErrorCode::kPermissionDenied) return file;
         refused = file.error();
       }
-    }
+      return std::nullopt;
+    };
+    if (auto file = open_as(requested.lexically_normal())) return std::move(*file);
+    std::error_code ec;  // only now the file system: the path's symlinks resolved
+    if (auto file = open_as(fs::weakly_canonical(requested, ec))) return std::move(*file);
+    std::string roots;
+    for (const auto& root : config.data_roots) roots += (roots.empty() ? "" : ", ") + root.string();
     return permission_denied("'" + requested.string() + "' is outside the data roots (" + roots + ")" +
                              (refused ? ": " + refused->message : std::string()));
   }
