@@ -104,7 +104,9 @@ TEST(OccupancyMap, InvalidPointsAreSkipped) {
 }
 
 TEST(OccupancyMap, BoxQueries) {
-  OccupancyMap map(at(0.02));
+  Config exact = at(0.02);
+  exact.ray_stop_after = 0;  // every ray to the sensor: the counts below are exact
+  OccupancyMap map(exact);
   map.insert(wall(), Pose::Identity());
   const BoxOccupancy on_wall = map.query_box({{-0.1, -0.1, 1.95}, {0.1, 0.1, 2.05}});
   EXPECT_EQ(on_wall.state, Occupancy::kOccupied);
@@ -118,6 +120,21 @@ TEST(OccupancyMap, BoxQueries) {
   EXPECT_EQ(behind.state, Occupancy::kUnknown);
   EXPECT_EQ(behind.unknown_voxels, 10u * 10u * 10u);
   EXPECT_EQ(map.query_box({{1, 1, 1}, {0, 0, 0}}).state, Occupancy::kUnknown) << "inverted box";
+}
+
+// The default insertion stops a ray after 16 voxels in a row that other rays already freed; on
+// one frame that leaves a few holes in the cone: 22 of the 2000 voxels 1 m in front of the wall
+// (1.1 %), none on the wall, nothing behind it.
+TEST(OccupancyMap, RayShortcutLeavesFewHoles) {
+  OccupancyMap map(at(0.02));
+  map.insert(wall(), Pose::Identity());
+  const BoxOccupancy in_front = map.query_box({{-0.1, -0.1, 0.8}, {0.1, 0.1, 1.2}});
+  std::printf("1 m in front of the wall after one frame: %zu free, %zu unknown, %zu occupied\n", in_front.free_voxels,
+              in_front.unknown_voxels, in_front.occupied_voxels);
+  EXPECT_EQ(in_front.occupied_voxels, 0u);
+  EXPECT_LE(in_front.unknown_voxels, 30u);
+  EXPECT_EQ(map.query_box({{-0.1, -0.1, 1.95}, {0.1, 0.1, 2.05}}).state, Occupancy::kOccupied);
+  EXPECT_EQ(map.query_box({{-0.1, -0.1, 2.5}, {0.1, 0.1, 2.7}}).unknown_voxels, 10u * 10u * 10u);
 }
 
 TEST(OccupancyMap, ClearBoxFreesKnownVoxelsOnly) {

@@ -28,7 +28,7 @@ class ConfigTest : public ::testing::Test {
 
 TEST_F(ConfigTest, ReadsEveryKnownKey) {
   Config c;
-  ASSERT_TRUE(load("background:\n  resolution_m: 0.05\n  max_range_m: 3\n  fast_insertion: false\n"
+  ASSERT_TRUE(load("background:\n  resolution_m: 0.05\n  max_range_m: 3\n  fast_insertion: false\n  ray_stop_after: 4\n"
                    "segmentation:\n  voxel_size_m: 0.02\n  up_vector: [0, 0, 1]\n  seed: 9\n  max_planes: 2\n"
                    "tracking:\n  match_distance_m: 0.1\nevents:\n  max_log: 50\n",
                    c)
@@ -36,6 +36,7 @@ TEST_F(ConfigTest, ReadsEveryKnownKey) {
   EXPECT_DOUBLE_EQ(c.background.resolution_m, 0.05);
   EXPECT_DOUBLE_EQ(c.background.max_range_m, 3);
   EXPECT_FALSE(c.background.fast_insertion);
+  EXPECT_EQ(c.background.ray_stop_after, 4);
   EXPECT_DOUBLE_EQ(c.segmentation.voxel_size_m, 0.02);
   ASSERT_TRUE(c.segmentation.up.has_value());
   EXPECT_DOUBLE_EQ(c.segmentation.up->z(), 1.0);

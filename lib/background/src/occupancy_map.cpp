@@ -73,6 +73,7 @@ Status validate(const Config& c) {
   if (!(c.prob_miss > 0.0 && c.prob_miss < 0.5)) return bad("prob_miss", "must be in (0, 0.5), got " + std::to_string(c.prob_miss));
   if (!(c.clamp_min > 0.0 && c.clamp_min < 0.5)) return bad("clamp_min", "must be in (0, 0.5), got " + std::to_string(c.clamp_min));
   if (!(c.clamp_max > 0.5 && c.clamp_max < 1.0)) return bad("clamp_max", "must be in (0.5, 1), got " + std::to_string(c.clamp_max));
+  if (c.ray_stop_after < 0 || c.ray_stop_after > 1000) return bad("ray_stop_after", "must be in [0, 1000], got " + std::to_string(c.ray_stop_after));
   return {};
 }
 
@@ -91,39 +92,77 @@ OccupancyMap::OccupancyMap(OccupancyMap&&) noexcept = default;
 OccupancyMap& OccupancyMap::operator=(OccupancyMap&&) noexcept = default;
 
 namespace {
-// The voxels from the origin's voxel up to, not including, the end's voxel: OctoMap's
-// OcTreeBaseImpl::computeRayKeys (Amanatides & Woo), step for step, with its float/double
-// arithmetic, so that the rays match OctoMap's; they go into a RaySet instead of a KeyRay.
+// Amanatides & Woo's voxel walk as OctoMap's OcTreeBaseImpl::computeRayKeys does it, step for
+// step, with its float/double arithmetic, so that the rays match OctoMap's.
+class RayWalk {
+ public:
+  RayWalk(const octomap::ColorOcTree& tree, const octomap::point3d& from, const OcTreeKey& key_from, const octomap::point3d& to)
+      : current_(key_from) {
+    octomap::point3d direction = to - from;
+    length_ = static_cast<float>(direction.norm());
+    direction /= length_;
+    const double res = tree.getResolution();
+    for (unsigned i = 0; i < 3; ++i) {
+      step_[i] = direction(i) > 0.0 ? 1 : (direction(i) < 0.0 ? -1 : 0);
+      if (step_[i] != 0) {
+        double border = tree.keyToCoord(current_[i]);
+        border += static_cast<float>(step_[i] * res * 0.5);
+        t_max_[i] = (border - from(i)) / direction(i);
+        t_delta_[i] = res / std::fabs(direction(i));
+      } else {
+        t_max_[i] = t_delta_[i] = std::numeric_limits<double>::max();
+      }
+    }
+  }
+  /// Steps into the next voxel; false once the walk has passed the far end.
+  bool next() {
+    const unsigned dim = t_max_[0] < t_max_[1] ? (t_max_[0] < t_max_[2] ? 0 : 2) : (t_max_[1] < t_max_[2] ? 1 : 2);
+    current_[dim] = static_cast<octomap::key_type>(current_[dim] + step_[dim]);
+    t_max_[dim] += t_delta_[dim];
+    return std::min(std::min(t_max_[0], t_max_[1]), t_max_[2]) <= length_;
+  }
+  const OcTreeKey& key() const { return current_; }
+
+ private:
+  OcTreeKey current_;
+  float length_ = 0.0f;
+  int step_[3];
+  double t_max_[3], t_delta_[3];
+};
+
+// The voxels from the origin's voxel up to, not including, the end's voxel (OctoMap's ray).
 void cast_ray(const octomap::ColorOcTree& tree, const octomap::point3d& origin, const OcTreeKey& key_origin,
               const octomap::point3d& end, const OcTreeKey& key_end, RaySet& rays) {
   if (key_origin == key_end) return;
   rays.insert_free(key_origin);
-  octomap::point3d direction = end - origin;
-  const float length = static_cast<float>(direction.norm());
-  direction /= length;
-  int step[3];
-  double t_max[3], t_delta[3];
-  OcTreeKey current = key_origin;
-  const double res = tree.getResolution();
-  for (unsigned i = 0; i < 3; ++i) {
-    step[i] = direction(i) > 0.0 ? 1 : (direction(i) < 0.0 ? -1 : 0);
-    if (step[i] != 0) {
-      double border = tree.keyToCoord(current[i]);
-      border += static_cast<float>(step[i] * res * 0.5);
-      t_max[i] = (border - origin(i)) / direction(i);
-      t_delta[i] = res / std::fabs(direction(i));
-    } else {
-      t_max[i] = t_delta[i] = std::numeric_limits<double>::max();
-    }
-  }
+  RayWalk walk(tree, origin, key_origin, end);
   while (true) {
-    const unsigned dim = t_max[0] < t_max[1] ? (t_max[0] < t_max[2] ? 0 : 2) : (t_max[1] < t_max[2] ? 1 : 2);
-    current[dim] = static_cast<octomap::key_type>(current[dim] + step[dim]);
-    t_max[dim] += t_delta[dim];
-    if (current == key_end) return;
-    if (std::min(std::min(t_max[0], t_max[1]), t_max[2]) > length) return;
-    rays.insert_free(current);
+    const bool inside = walk.next();
+    if (walk.key() == key_end || !inside) return;
+    rays.insert_free(walk.key());
   }
+}
+
+// The same voxels walked the other way, from the end's voxel centre back to the sensor, and cut
+// short where the ray has run through `stop_after` voxels in a row that other rays of this frame
+// already freed: from there on it would mostly repeat them (neighbouring rays converge towards
+// the sensor). This is voxblox's FastTsdfIntegrator shortcut (max_consecutive_ray_collisions,
+// 2 by default there); it trades a few missed voxels inside the frustum for most of the steps.
+void cast_ray_back(const octomap::ColorOcTree& tree, const octomap::point3d& sensor, const OcTreeKey& key_sensor,
+                   const octomap::point3d& end, const OcTreeKey& key_end, int stop_after, RaySet& rays) {
+  if (key_sensor == key_end) return;
+  RayWalk walk(tree, end, key_end, sensor);
+  int repeated = 0;
+  while (walk.next()) {
+    if (rays.is_free(walk.key())) {
+      if (++repeated >= stop_after) return;
+    } else {
+      repeated = 0;
+      rays.insert_free(walk.key());
+    }
+    if (walk.key() == key_sensor) return;
+  }
+  rays.insert_free(key_sensor);
 }
 }  // namespace
 
@@ -213,7 +252,8 @@ InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world
   for (const auto& [k, c] : endpoints) {
     const OcTreeKey end = unpack(k);
     rays.insert_end(end);
-    cast_ray(tree, origin, origin_key, tree.keyToCoord(end), end, rays);
+    if (config_.ray_stop_after > 0) cast_ray_back(tree, origin, origin_key, tree.keyToCoord(end), end, config_.ray_stop_after, rays);
+    else cast_ray(tree, origin, origin_key, tree.keyToCoord(end), end, rays);
   }
   for (std::uint64_t k : clipped) {
     const OcTreeKey end = unpack(k);

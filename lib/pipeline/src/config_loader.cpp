@@ -45,7 +45,8 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
     if (auto st = read_all([&] { return s.read("resolution_m", b.resolution_m); }, [&] { return s.read("max_range_m", b.max_range_m); },
                            [&] { return s.read("prob_hit", b.prob_hit); }, [&] { return s.read("prob_miss", b.prob_miss); },
                            [&] { return s.read("clamp_min", b.clamp_min); }, [&] { return s.read("clamp_max", b.clamp_max); },
-                           [&] { return s.read("fast_insertion", b.fast_insertion); });
+                           [&] { return s.read("fast_insertion", b.fast_insertion); },
+                           [&] { return s.read("ray_stop_after", b.ray_stop_after); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

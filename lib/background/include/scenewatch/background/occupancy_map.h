@@ -23,6 +23,9 @@ struct Config {
   /// true: batched ray casting from voxel-discretized endpoints (fast). false: OctoMap's plain
   /// insertPointCloud, one ray per point (the reference).
   bool fast_insertion = true;
+  /// Fast insertion only: a ray is cast from its end back towards the sensor and stops after this
+  /// many voxels in a row already freed by other rays of the frame (0: every ray to the sensor).
+  int ray_stop_after = 16;
 };
 
 /// Validates ranges; the message names the key (e.g. "background.resolution_m").
