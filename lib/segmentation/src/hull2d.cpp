@@ -1,6 +1,7 @@
 #include "hull2d.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace scenewatch::segmentation {
@@ -18,7 +19,40 @@ double cross2(const Vec2& o, const Vec2& a, const Vec2& b) {
 
 }  // namespace
 
+namespace {
+
+// Akl-Toussaint: the points extreme along x, y, x + y and x - y span a polygon whose strict
+// interior cannot hold a hull vertex; dropping those points first leaves little to sort.
+void drop_interior(std::vector<Vec2>& pts) {
+  if (pts.size() < 64) return;
+  std::array<Vec2, 8> extreme;
+  extreme.fill(pts.front());
+  for (const Vec2& p : pts) {
+    if (p.x() < extreme[0].x()) extreme[0] = p;
+    if (p.x() > extreme[1].x()) extreme[1] = p;
+    if (p.y() < extreme[2].y()) extreme[2] = p;
+    if (p.y() > extreme[3].y()) extreme[3] = p;
+    if (p.x() + p.y() < extreme[4].x() + extreme[4].y()) extreme[4] = p;
+    if (p.x() + p.y() > extreme[5].x() + extreme[5].y()) extreme[5] = p;
+    if (p.x() - p.y() < extreme[6].x() - extreme[6].y()) extreme[6] = p;
+    if (p.x() - p.y() > extreme[7].x() - extreme[7].y()) extreme[7] = p;
+  }
+  const std::vector<Vec2> poly = convex_hull(std::vector<Vec2>(extreme.begin(), extreme.end()));
+  if (poly.size() < 3) return;
+  pts.erase(std::remove_if(pts.begin(), pts.end(),
+                           [&](const Vec2& p) {
+                             for (std::size_t i = 0; i < poly.size(); ++i) {
+                               if (cross2(poly[i], poly[(i + 1) % poly.size()], p) <= 0) return false;
+                             }
+                             return true;
+                           }),
+            pts.end());
+}
+
+}  // namespace
+
 std::vector<Vec2> convex_hull(std::vector<Vec2> pts) {
+  drop_interior(pts);
   std::sort(pts.begin(), pts.end(), [](const Vec2& a, const Vec2& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
   pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
   if (pts.size() < 3) return pts;

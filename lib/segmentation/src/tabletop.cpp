@@ -21,6 +21,7 @@
 #include "occlusion_join.h"
 #include "support.h"
 #include "union_find.h"
+#include "voxel_columns.h"
 #include "voxel_index.h"
 
 namespace scenewatch::segmentation {
@@ -436,22 +437,19 @@ std::vector<Piece> euclidean_clusters(const Cloud& cloud, const VoxelIndex& grid
   // voxels higher than that above its own plane belongs to a larger structure (the foot of a
   // wall, a cabinet) and takes its cluster out.
   std::vector<char> attached(object_voxels.size(), 0);
+  const VoxelColumns columns(grid);
   for (std::size_t i = 0; i < object_voxels.size(); ++i) {
     const int v = object_voxels[i];
-    const auto& c = grid.coords[v];
-    for (int dx = -reach; dx <= reach; ++dx)
-      for (int dy = -reach; dy <= reach; ++dy)
-        for (int dz = -reach; dz <= reach; ++dz) {
-          const int w = grid.find(c[0] + dx, c[1] + dy, c[2] + dz);
-          if (w < 0 || (centroids[w] - centroids[v]).squaredNorm() > tol2) continue;
-          if (local[w] < 0) {
-            if (!in_plane[w] && frames[owner[v]].model.distance(centroids[w]) > cfg.max_object_height_m) attached[i] = 1;
-            continue;
-          }
-          // Each unordered pair once: only neighbours after this voxel in lexicographic order.
-          if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) continue;
-          if (owner[w] == owner[v]) uf.unite(static_cast<int>(i), local[w]);
-        }
+    columns.for_each_near(grid.coords[v], reach, [&](int w, int dx, int dy, int dz) {
+      if ((centroids[w] - centroids[v]).squaredNorm() > tol2) return;
+      if (local[w] < 0) {
+        if (!in_plane[w] && frames[owner[v]].model.distance(centroids[w]) > cfg.max_object_height_m) attached[i] = 1;
+        return;
+      }
+      // Each unordered pair once: only neighbours after this voxel in lexicographic order.
+      if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) return;
+      if (owner[w] == owner[v]) uf.unite(static_cast<int>(i), local[w]);
+    });
   }
   for (std::size_t i = 0; i < object_voxels.size(); ++i) {
     if (attached[i]) attached[uf.find(static_cast<int>(i))] = 1;

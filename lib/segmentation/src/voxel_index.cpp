@@ -6,7 +6,8 @@ namespace scenewatch::segmentation {
 
 VoxelIndex::VoxelIndex(const Cloud& cloud, double voxel_size_m) : size(voxel_size_m) {
   lookup.reserve(cloud.size() / 8 + 16);
-  build(cloud, [&](auto&& visit) {
+  // Visited in index order: the visiting order's voxels are the points' voxels.
+  point_voxel = build(cloud, [&](auto&& visit) {
     for (std::size_t i = 0; i < cloud.size(); ++i) visit(i);
   });
 }
@@ -18,9 +19,10 @@ VoxelIndex::VoxelIndex(const Cloud& cloud, const std::vector<int>& indices, doub
 }
 
 template <typename ForEachIndex>
-void VoxelIndex::build(const Cloud& cloud, ForEachIndex&& for_each_index) {
+std::vector<int> VoxelIndex::build(const Cloud& cloud, ForEachIndex&& for_each_index) {
   const float inv = static_cast<float>(1.0 / size);
-  point_voxel.assign(cloud.size(), -1);
+  // The voxel of each visited point, in visiting order (-1: invalid point).
+  std::vector<int> visited_voxel;
   std::vector<Eigen::Vector3f> sums;
   // Neighbouring points of an organized cloud mostly share a voxel: remember the last one and
   // skip the hash lookup when the key repeats.
@@ -28,7 +30,10 @@ void VoxelIndex::build(const Cloud& cloud, ForEachIndex&& for_each_index) {
   int last_voxel = -1;
   for_each_index([&](std::size_t i) {
     const PointT& p = cloud.points[i];
-    if (!is_valid(p)) return;
+    if (!is_valid(p)) {
+      visited_voxel.push_back(-1);
+      return;
+    }
     const int x = static_cast<int>(std::floor(p.x * inv));
     const int y = static_cast<int>(std::floor(p.y * inv));
     const int z = static_cast<int>(std::floor(p.z * inv));
@@ -47,7 +52,7 @@ void VoxelIndex::build(const Cloud& cloud, ForEachIndex&& for_each_index) {
     }
     sums[v] += p.getVector3fMap();
     ++member_offsets[v];
-    point_voxel[i] = v;
+    visited_voxel.push_back(v);
   });
   // Counting sort of the points by voxel (counts become offsets).
   const std::size_t n = sums.size();
@@ -63,9 +68,12 @@ void VoxelIndex::build(const Cloud& cloud, ForEachIndex&& for_each_index) {
   member_points.resize(running);
   std::vector<int> fill(member_offsets.begin(), member_offsets.end() - 1);
   // Over the visited points only: a subset of a large cloud (one cluster) costs its own size.
+  std::size_t k = 0;
   for_each_index([&](std::size_t i) {
-    if (point_voxel[i] >= 0) member_points[fill[point_voxel[i]]++] = static_cast<int>(i);
+    const int v = visited_voxel[k++];
+    if (v >= 0) member_points[fill[v]++] = static_cast<int>(i);
   });
+  return visited_voxel;
 }
 
 }  // namespace scenewatch::segmentation
