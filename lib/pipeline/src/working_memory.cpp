@@ -183,6 +183,34 @@ struct WorkingMemory::Impl {
     return out;
   }
 
+  // Change detection against the map as it stands before this frame, then the frame into the
+  // map (without the points of unconfirmed candidates); confirmed changes are written into it at
+  // once. Runs beside the segmentation and the image surprise, which do not read the map.
+  ChangeOutcome update_map(const Frame& frame, const Pose& T, const Config& config, FrameResult& result) {
+    ChangeOutcome changed;
+    if (config.change_enabled && frames > 0) {
+      const auto t_change = Clock::now();
+      changed = detect_changes(frame, T, config.change);
+      result.change_ms = ms_since(t_change);
+      result.change_candidates = changes.candidates();
+    }
+    CloudConstPtr to_insert = frame.cloud;
+    if (!changed.pending.empty()) to_insert = without_pending(*frame.cloud, changed.pending, changed.K);
+    const auto t_ins = Clock::now();
+    std::unique_lock<std::shared_mutex> write(map_mutex);
+    result.insert_stats = map.insert(*to_insert, T);
+    for (const auto& c : changed.confirmed) {
+      if (c.before) map.set_voxels(c.before->points_world, background::Occupancy::kFree);
+      if (c.after) map.set_voxels(c.after->points_world, background::Occupancy::kOccupied);
+    }
+    for (const auto& c : changed.absorbed) {
+      map.set_voxels(c.points_world, c.kind == change::ChangeKind::kAdded ? background::Occupancy::kOccupied
+                                                                          : background::Occupancy::kFree);
+    }
+    result.insert_ms = ms_since(t_ins);
+    return changed;
+  }
+
   void emit(std::vector<Event>& batch, std::size_t max_log) {
     std::vector<EventCallback> callbacks;
     {
@@ -233,20 +261,16 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   result.frame_index = m.frames;
   result.points = *valid_points;
 
-  // Two independent halves on the two cores: the image surprise and the geometric change detection
-  // (both against the memory as it stands before this frame) beside the segmentation of the frame.
-  ChangeOutcome changed;
-  auto against_memory = std::async(std::launch::async, [&] {
+  // Three independent parts on the two cores, each against the memory as it stands before this
+  // frame: the image surprise (keyframes and mesh), the geometric change detection with the map
+  // update (the octree), and the segmentation of the frame (this thread). None reads what another
+  // writes; the tracker and the event fusion below need all three.
+  auto surprise = std::async(std::launch::async, [&] {
     const auto t_surprise = Clock::now();
     result.surprise = m.appearance.process(frame);  // then its keyframe update
     result.surprise_ms = ms_since(t_surprise);
-    if (config_.change_enabled && m.frames > 0) {
-      const auto t_change = Clock::now();
-      changed = m.detect_changes(frame, T, config_.change);
-      result.change_ms = ms_since(t_change);
-      result.change_candidates = m.changes.candidates();
-    }
   });
+  auto map_update = std::async(std::launch::async, [&] { return m.update_map(frame, T, config_, result); });
 
   // Segment in the camera frame (indices stay those of the input cloud), then move to the world.
   segmentation::Config seg = config_.segmentation;
@@ -268,26 +292,9 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
     observations[i].range_m = (result.objects[i].centroid - T.translation()).norm();
   }
 
-  against_memory.get();  // rethrows what the other half threw
+  surprise.get();  // each rethrows what its part threw
+  const ChangeOutcome changed = map_update.get();
   const auto& [pending, absorbed, confirmed, K_change] = changed;
-  CloudConstPtr to_insert = frame.cloud;
-  if (!pending.empty()) to_insert = without_pending(*frame.cloud, pending, K_change);
-
-  // Update the background; confirmed changes are written into it at once.
-  const auto t_ins = Clock::now();
-  {
-    std::unique_lock<std::shared_mutex> write(m.map_mutex);
-    result.insert_stats = m.map.insert(*to_insert, T);
-    for (const auto& c : confirmed) {
-      if (c.before) m.map.set_voxels(c.before->points_world, background::Occupancy::kFree);
-      if (c.after) m.map.set_voxels(c.after->points_world, background::Occupancy::kOccupied);
-    }
-    for (const auto& c : absorbed) {
-      m.map.set_voxels(c.points_world, c.kind == change::ChangeKind::kAdded ? background::Occupancy::kOccupied
-                                                                            : background::Occupancy::kFree);
-    }
-  }
-  result.insert_ms = ms_since(t_ins);
   // One fact, one event: appearance regions where geometry changes are its evidence; others must persist.
   {
     std::vector<Event> geometric;
