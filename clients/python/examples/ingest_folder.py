@@ -22,7 +22,8 @@ from scenewatch.rgbd import Sequence
 def report(name, reply):
     kinds = ", ".join(pb.Event.Kind.Name(e.kind) for e in reply.events)
     print(f"{name}: {reply.points} points, {len(reply.planes)} planes, {len(reply.clusters)} objects, "
-          f"{len(reply.events)} events{' (' + kinds + ')' if kinds else ''}, {reply.total_ms:.0f} ms", flush=True)
+          f"{len(reply.events)} event{'' if len(reply.events) == 1 else 's'}{' (' + kinds + ')' if kinds else ''}, "
+          f"{reply.total_ms:.0f} ms", flush=True)
 
 
 def main():
