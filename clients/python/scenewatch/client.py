@@ -72,7 +72,8 @@ class Subscription:
 
     ``last_event_id``: events up to this id happened before the subscription (fetch them with
     ``Client.get_events(since=...)``). Iterating blocks until the next event; ``next(timeout_s)``
-    raises ``Timeout`` when none comes in time.
+    raises ``Timeout`` when none comes in time. When the daemon goes away the iteration raises
+    ``ConnectionLost`` (it does not just end: a planner must know it is no longer told).
     """
 
     def __init__(self, client, last_event_id, timeout_s):
@@ -89,10 +90,7 @@ class Subscription:
         return self
 
     def __next__(self):
-        try:
-            return self.next()
-        except ConnectionLost:
-            raise StopIteration
+        return self.next()
 
 
 class Client:
@@ -149,6 +147,8 @@ class Client:
     def ingest_frame(self, frame=None, **fields):
         """Processes one frame: a pb.IngestFrame, or its fields as keywords (cloud=pb.Cloud,
         pose=4x4 matrix or pb.Pose, intrinsics=pb.Intrinsics, stamp_s, source). pb.IngestReply."""
+        if frame is not None and fields:
+            raise TypeError("ingest_frame takes a pb.IngestFrame or its fields as keywords, not both")
         if frame is None:
             if "pose" in fields:
                 fields["pose"] = pose_message(fields["pose"])

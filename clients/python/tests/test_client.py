@@ -174,6 +174,8 @@ class ClientTest(unittest.TestCase):
 
         with self.assertRaises(ValueError):
             self.client.ingest_frame(cloud=bad.cloud, pose=[1, 0, 0])
+        with self.assertRaises(TypeError):
+            self.client.ingest_frame(bad, stamp_s=1.0)
         # The connection survives refusals, and nothing changed.
         self.assertEqual(self.client.stats().frames_processed, 0)
 
@@ -205,9 +207,14 @@ class ClientTest(unittest.TestCase):
             scenewatch.Client("127.0.0.1", port, timeout_s=5)
         self.assertIn(f"127.0.0.1:{port}", str(caught.exception))
 
+        listener = scenewatch.Client("127.0.0.1", self.daemon.port, timeout_s=5)
+        self.addCleanup(listener.close)
+        subscription = iter(listener.subscribe(timeout_s=30))
         self.assertEqual(self.daemon.stop(), 0)
         with self.assertRaises(scenewatch.ConnectionLost):
             self.client.health()
+        with self.assertRaises(scenewatch.ConnectionLost):
+            next(subscription)  # a subscriber is told, not left waiting
 
 
 if __name__ == "__main__":
