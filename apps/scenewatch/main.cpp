@@ -52,6 +52,10 @@ int main(int argc, char** argv) {
   std::optional<double> ingest_depth_scale;
   auto* ingest = app.add_subcommand(
       "ingest", "send cloud files or RGB-D sequence folders, frame by frame (--json: one object per line)");
+  ingest->footer(
+      "Sequence folders: the 7-Scenes layout (frame-NNNNNN.color.png|.jpg, .depth.png, .pose.txt,\n"
+      "camera-intrinsics.txt) or the TUM RGB-D layout (rgb.txt, depth.txt, groundtruth.txt), told apart by\n"
+      "their files. Depth in mm (TUM: 1/5000 m) unless depth-scale.txt or --depth-scale says otherwise.");
   ingest->add_option("paths", ingest_paths, "cloud files and/or sequence folders")->required();
   ingest->add_flag("--server-side", server_side,
                    "let the daemon read the files itself (absolute paths under its data roots)");
@@ -156,7 +160,9 @@ int main(int argc, char** argv) {
       "Inputs: SEQDIR (every frame, with its poses), SEQDIR:N, SEQDIR:A-B (frames A to B, 0-based), cloud files.\n"
       "Examples:\n"
       "  scenewatch replay ../shared/data/redkitchen\n"
-      "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json");
+      "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json\n"
+      "  scenewatch replay rgbd_dataset_freiburg1_xyz          (a TUM RGB-D folder: rgb.txt, depth.txt, groundtruth.txt)\n"
+      "  scenewatch replay ../shared/data/ycb --depth-scale 0.0001   (depth in units of 0.1 mm)");
   replay->add_option("inputs", replay_options.inputs, "sequence folders, frame ranges or cloud files")->required();
   replay->add_option("--config", replay_options.config, "YAML config, as the daemon's (its pipeline sections are used)");
   replay->add_option("--stride", replay_options.stride, "process every N-th frame of each input")
