@@ -1,6 +1,7 @@
 #pragma once
 // The commands of the scenewatch CLI. Each returns the process exit code.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -28,7 +29,9 @@ struct RemoteOptions {
 
 int run_health(const RemoteOptions& options);
 int run_stats(const RemoteOptions& options);
-int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side);
+/// `depth_scale_m`: metres per depth unit of sequence folders (unset: the folder's or layout's).
+int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side,
+               const std::optional<double>& depth_scale_m);
 int run_planes(const RemoteOptions& options);
 int run_objects(const RemoteOptions& options);
 /// `points`: x y z triples; `box`: empty or min x y z, max x y z.
@@ -51,6 +54,7 @@ struct SurpriseOptions {
   std::string config;                   ///< YAML: its appearance and surprise sections
   double saturation = 24.0;             ///< heatmap scale in nats
   bool json = false;
+  std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
 };
 /// Image-based surprise of an observed frame against reference frames (offline), or against the
 /// daemon's appearance memory when no reference is given.
@@ -83,6 +87,7 @@ struct DiffOptions {
   std::string config;         ///< YAML config: its change and background sections are used
   bool force_map = false;     ///< compare through the map even for same-camera pairs
   double resolution_m = 0;    ///< map voxel edge for the map path (0 = config / default)
+  std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
 };
 /// Offline: geometric change detection between two observations (no daemon involved).
 int run_diff(const DiffOptions& options);
@@ -94,6 +99,7 @@ struct ReplayOptions {
   bool json = false;                ///< one JSON line per event, then a summary line
   bool progress = true;             ///< a progress line on stderr every 25 frames
   std::string heatmap_dir;          ///< when set: surprise-NNNNNN.png per frame with a surprise map
+  std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
 };
 /// Offline: recordings through the working memory as the daemon would run them; prints the
 /// event stream and a summary (events per 100 frames, time per frame and per stage).

@@ -1,6 +1,7 @@
 #include "frame_spec.h"
 
 #include <filesystem>
+#include <iostream>
 
 #include "scenewatch/io/rgbd.h"
 #include "scenewatch/io/sequence.h"
@@ -48,11 +49,11 @@ Result<Parsed> parse(const std::string& spec) {
       if (*last < *first) return invalid_argument("'" + spec + "': the range ends before it starts");
       p.last = *last;
     }
-    if (!io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png or .color.jpg)");
+    if (!io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png or .color.jpg, or a TUM rgb.txt)");
   }
   if (!fs::exists(p.path, ec)) return not_found("'" + p.path + "': no such file or folder");
   p.sequence = fs::is_directory(p.path, ec);
-  if (p.sequence && !io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png or .color.jpg)");
+  if (p.sequence && !io::is_sequence_dir(p.path)) return invalid_argument("'" + p.path + "' is not a sequence folder (frame-NNNNNN.color.png or .color.jpg, or a TUM rgb.txt)");
   return p;
 }
 
@@ -70,11 +71,17 @@ Status resolve_name(Parsed& p, const io::Sequence& seq, const std::string& spec)
 
 }  // namespace
 
-Result<std::size_t> count_frames(const std::string& spec) {
+io::SequenceOptions sequence_options(const std::optional<double>& depth_scale_m) {
+  io::SequenceOptions options;
+  options.depth_scale_m = depth_scale_m;
+  return options;
+}
+
+Result<std::size_t> count_frames(const std::string& spec, const io::SequenceOptions& sequence) {
   auto p = parse(spec);
   if (!p) return p.error();
   if (!p->sequence) return std::size_t{1};
-  auto seq = io::open_sequence(p->path);
+  auto seq = io::open_sequence(p->path, sequence);
   if (!seq) return seq.error();
   if (auto st = resolve_name(*p, *seq, spec); !st) return st.error();
   const std::size_t n = seq->frames.size();
@@ -83,7 +90,7 @@ Result<std::size_t> count_frames(const std::string& spec) {
 }
 
 Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& intrinsics,
-                      const std::function<Status(Frame)>& each) {
+                      const std::function<Status(Frame)>& each, const io::SequenceOptions& sequence) {
   auto p = parse(spec);
   if (!p) return p.error();
   if (!p->sequence) {
@@ -99,8 +106,11 @@ Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& 
     }
     return each(std::move(*frame));
   }
-  auto seq = io::open_sequence(p->path);
+  auto seq = io::open_sequence(p->path, sequence);
   if (!seq) return seq.error();
+  if (auto skipped = io::skipped_summary(*seq, sequence); !skipped.empty()) {
+    std::cerr << "scenewatch: " << p->path << ": " << skipped << "\n";
+  }
   if (auto st = resolve_name(*p, *seq, spec); !st) return st.error();
   const std::size_t n = seq->frames.size();
   if (p->first >= n) return invalid_argument("'" + spec + "': the sequence has " + std::to_string(n) + " frames");

@@ -13,15 +13,20 @@
 
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
+#include "scenewatch/io/sequence.h"
 
 namespace scenewatch::cli {
 
 /// How many frames a spec names (opens sequences, reads no images).
-Result<std::size_t> count_frames(const std::string& spec);
+Result<std::size_t> count_frames(const std::string& spec, const io::SequenceOptions& sequence = {});
 
 /// Loads the frames of a spec in order, calling `each` for every one (stops at its error).
-/// `intrinsics` replaces the recovered intrinsics of cloud files.
+/// `intrinsics` replaces the recovered intrinsics of cloud files; `sequence` says how sequence
+/// folders are read (depth scale). Frames a TUM folder leaves out are counted on stderr.
 Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& intrinsics,
-                      const std::function<Status(Frame)>& each);
+                      const std::function<Status(Frame)>& each, const io::SequenceOptions& sequence = {});
+
+/// The SequenceOptions of a command's --depth-scale (unset: the folder's or the layout's unit).
+io::SequenceOptions sequence_options(const std::optional<double>& depth_scale_m);
 
 }  // namespace scenewatch::cli

@@ -2,6 +2,7 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <optional>
 #include <iostream>
 
 #include "commands.h"
@@ -17,6 +18,14 @@ void add_remote_options(CLI::App* command, RemoteOptions& options) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command->add_flag("--json", options.json, "print machine-readable JSON");
+}
+
+/// --depth-scale for every command that reads RGB-D sequence folders.
+void add_depth_scale_option(CLI::App* command, std::optional<double>& depth_scale_m) {
+  command->add_option("--depth-scale", depth_scale_m,
+                      "metres per depth unit of RGB-D sequence folders (0.001 = mm, 0.0002 = TUM's 1/5000 m, "
+                      "0.0001 = 0.1 mm); default: the folder's depth-scale.txt, else its layout's unit")
+      ->check(CLI::Range(1e-7, 1.0));
 }
 
 }  // namespace
@@ -40,13 +49,19 @@ int main(int argc, char** argv) {
 
   std::vector<std::string> ingest_paths;
   bool server_side = false;
+  std::optional<double> ingest_depth_scale;
   auto* ingest = app.add_subcommand(
       "ingest", "send cloud files or RGB-D sequence folders, frame by frame (--json: one object per line)");
+  ingest->footer(
+      "Sequence folders: the 7-Scenes layout (frame-NNNNNN.color.png|.jpg, .depth.png, .pose.txt,\n"
+      "camera-intrinsics.txt) or the TUM RGB-D layout (rgb.txt, depth.txt, groundtruth.txt), told apart by\n"
+      "their files. Depth in mm (TUM: 1/5000 m) unless depth-scale.txt or --depth-scale says otherwise.");
   ingest->add_option("paths", ingest_paths, "cloud files and/or sequence folders")->required();
   ingest->add_flag("--server-side", server_side,
                    "let the daemon read the files itself (absolute paths under its data roots)");
+  add_depth_scale_option(ingest, ingest_depth_scale);
   add_remote_options(ingest, remote);
-  ingest->callback([&] { action = [&] { return run_ingest(remote, ingest_paths, server_side); }; });
+  ingest->callback([&] { action = [&] { return run_ingest(remote, ingest_paths, server_side, ingest_depth_scale); }; });
 
   auto* planes = app.add_subcommand("planes", "supporting planes of the last frame");
   add_remote_options(planes, remote);
@@ -132,6 +147,7 @@ int main(int argc, char** argv) {
   diff->add_flag("--force-map", diff_options.force_map, "compare through the occupancy map even for same-camera pairs");
   diff->add_option("--resolution", diff_options.resolution_m, "map voxel edge in metres for the map path")
       ->check(CLI::Range(0.002, 0.2));
+  add_depth_scale_option(diff, diff_options.depth_scale_m);
   diff->callback([&] { action = [&] { return run_diff(diff_options); }; });
 
   ReplayOptions replay_options;
@@ -144,7 +160,9 @@ int main(int argc, char** argv) {
       "Inputs: SEQDIR (every frame, with its poses), SEQDIR:N, SEQDIR:A-B (frames A to B, 0-based), cloud files.\n"
       "Examples:\n"
       "  scenewatch replay ../shared/data/redkitchen\n"
-      "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json");
+      "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json\n"
+      "  scenewatch replay rgbd_dataset_freiburg1_xyz          (a TUM RGB-D folder: rgb.txt, depth.txt, groundtruth.txt)\n"
+      "  scenewatch replay ../shared/data/ycb --depth-scale 0.0001   (depth in units of 0.1 mm)");
   replay->add_option("inputs", replay_options.inputs, "sequence folders, frame ranges or cloud files")->required();
   replay->add_option("--config", replay_options.config, "YAML config, as the daemon's (its pipeline sections are used)");
   replay->add_option("--stride", replay_options.stride, "process every N-th frame of each input")
@@ -153,6 +171,7 @@ int main(int argc, char** argv) {
   replay->add_option("--heatmaps", replay_options.heatmap_dir,
                      "write each frame's image surprise over its colour image as DIR/surprise-NNNNNN.png");
   replay->add_flag("--json", replay_options.json, "one JSON object per event (with its frame), then a summary object");
+  add_depth_scale_option(replay, replay_options.depth_scale_m);
   replay->callback([&] { action = [&] { return run_replay(replay_options); }; });
 
   SurpriseOptions surprise_options;
@@ -180,6 +199,7 @@ int main(int argc, char** argv) {
   surprise->add_option("--saturation", surprise_options.saturation, "heatmap scale: nats shown as the hottest colour")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  add_depth_scale_option(surprise, surprise_options.depth_scale_m);
   add_remote_options(surprise, remote);  // --json among them: regions as APPEARANCE_CHANGE events
   surprise->callback([&] {
     action = [&] {

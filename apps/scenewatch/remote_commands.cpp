@@ -9,6 +9,7 @@
 
 #include "commands.h"
 #include "format.h"
+#include "frame_spec.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/service/client.h"
 
@@ -144,7 +145,8 @@ int run_stats(const RemoteOptions& options) {
   });
 }
 
-int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side) {
+int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side,
+               const std::optional<double>& depth_scale_m) {
   auto client = connect(options);
   if (!client) return fail(client.error().message);
   const bool show_progress = !options.json && ::isatty(STDOUT_FILENO) == 1;
@@ -182,11 +184,15 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       continue;
     }
     if (io::is_sequence_dir(path)) {
-      auto sequence = io::open_sequence(path);
+      const io::SequenceOptions sequence_options = cli::sequence_options(depth_scale_m);
+      auto sequence = io::open_sequence(path, sequence_options);
       if (!sequence) {
         fail(naming(path, sequence.error().message));
         ++failures;
         continue;
+      }
+      if (auto skipped = io::skipped_summary(*sequence, sequence_options); !skipped.empty()) {
+        std::cerr << "scenewatch: " << path << ": " << skipped << "\n";
       }
       ProgressBar bar(show_progress);
       const std::size_t total = sequence->frames.size();

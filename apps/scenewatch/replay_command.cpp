@@ -55,7 +55,8 @@ int run_replay(const ReplayOptions& options) {
   std::vector<double> frame_ms;
   const auto wall0 = std::chrono::steady_clock::now();
   for (const auto& spec : options.inputs) {
-    auto n = count_frames(spec);
+    const io::SequenceOptions sequence = sequence_options(options.depth_scale_m);
+    auto n = count_frames(spec, sequence);
     if (!n) return fail(n.error().message);
     std::size_t index = 0;
     auto st = for_each_frame(spec, std::nullopt, [&](Frame frame) -> Status {
@@ -95,7 +96,7 @@ int run_replay(const ReplayOptions& options) {
         std::cerr << "  " << frames << " frames, " << total_events << " events\n";
       }
       return {};
-    });
+    }, sequence);
     if (!st) return fail(st.error().message);
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

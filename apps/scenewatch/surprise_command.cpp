@@ -86,7 +86,7 @@ Result<Outcome> offline(const SurpriseOptions& o) {
   // The observation first: a bad one should fail before minutes of reference loading.
   std::optional<background::Keyframe> observed;
   {
-    auto n = count_frames(o.observed);
+    auto n = count_frames(o.observed, sequence_options(o.depth_scale_m));
     if (!n) return n.error();
     if (*n != 1) return invalid_argument("'" + o.observed + "' names " + std::to_string(*n) + " frames; the observation must be one (SEQDIR:N)");
     auto st = for_each_frame(o.observed, intrinsics, [&](Frame f) -> Status {
@@ -95,13 +95,13 @@ Result<Outcome> offline(const SurpriseOptions& o) {
       if (!f.has_color) return invalid_argument("'" + o.observed + "' has no colour");
       observed = std::move(*kf);
       return {};
-    });
+    }, sequence_options(o.depth_scale_m));
     if (!st) return st.error();
   }
   background::AppearanceMemory memory(config->appearance);
   std::size_t total = 0, done = 0;
   for (const auto& spec : o.references) {
-    auto n = count_frames(spec);
+    auto n = count_frames(spec, sequence_options(o.depth_scale_m));
     if (!n) return n.error();
     total += *n;
   }
@@ -115,7 +115,7 @@ Result<Outcome> offline(const SurpriseOptions& o) {
       auto added = memory.add(std::move(*kf));
       if (!added) return Error{added.error().code, f.source + ": " + added.error().message};
       return {};
-    });
+    }, sequence_options(o.depth_scale_m));
     bar.clear();
     if (!st) return st.error();
   }
@@ -150,7 +150,7 @@ Result<Outcome> remote(const SurpriseOptions& o, const RemoteOptions& r) {
       if (observed) return invalid_argument("'" + o.observed + "' names several frames; the observation must be one");
       observed = std::move(f);
       return {};
-    });
+    }, sequence_options(o.depth_scale_m));
     if (!st) return st.error();
   }
   auto got = fetch_surprise(r, observed ? &*observed : nullptr);

@@ -4,7 +4,11 @@
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 
+#include <Eigen/Eigenvalues>
+
+#include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <limits>
 
 #include "scenewatch/io/cloud_io.h"
@@ -389,6 +393,243 @@ TEST_F(IoTest, TumSequenceAndItsErrors) {
   ASSERT_FALSE(no_depth.ok());
   expect_error_mentions(no_depth.error(), {"frame-000001.depth.png"});
   EXPECT_FALSE(open_sequence(dir_ / "absent").ok());
+}
+
+// A TUM RGB-D benchmark folder as published: rgb/ and depth/ PNGs listed in rgb.txt and
+// depth.txt, poses in groundtruth.txt at a higher rate, no camera-intrinsics.txt.
+class TumLayoutTest : public IoTest {
+ protected:
+  void SetUp() override {
+    fs::create_directories(dir_ / "rgb");
+    fs::create_directories(dir_ / "depth");
+    const ColorImage c{4, 2, std::vector<std::uint8_t>(24, 90)};
+    const DepthImage d{4, 2, std::vector<std::uint16_t>(8, 5000)};  // 1 m in units of 1/5000 m
+    std::vector<StampedFile> rgb, depth;
+    // Colour at 30 Hz; depth near the first three only (10.100 and 10.133 have none within 0.02 s).
+    for (double t : {10.0, 10.033, 10.066, 10.1, 10.133}) rgb.push_back({t, name("rgb", t), 0});
+    for (double t : {10.004, 10.037, 10.07, 10.16}) depth.push_back({t, name("depth", t), 0});
+    for (const auto& f : rgb) ASSERT_TRUE(write_color_png(dir_ / f.file, c).ok());
+    for (const auto& f : depth) ASSERT_TRUE(write_depth_png(dir_ / f.file, d).ok());
+    ASSERT_TRUE(write_tum_list(dir_ / "rgb.txt", rgb).ok());
+    ASSERT_TRUE(write_tum_list(dir_ / "depth.txt", depth).ok());
+    // Ground truth at 100 Hz up to 10.045 s: the depth at 10.070 has no pose within 0.02 s.
+    std::vector<StampedPose> poses;
+    for (int i = 0; i <= 5; ++i) {
+      StampedPose p;
+      p.stamp_s = 9.995 + 0.01 * i;
+      p.T_world_camera = Eigen::Translation3d(0.1 * i, 0, 0) * Eigen::AngleAxisd(0.05 * i, Eigen::Vector3d::UnitY());
+      poses.push_back(p);
+    }
+    ASSERT_TRUE(write_tum(dir_ / "groundtruth.txt", poses).ok());
+  }
+  static fs::path name(const std::string& folder, double t) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, "%.6f.png", t);
+    return fs::path(folder) / buffer;
+  }
+};
+
+TEST_F(TumLayoutTest, AssociatesColourDepthAndPoseByTime) {
+  EXPECT_TRUE(is_sequence_dir(dir_.path()));
+  auto seq = open_sequence(dir_);
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  EXPECT_EQ(seq->layout, SequenceLayout::kTum);
+  ASSERT_EQ(seq->frames.size(), 2u);
+  EXPECT_EQ(seq->skipped_without_depth, 2u);
+  EXPECT_EQ(seq->skipped_without_pose, 1u);
+  EXPECT_EQ(skipped_summary(*seq),
+            "2 colour images without a depth image within 0.02 s skipped; "
+            "1 colour image without a ground-truth pose within 0.02 s skipped");
+  EXPECT_EQ(seq->frames[0].name, "10.000000");
+  EXPECT_EQ(seq->frames[1].color.filename(), "10.033000.png");
+  EXPECT_EQ(seq->frames[1].depth.filename(), "10.037000.png");
+  EXPECT_DOUBLE_EQ(seq->frames[1].stamp_s, 10.037) << "the depth image's time";
+  // Nearest ground truth: 10.005 for the depth at 10.004, 10.035 for 10.037.
+  ASSERT_TRUE(seq->frames[1].T_world_camera.has_value());
+  EXPECT_NEAR(seq->frames[0].T_world_camera->translation().x(), 0.1, 1e-9);
+  EXPECT_NEAR(seq->frames[1].T_world_camera->translation().x(), 0.4, 1e-9);
+  // TUM's default intrinsics, the image size from the files, depth in 1/5000 m.
+  EXPECT_EQ(seq->intrinsics.fx, 525.0);
+  EXPECT_EQ(seq->intrinsics.cy, 239.5);
+  EXPECT_EQ(seq->intrinsics.width, 4);
+  EXPECT_DOUBLE_EQ(seq->depth_scale_m, 1.0 / 5000);
+  auto frame = load_sequence_frame(*seq, 1);
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  EXPECT_FLOAT_EQ(frame->cloud->at(1, 1).z, 1.0f);
+  EXPECT_EQ(frame->cloud->at(1, 1).r, 90);
+
+  // A looser tolerance takes the frame at 10.100 (depth 10.070 is taken; 10.133 pairs with 10.160).
+  SequenceOptions loose;
+  loose.max_time_difference_s = 0.05;
+  auto more = open_sequence(dir_, loose);
+  ASSERT_TRUE(more.ok()) << more.error().message;
+  EXPECT_EQ(more->frames.size() + more->skipped_without_depth + more->skipped_without_pose, 5u);
+  EXPECT_EQ(more->skipped_without_depth, 1u) << "10.066 and 10.100 both want 10.070; the nearer wins";
+}
+
+TEST_F(TumLayoutTest, IntrinsicsAndDepthScaleFilesAndOptions) {
+  ASSERT_TRUE(write_intrinsics(dir_ / "camera-intrinsics.txt", Intrinsics{517.3, 516.5, 318.6, 255.3, 0, 0}).ok());
+  write_text("depth-scale.txt", "# metres per unit\n0.0001\n");
+  auto seq = open_sequence(dir_);
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  EXPECT_EQ(seq->intrinsics.fx, 517.3);
+  EXPECT_DOUBLE_EQ(seq->depth_scale_m, 1e-4);
+  auto frame = load_sequence_frame(*seq, 0);
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  EXPECT_FLOAT_EQ(frame->cloud->at(0, 0).z, 0.5f) << "5000 units of 0.1 mm";
+  SequenceOptions options;
+  options.depth_scale_m = 0.001;  // the command line's --depth-scale wins over the file
+  auto mm = open_sequence(dir_, options);
+  ASSERT_TRUE(mm.ok()) << mm.error().message;
+  auto frame_mm = load_sequence_frame(*mm, 0);
+  ASSERT_TRUE(frame_mm.ok()) << frame_mm.error().message;
+  EXPECT_FLOAT_EQ(frame_mm->cloud->at(0, 0).z, 5.0f);
+
+  options.depth_scale_m = -1;
+  auto negative = open_sequence(dir_, options);
+  ASSERT_FALSE(negative.ok());
+  expect_error_mentions(negative.error(), {"--depth-scale", "(0, 1]", "-1"});
+  write_text("depth-scale.txt", "0\n");
+  auto zero = open_sequence(dir_);
+  ASSERT_FALSE(zero.ok());
+  expect_error_mentions(zero.error(), {"depth-scale.txt", "(0, 1]"});
+  write_text("depth-scale.txt", "\n1e-4 mm\n");
+  auto word = open_sequence(dir_);
+  ASSERT_FALSE(word.ok());
+  expect_error_mentions(word.error(), {"depth-scale.txt", "line 2", "'mm'"});
+  write_text("depth-scale.txt", "0.001 0.001\n");
+  auto two = open_sequence(dir_);
+  ASSERT_FALSE(two.ok());
+  expect_error_mentions(two.error(), {"depth-scale.txt", "one number", "found 2"});
+}
+
+TEST_F(TumLayoutTest, MalformedListsNameTheFileAndLine) {
+  write_text("rgb.txt", "# colour images\n10.0 rgb/10.000000.png\n10.o33 rgb/10.033000.png\n");
+  auto bad_stamp = open_sequence(dir_);
+  ASSERT_FALSE(bad_stamp.ok());
+  expect_error_mentions(bad_stamp.error(), {"rgb.txt", "line 3", "'10.o33'", "not a number"});
+
+  write_text("rgb.txt", "10.0 rgb/10.000000.png\n10.033\n");
+  auto no_file = open_sequence(dir_);
+  ASSERT_FALSE(no_file.ok());
+  expect_error_mentions(no_file.error(), {"rgb.txt", "line 2", "no file name"});
+
+  write_text("rgb.txt", "10.0 rgb/10.000000.png\n");
+  write_text("depth.txt", "10.004 depth/10.004000.png\n10.037 depth/gone.png\n");
+  auto missing = open_sequence(dir_);
+  ASSERT_FALSE(missing.ok());
+  expect_error_mentions(missing.error(), {"depth.txt", "line 2", "depth/gone.png", "does not exist"});
+
+  fs::remove(dir_ / "depth.txt");
+  EXPECT_TRUE(is_sequence_dir(dir_.path())) << "rgb.txt marks the layout; what is missing is then named";
+  auto no_list = open_sequence(dir_);
+  ASSERT_FALSE(no_list.ok());
+  expect_error_mentions(no_list.error(), {"depth.txt", "missing"});
+
+  write_text("depth.txt", "10.004 depth/10.004000.png\n");
+  write_text("groundtruth.txt", "# timestamp tx ty tz qx qy qz qw\n10.0 0 0 0 0 0 0 1\n10.01 0 0 0 0 0 1\n");
+  auto bad_pose = open_sequence(dir_);
+  ASSERT_FALSE(bad_pose.ok());
+  expect_error_mentions(bad_pose.error(), {"groundtruth.txt", "line 3"});
+
+  write_text("groundtruth.txt", "20.0 0 0 0 0 0 0 1\n");
+  auto no_pose = open_sequence(dir_);
+  ASSERT_FALSE(no_pose.ok());
+  expect_error_mentions(no_pose.error(), {"no frame has colour, depth and pose", "without a ground-truth pose"});
+}
+
+TEST_F(IoTest, DepthScaleFileBesideTheFramesLayout) {
+  ColorImage c{4, 2, std::vector<std::uint8_t>(24, 90)};
+  DepthImage d{4, 2, std::vector<std::uint16_t>(8, 12000)};
+  ASSERT_TRUE(write_color_png(dir_ / "frame-000000.color.png", c).ok());
+  ASSERT_TRUE(write_depth_png(dir_ / "frame-000000.depth.png", d).ok());
+  ASSERT_TRUE(write_intrinsics(dir_ / "camera-intrinsics.txt", Intrinsics{100, 100, 2, 1, 0, 0}).ok());
+  auto mm = open_sequence(dir_);
+  ASSERT_TRUE(mm.ok()) << mm.error().message;
+  EXPECT_DOUBLE_EQ(mm->depth_scale_m, 0.001) << "millimetres unless told otherwise";
+  write_text("depth-scale.txt", "0.0001\n");
+  auto seq = open_sequence(dir_);
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  auto frame = load_sequence_frame(*seq, 0);
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  EXPECT_FLOAT_EQ(frame->cloud->at(2, 1).z, 1.2f);
+}
+
+// The tomato soup can of YCB-Video frame 3 (depth in units of 0.1 mm) measured on the loaded
+// cloud: its side wall, between 2 and 8 cm above the writing tablet it stands on, projected on
+// the tablet's plane, fits a circle of the can's diameter (65.8 mm by its model).
+double soup_can_diameter_m(const Cloud& cloud) {
+  // The tablet: pixels below the can (rows 458-477, columns 110-329), plane by PCA.
+  std::vector<Eigen::Vector3d> tablet;
+  for (int v = 458; v < 478; v += 2)
+    for (int u = 110; u < 330; u += 3)
+      if (is_valid(cloud.at(u, v))) tablet.push_back(cloud.at(u, v).getVector3fMap().cast<double>());
+  if (tablet.size() < 100) return -1;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : tablet) centroid += p;
+  centroid /= static_cast<double>(tablet.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : tablet) cov += (p - centroid) * (p - centroid).transpose();
+  Eigen::Vector3d up = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  if (up.dot(-centroid) < 0) up = -up;  // towards the camera's side: the can stands there
+  const Eigen::Vector3d e1 = (Eigen::Vector3d::UnitX() - up.x() * up).normalized(), e2 = up.cross(e1);
+  // The can's front at pixel (228, 390); its wall points within 6 cm of it across the tablet.
+  if (!is_valid(cloud.at(228, 390))) return -1;
+  const Eigen::Vector3d seed = cloud.at(228, 390).getVector3fMap().cast<double>();
+  const Eigen::Vector2d seed_2d(seed.dot(e1), seed.dot(e2));
+  // Kasa circle fit: x^2 + y^2 = 2 a x + 2 b y + c, least squares.
+  Eigen::Matrix3d A = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  std::size_t n = 0;
+  for (int v = 300; v < 450; ++v) {
+    for (int u = 150; u < 310; ++u) {
+      if (!is_valid(cloud.at(u, v))) continue;
+      const Eigen::Vector3d p = cloud.at(u, v).getVector3fMap().cast<double>();
+      const double height = (p - centroid).dot(up);
+      const Eigen::Vector2d q(p.dot(e1), p.dot(e2));
+      if (height < 0.02 || height > 0.08 || (q - seed_2d).norm() > 0.06) continue;
+      const Eigen::Vector3d row(2 * q.x(), 2 * q.y(), 1);
+      A += row * row.transpose();
+      b += row * q.squaredNorm();
+      ++n;
+    }
+  }
+  if (n < 1000) return -1;
+  const Eigen::Vector3d abc = A.ldlt().solve(b);
+  return 2 * std::sqrt(abc.z() + abc.x() * abc.x() + abc.y() * abc.y());
+}
+
+TEST_F(IoTest, YcbFramesLoadAtTheirMetricScale) {
+  SCENEWATCH_REQUIRE_DATA("ycb/frame-000003.depth.png");
+  const fs::path ycb = test::data_dir() / "ycb";
+  // As recorded, with the unit on the command line (--depth-scale 0.0001) ...
+  SequenceOptions options;
+  options.depth_scale_m = 1e-4;
+  auto seq = open_sequence(ycb, options);
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  ASSERT_EQ(seq->frames.size(), 3u);
+  ASSERT_EQ(seq->frames[1].name, "frame-000003");
+  auto frame = load_sequence_frame(*seq, 1);
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  const double diameter = soup_can_diameter_m(*frame->cloud);
+  std::cout << "tomato soup can, YCB frame 3: " << diameter * 1000 << " mm across (model: 65.8 mm)\n";
+  EXPECT_NEAR(diameter, 0.0658, 0.003);
+  EXPECT_NEAR(frame->cloud->at(228, 390).z, 0.74, 0.01) << "the can stands 74 cm from the camera";
+
+  // ... and with a depth-scale.txt beside camera-intrinsics.txt (a copy of the folder's files).
+  for (const char* f : {"camera-intrinsics.txt", "frame-000003.color.png", "frame-000003.depth.png"})
+    fs::create_symlink(ycb / f, dir_ / f);
+  write_text("depth-scale.txt", "0.0001\n");
+  auto with_file = open_sequence(dir_);
+  ASSERT_TRUE(with_file.ok()) << with_file.error().message;
+  auto same = load_sequence_frame(*with_file, 0);
+  ASSERT_TRUE(same.ok()) << same.error().message;
+  EXPECT_EQ(same->cloud->at(228, 390).z, frame->cloud->at(228, 390).z);
+
+  // Read as millimetres the can would stand 7.4 m away.
+  auto as_mm = load_sequence_frame(*open_sequence(ycb), 1);
+  ASSERT_TRUE(as_mm.ok()) << as_mm.error().message;
+  EXPECT_NEAR(as_mm->cloud->at(228, 390).z, 7.4, 0.1);
 }
 
 TEST_F(IoTest, CloudFrameUsesThePcdViewpoint) {

@@ -11,6 +11,8 @@
 
 #include "daemon_harness.h"
 #include "scenewatch/io/cloud_io.h"
+#include "scenewatch/io/image_io.h"
+#include "scenewatch/io/rgbd.h"
 
 namespace scenewatch::test {
 namespace {
@@ -261,6 +263,89 @@ TEST_F(CliTest, ReplayTellsTheStreamAndCountsIt) {
   EXPECT_NE(result.err.find("1 frames"), std::string::npos) << result.err;
   result = cli({"replay", before, "--stride", "0"});
   EXPECT_EQ(result.exit_code, 2) << "usage error";
+}
+
+TEST_F(CliTest, TumFoldersAndDepthScalesWhereverSequencesAreRead) {
+  // The sample frame three ways: as shipped (depth in mm), as a TUM RGB-D folder (depth in
+  // 1/5000 m, stamps in lists, pose in groundtruth.txt, one colour image without depth), and in
+  // the shipped layout with depth in 1/5000 m, read with --depth-scale or a depth-scale.txt.
+  const fs::path sample = source_dir() / "sample_clouds/tabletop";
+  const fs::path tum = tmp_ / "tum", fifth = tmp_ / "fifth";
+  fs::create_directories(tum / "rgb");
+  fs::create_directories(tum / "depth");
+  fs::create_directories(fifth);
+  auto depth = io::read_depth_png(sample / "frame-000000.depth.png");
+  ASSERT_TRUE(depth.ok()) << depth.error().message;
+  for (auto& d : depth->depth_mm) d = static_cast<std::uint16_t>(d * 5);
+  ASSERT_TRUE(io::write_depth_png(tum / "depth/1.003000.png", *depth).ok());
+  ASSERT_TRUE(io::write_depth_png(fifth / "frame-000000.depth.png", *depth).ok());
+  fs::copy_file(sample / "frame-000000.color.png", tum / "rgb/1.000000.png");
+  fs::copy_file(sample / "frame-000000.color.png", tum / "rgb/2.000000.png");
+  ASSERT_TRUE(io::write_tum_list(tum / "rgb.txt", {{1.0, "rgb/1.000000.png", 0}, {2.0, "rgb/2.000000.png", 0}}).ok());
+  ASSERT_TRUE(io::write_tum_list(tum / "depth.txt", {{1.003, "depth/1.003000.png", 0}}).ok());
+  auto pose = io::read_pose_matrix(sample / "frame-000000.pose.txt");
+  ASSERT_TRUE(pose.ok()) << pose.error().message;
+  ASSERT_TRUE(io::write_tum(tum / "groundtruth.txt", {{0.99, Eigen::Translation3d(0, 0, 0.05) * *pose}, {1.001, *pose}}).ok());
+  for (const char* f : {"camera-intrinsics.txt", "frame-000000.color.png", "frame-000000.pose.txt"}) {
+    fs::copy_file(sample / f, fifth / f);
+  }
+  fs::copy_file(sample / "camera-intrinsics.txt", tum / "camera-intrinsics.txt");
+
+  // Offline: replay reads the TUM folder and says what it skipped.
+  auto result = cli({"replay", tum.string(), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.err.find("1 colour image without a depth image within 0.02 s skipped"), std::string::npos)
+      << result.err;
+  EXPECT_EQ(parse(result.out).at("frames"), 1);
+
+  // Through the daemon: the same points and objects whichever way the frame was stored.
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "segmentation:\n  up_vector: [0, 0, 1]\n"));
+  auto ingest = [&](std::vector<std::string> args) {
+    EXPECT_EQ(remote({"reset"}).exit_code, 0);
+    args.insert(args.begin(), "ingest");
+    args.push_back("--json");
+    auto r = remote(args);
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    return r.exit_code == 0 ? parse(r.out) : json();
+  };
+  const json shipped = ingest({sample.string()});
+  ASSERT_TRUE(shipped.is_object());
+  ASSERT_EQ(shipped.at("clusters").size(), 4u);
+  const auto same_as_shipped = [&](const json& j, const std::string& how) {
+    ASSERT_TRUE(j.is_object()) << how;
+    EXPECT_EQ(j.at("points"), shipped.at("points")) << how;
+    ASSERT_EQ(j.at("clusters").size(), shipped.at("clusters").size()) << how;
+    for (std::size_t k = 0; k < j.at("clusters").size(); ++k) {
+      for (std::size_t axis = 0; axis < 3; ++axis) {
+        EXPECT_NEAR(j.at("clusters")[k].at("centroid").at(axis).get<double>(),
+                    shipped.at("clusters")[k].at("centroid").at(axis).get<double>(), 1e-4)
+            << how << ", cluster " << k << " " << axis;
+      }
+    }
+  };
+  same_as_shipped(ingest({tum.string()}), "TUM layout");
+  same_as_shipped(ingest({fifth.string(), "--depth-scale", "0.0002"}), "--depth-scale 0.0002");
+  std::ofstream(fifth / "depth-scale.txt") << "0.0002\n";
+  same_as_shipped(ingest({fifth.string()}), "depth-scale.txt");
+  // Read as millimetres the table would be five times farther: not the same frame.
+  const json misread = ingest({fifth.string(), "--depth-scale", "0.001"});
+  ASSERT_TRUE(misread.is_object());
+  const bool same = misread.at("points") == shipped.at("points") &&
+                    misread.at("clusters").size() == shipped.at("clusters").size() &&
+                    std::abs(misread.at("clusters")[0].at("centroid").at(2).get<double>() -
+                             shipped.at("clusters")[0].at("centroid").at(2).get<double>()) < 1e-3;
+  EXPECT_FALSE(same) << "the depth unit must matter";
+
+  // Bad scales: out of range on the command line is a usage error; in the file, an error naming it.
+  result = remote({"ingest", fifth.string(), "--depth-scale", "0"});
+  EXPECT_EQ(result.exit_code, 2) << result.err;
+  std::ofstream(fifth / "depth-scale.txt") << "1e-4 mm\n";
+  result = remote({"ingest", fifth.string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("depth-scale.txt' line 1: 'mm' is not a number"), std::string::npos) << result.err;
+  result = cli({"replay", fifth.string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("depth-scale.txt"), std::string::npos) << result.err;
 }
 
 TEST_F(CliTest, DiffOfAnMosdPairAndBadInput) {

@@ -62,7 +62,30 @@ Status write_text(const fs::path& path, const std::string& text) {
 
 }  // namespace
 
-Result<CloudPtr> rgbd_to_cloud(const ColorImage& color, const DepthImage& depth, const Intrinsics& K, double max_depth_m) {
+Status validate_depth_scale(double depth_scale_m, const std::string& where) {
+  if (!(std::isfinite(depth_scale_m) && depth_scale_m > 0 && depth_scale_m <= 1.0)) {
+    std::ostringstream os;
+    os << where << ": the depth scale must be in (0, 1] metres per depth unit (0.001 for millimetres), got "
+       << depth_scale_m;
+    return invalid_argument(os.str());
+  }
+  return {};
+}
+
+Result<double> read_depth_scale(const fs::path& path) {
+  auto values = read_numbers(path);
+  if (!values) return values.error();
+  if (values->size() != 1) {
+    return invalid_argument(quoted(path) + ": expected one number, the metres per depth unit, found " +
+                            std::to_string(values->size()));
+  }
+  if (auto st = validate_depth_scale(values->front(), quoted(path)); !st) return st.error();
+  return values->front();
+}
+
+Result<CloudPtr> rgbd_to_cloud(const ColorImage& color, const DepthImage& depth, const Intrinsics& K, double depth_scale_m,
+                               double max_depth_m) {
+  if (auto st = validate_depth_scale(depth_scale_m, "rgbd_to_cloud"); !st) return st.error();
   if (depth.empty()) return invalid_argument("depth image is empty");
   if (depth.depth_mm.size() != static_cast<std::size_t>(depth.width) * depth.height) {
     return invalid_argument("depth buffer size does not match its width x height");
@@ -94,7 +117,7 @@ Result<CloudPtr> rgbd_to_cloud(const ColorImage& color, const DepthImage& depth,
       p.g = color.rgb[3 * i + 1];
       p.b = color.rgb[3 * i + 2];
       const std::uint16_t d = depth.depth_mm[i];
-      const double z = d * 1e-3;
+      const double z = d * depth_scale_m;
       // 0 is "no depth" everywhere; 65535 is 7-Scenes' marker for it.
       if (d == 0 || d == 65535 || z > max_depth_m) {
         p.x = p.y = p.z = nan;
@@ -197,6 +220,35 @@ Status write_tum(const fs::path& path, const std::vector<StampedPose>& poses) {
     os << std::fixed << std::setprecision(6) << p.stamp_s << std::defaultfloat << std::setprecision(12) << " " << t.x()
        << " " << t.y() << " " << t.z() << " " << q.x() << " " << q.y() << " " << q.z() << " " << q.w() << "\n";
   }
+  return write_text(path, os.str());
+}
+
+Result<std::vector<StampedFile>> read_tum_list(const fs::path& path) {
+  std::vector<StampedFile> files;
+  auto st = for_each_line(path, [&](int line_no, const std::string& line) -> Status {
+    std::istringstream ls(line);
+    std::string stamp, file, rest;
+    if (!(ls >> stamp)) return {};
+    const std::string where = quoted(path) + " line " + std::to_string(line_no) + ": ";
+    char* end = nullptr;
+    const double t = std::strtod(stamp.c_str(), &end);
+    if (end == stamp.c_str() || *end != '\0' || !std::isfinite(t)) {
+      return invalid_argument(where + "timestamp '" + stamp + "' is not a number");
+    }
+    if (!(ls >> file)) return invalid_argument(where + "expected 'timestamp filename', found no file name");
+    if (ls >> rest) return invalid_argument(where + "expected 'timestamp filename', found more ('" + rest + "')");
+    files.push_back({t, file, line_no});
+    return {};
+  });
+  if (!st) return st.error();
+  if (files.empty()) return invalid_argument(quoted(path) + ": no images listed");
+  return files;
+}
+
+Status write_tum_list(const fs::path& path, const std::vector<StampedFile>& files) {
+  std::ostringstream os;
+  os << "# timestamp filename\n" << std::fixed << std::setprecision(6);
+  for (const auto& f : files) os << f.stamp_s << " " << f.file.generic_string() << "\n";
   return write_text(path, os.str());
 }
 

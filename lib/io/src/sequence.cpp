@@ -1,8 +1,11 @@
 // Sequence folders: frame-NNNNNN.color.{png,jpg} and frame-NNNNNN.depth.png with per-frame 4x4 poses
-// or a TUM trajectory.
+// or a TUM trajectory; or the TUM RGB-D benchmark's rgb.txt, depth.txt and groundtruth.txt.
 #include <algorithm>
+#include <cmath>
+#include <sstream>
 #include <system_error>
 
+#include "scenewatch/core/files.h"
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/io/image_io.h"
 #include "scenewatch/io/rgbd.h"
@@ -39,22 +42,49 @@ std::vector<FrameName> frame_names(const fs::path& dir) {
   std::sort(names.begin(), names.end());
   return names;
 }
-}  // namespace
 
-bool is_sequence_dir(const fs::path& path) {
+
+constexpr const char* kTumColorList = "rgb.txt";
+constexpr const char* kTumDepthList = "depth.txt";
+constexpr const char* kTumGroundTruth = "groundtruth.txt";
+constexpr const char* kDepthScaleFile = "depth-scale.txt";
+
+bool has_file(const fs::path& path) {
   std::error_code ec;
-  return fs::is_directory(path, ec) && !frame_names(path).empty();
+  return fs::exists(path, ec);
 }
 
-Result<Sequence> open_sequence(const fs::path& dir) {
+// The depth unit: the caller's, else depth-scale.txt, else the layout's.
+Status read_scale(const fs::path& dir, const SequenceOptions& options, double layout_unit_m, Sequence& seq) {
+  if (options.depth_scale_m) {
+    if (auto st = validate_depth_scale(*options.depth_scale_m, "--depth-scale"); !st) return st;
+    seq.depth_scale_m = *options.depth_scale_m;
+    return {};
+  }
+  seq.depth_scale_m = layout_unit_m;
+  if (!has_file(dir / kDepthScaleFile)) return {};
+  auto scale = read_depth_scale(dir / kDepthScaleFile);
+  if (!scale) return scale.error();
+  seq.depth_scale_m = *scale;
+  return {};
+}
+
+Status fill_image_size(Sequence& seq) {
+  auto size = read_png_size(seq.frames.front().depth);
+  if (!size) return size.error();
+  seq.intrinsics.width = size->first;
+  seq.intrinsics.height = size->second;
+  return {};
+}
+
+// frame-NNNNNN.color.{png,jpg} + .depth.png, poses per frame or one trajectory line per frame.
+Result<Sequence> open_frames_layout(const fs::path& dir, const SequenceOptions& options) {
   std::error_code ec;
   const std::string where = "'" + dir.string() + "'";
-  if (!fs::exists(dir, ec)) return not_found(where + ": no such directory");
-  if (!fs::is_directory(dir, ec)) return invalid_argument(where + ": not a directory");
   Sequence seq;
   seq.dir = dir;
+  seq.layout = SequenceLayout::kFrames;
   const auto names = frame_names(dir);
-  if (names.empty()) return invalid_argument(where + ": no frame-*.color.png or .color.jpg files; not a sequence folder");
   for (std::size_t i = 1; i < names.size(); ++i) {
     if (names[i].name == names[i - 1].name) {
       return invalid_argument(where + ": " + names[i].name + " has two colour images ('" + names[i - 1].color + "', '" +
@@ -65,6 +95,7 @@ Result<Sequence> open_sequence(const fs::path& dir) {
   auto K = read_intrinsics(dir / "camera-intrinsics.txt");
   if (!K) return K.error();
   seq.intrinsics = *K;
+  if (auto st = read_scale(dir, options, kDepthMillimetres, seq); !st) return st.error();
 
   for (const auto& [name, color] : names) {
     SequenceEntry e;
@@ -74,11 +105,7 @@ Result<Sequence> open_sequence(const fs::path& dir) {
     if (!fs::exists(e.depth, ec)) return invalid_argument("'" + e.depth.string() + "': missing depth image for " + name);
     seq.frames.push_back(std::move(e));
   }
-
-  auto size = read_png_size(seq.frames.front().depth);
-  if (!size) return size.error();
-  seq.intrinsics.width = size->first;
-  seq.intrinsics.height = size->second;
+  if (auto st = fill_image_size(seq); !st) return st.error();
 
   // Poses: per-frame 4x4 files (7-Scenes) take precedence over a trajectory file.
   const bool per_frame_poses = std::all_of(seq.frames.begin(), seq.frames.end(), [&](const SequenceEntry& e) {
@@ -113,6 +140,153 @@ Result<Sequence> open_sequence(const fs::path& dir) {
   return seq;
 }
 
+// A TUM image list, sorted by time, every listed file checked to exist.
+Result<std::vector<StampedFile>> read_image_list(const fs::path& dir, const char* list_name) {
+  const fs::path list = dir / list_name;
+  if (!has_file(list)) {
+    return not_found(quoted(list) + ": missing; a TUM RGB-D folder has rgb.txt, depth.txt and (for poses) groundtruth.txt");
+  }
+  auto files = read_tum_list(list);
+  if (!files) return files.error();
+  for (const auto& f : *files) {
+    if (!has_file(dir / f.file)) {
+      return not_found(quoted(list) + " line " + std::to_string(f.line) + ": '" + f.file.string() + "' does not exist");
+    }
+  }
+  std::stable_sort(files->begin(), files->end(), [](const StampedFile& a, const StampedFile& b) { return a.stamp_s < b.stamp_s; });
+  return files;
+}
+
+// Index of the stamp nearest to t in a sorted list, or -1 when none is within max_dt.
+template <typename T, typename StampOf>
+std::ptrdiff_t nearest(const std::vector<T>& sorted, double t, double max_dt, StampOf stamp_of) {
+  auto it = std::lower_bound(sorted.begin(), sorted.end(), t, [&](const T& x, double v) { return stamp_of(x) < v; });
+  std::ptrdiff_t best = -1;
+  double best_dt = max_dt;
+  for (auto c : {it, it == sorted.begin() ? it : std::prev(it)}) {
+    if (c == sorted.end()) continue;
+    const double dt = std::abs(stamp_of(*c) - t);
+    if (dt <= best_dt) {
+      best_dt = dt;
+      best = c - sorted.begin();
+    }
+  }
+  return best;
+}
+
+Result<Sequence> open_tum_layout(const fs::path& dir, const SequenceOptions& options) {
+  if (!(options.max_time_difference_s >= 0)) return invalid_argument("the association tolerance must be >= 0 s");
+  Sequence seq;
+  seq.dir = dir;
+  seq.layout = SequenceLayout::kTum;
+  auto colors = read_image_list(dir, kTumColorList);
+  if (!colors) return colors.error();
+  auto depths = read_image_list(dir, kTumDepthList);
+  if (!depths) return depths.error();
+  if (has_file(dir / "camera-intrinsics.txt")) {
+    auto K = read_intrinsics(dir / "camera-intrinsics.txt");
+    if (!K) return K.error();
+    seq.intrinsics = *K;
+  } else {
+    seq.intrinsics.fx = seq.intrinsics.fy = 525.0;  // TUM's default for the ROS driver's registered images
+    seq.intrinsics.cx = 319.5;
+    seq.intrinsics.cy = 239.5;
+  }
+  if (auto st = read_scale(dir, options, kDepthTum, seq); !st) return st.error();
+  std::optional<std::vector<StampedPose>> poses;
+  if (has_file(dir / kTumGroundTruth)) {
+    auto read = read_tum(dir / kTumGroundTruth);
+    if (!read) return read.error();
+    poses = std::move(*read);
+    std::stable_sort(poses->begin(), poses->end(), [](const auto& a, const auto& b) { return a.stamp_s < b.stamp_s; });
+  }
+
+  // Colour to depth as TUM's associate.py: the candidate pairs within the tolerance, closest first,
+  // each image used once.
+  const double tol = options.max_time_difference_s;
+  struct Pair {
+    double dt;
+    std::size_t color, depth;
+  };
+  std::vector<Pair> candidates;
+  for (std::size_t c = 0; c < colors->size(); ++c) {
+    const double t = (*colors)[c].stamp_s;
+    auto it = std::lower_bound(depths->begin(), depths->end(), t - tol,
+                               [](const StampedFile& f, double v) { return f.stamp_s < v; });
+    for (; it != depths->end() && it->stamp_s <= t + tol; ++it) {
+      candidates.push_back({std::abs(it->stamp_s - t), c, static_cast<std::size_t>(it - depths->begin())});
+    }
+  }
+  std::stable_sort(candidates.begin(), candidates.end(), [](const Pair& a, const Pair& b) { return a.dt < b.dt; });
+  std::vector<std::ptrdiff_t> depth_of(colors->size(), -1);
+  std::vector<bool> depth_used(depths->size(), false);
+  for (const Pair& p : candidates) {
+    if (depth_of[p.color] >= 0 || depth_used[p.depth]) continue;
+    depth_of[p.color] = static_cast<std::ptrdiff_t>(p.depth);
+    depth_used[p.depth] = true;
+  }
+
+  for (std::size_t c = 0; c < colors->size(); ++c) {
+    if (depth_of[c] < 0) {
+      ++seq.skipped_without_depth;
+      continue;
+    }
+    const StampedFile& depth = (*depths)[static_cast<std::size_t>(depth_of[c])];
+    SequenceEntry e;
+    e.name = (*colors)[c].file.stem().string();
+    e.color = dir / (*colors)[c].file;
+    e.depth = dir / depth.file;
+    e.stamp_s = depth.stamp_s;  // the points come from the depth image
+    if (poses) {
+      const auto k = nearest(*poses, depth.stamp_s, tol, [](const StampedPose& p) { return p.stamp_s; });
+      if (k < 0) {
+        ++seq.skipped_without_pose;
+        continue;
+      }
+      e.T_world_camera = (*poses)[static_cast<std::size_t>(k)].T_world_camera;
+    }
+    seq.frames.push_back(std::move(e));
+  }
+  if (seq.frames.empty()) {
+    std::ostringstream os;
+    os << "'" << dir.string() << "': no frame has colour, depth" << (poses ? " and pose" : "") << " within " << tol
+       << " s of each other (" << skipped_summary(seq, options) << ")";
+    return invalid_argument(os.str());
+  }
+  if (auto st = fill_image_size(seq); !st) return st.error();
+  return seq;
+}
+
+}  // namespace
+
+bool is_sequence_dir(const fs::path& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec) && (!frame_names(path).empty() || has_file(path / kTumColorList));
+}
+
+Result<Sequence> open_sequence(const fs::path& dir, const SequenceOptions& options) {
+  std::error_code ec;
+  const std::string where = "'" + dir.string() + "'";
+  if (!fs::exists(dir, ec)) return not_found(where + ": no such directory");
+  if (!fs::is_directory(dir, ec)) return invalid_argument(where + ": not a directory");
+  if (!frame_names(dir).empty()) return open_frames_layout(dir, options);
+  if (has_file(dir / kTumColorList)) return open_tum_layout(dir, options);
+  return invalid_argument(where + ": no frame-*.color.png or .color.jpg files and no TUM rgb.txt; not a sequence folder");
+}
+
+std::string skipped_summary(const Sequence& seq, const SequenceOptions& options) {
+  std::ostringstream os;
+  const auto say = [&](std::size_t n, const char* what) {
+    if (n == 0) return;
+    if (os.tellp() > 0) os << "; ";
+    os << n << (n == 1 ? " colour image" : " colour images") << " without " << what << " within "
+       << options.max_time_difference_s << " s skipped";
+  };
+  say(seq.skipped_without_depth, "a depth image");
+  say(seq.skipped_without_pose, "a ground-truth pose");
+  return os.str();
+}
+
 Result<Frame> load_sequence_frame(const Sequence& seq, std::size_t index) {
   if (index >= seq.frames.size()) return invalid_argument("frame index " + std::to_string(index) + " out of range");
   const SequenceEntry& e = seq.frames[index];
@@ -123,7 +297,7 @@ Result<Frame> load_sequence_frame(const Sequence& seq, std::size_t index) {
   Intrinsics K = seq.intrinsics;
   K.width = depth->width;
   K.height = depth->height;
-  auto cloud = rgbd_to_cloud(*color, *depth, K);
+  auto cloud = rgbd_to_cloud(*color, *depth, K, seq.depth_scale_m);
   if (!cloud) return Error{cloud.error().code, e.name + ": " + cloud.error().message};
   Frame frame;
   frame.cloud = *cloud;
