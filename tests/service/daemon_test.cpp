@@ -1,6 +1,7 @@
 // Integration: the real scenewatchd binary on a loopback port, driven through the protocol.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -196,6 +197,60 @@ TEST_F(DaemonTest, RealKitchenStreamedOverTcpIsCalm) {
   const auto stats = call(client, request([](proto::Request& r) { r.mutable_stats(); }));
   EXPECT_EQ(stats.stats().frames_processed(), seq->frames.size());
   EXPECT_EQ(stats.stats().events_emitted(), 0u);
+}
+
+TEST_F(DaemonTest, ALiveStreamThatOutpacesTheModelSkipsToTheNewestFrame) {
+  // A live sensor sends 30 frames/s without waiting for replies; a room frame takes longer than
+  // 33 ms. Eight VGA kitchen frames sent back to back as live frames: the first is processed at
+  // once, the ones that arrived meanwhile are answered "skipped" except the newest, which is
+  // processed. Every request gets its reply, in order. Frames not marked live are never skipped.
+  SCENEWATCH_REQUIRE_DATA("redkitchen/frame-000150.color.png");
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+  auto seq = io::open_sequence(data_dir() / "redkitchen");
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  constexpr std::uint64_t kFrames = 8;
+  std::vector<proto::Request> requests(kFrames);
+  for (std::uint64_t i = 0; i < kFrames; ++i) {
+    auto frame = io::load_sequence_frame(*seq, i);
+    ASSERT_TRUE(frame.ok()) << frame.error().message;
+    *requests[i].mutable_ingest_frame() = service::make_ingest_frame(*frame);
+    requests[i].set_id(i + 1);
+  }
+  auto send_all = [&](bool live) {
+    Client client = daemon_.connect();
+    for (auto& r : requests) {
+      r.mutable_ingest_frame()->set_live(live);
+      EXPECT_TRUE(client.send(r).ok());
+    }
+    std::vector<bool> skipped;
+    for (std::uint64_t i = 0; i < kFrames; ++i) {
+      auto reply = client.receive(120);
+      EXPECT_TRUE(reply.ok()) << (reply.ok() ? "" : reply.error().message);
+      if (!reply.ok()) break;
+      EXPECT_EQ(reply->id(), i + 1) << "replies come in request order";
+      EXPECT_EQ(reply->status().code(), proto::Status::OK) << reply->status().message();
+      skipped.push_back(reply->ingest().skipped());
+    }
+    return skipped;
+  };
+
+  const std::vector<bool> live = send_all(true);
+  ASSERT_EQ(live.size(), kFrames);
+  const auto skipped = static_cast<std::uint64_t>(std::count(live.begin(), live.end(), true));
+  std::printf("8 live frames back to back: %llu processed, %llu skipped\n",
+              static_cast<unsigned long long>(kFrames - skipped), static_cast<unsigned long long>(skipped));
+  EXPECT_FALSE(live.front()) << "the first frame finds nothing newer waiting";
+  EXPECT_FALSE(live.back()) << "the newest frame is always processed";
+  EXPECT_GE(skipped, kFrames - 3) << "frames that arrived during one frame's processing are skipped";
+  Client client = daemon_.connect();
+  auto stats = call(client, request([](proto::Request& r) { r.mutable_stats(); }));
+  EXPECT_EQ(stats.stats().frames_skipped(), skipped);
+  EXPECT_EQ(stats.stats().frames_processed(), kFrames - skipped);
+
+  const std::vector<bool> queued = send_all(false);
+  EXPECT_EQ(std::count(queued.begin(), queued.end(), true), 0) << "frames not marked live are all processed";
+  stats = call(client, request([](proto::Request& r) { r.mutable_stats(); }));
+  EXPECT_EQ(stats.stats().frames_processed(), 2 * kFrames - skipped);
 }
 
 TEST_F(DaemonTest, SimulatedChangesReachTheSubscriberOnceEach) {

@@ -231,6 +231,38 @@ TEST_F(RequestHandlerTest, ValidFrameIsProcessed) {
   EXPECT_EQ(stats.stats().points_processed(), 3000u);
 }
 
+TEST_F(RequestHandlerTest, LiveFramesAreRecognisedWithoutDecodingAndSkippedUnprocessed) {
+  RequestHandler handler(memory_, {});
+  proto::Request request;
+  request.set_id(77);
+  *request.mutable_ingest_frame() = make_ingest_frame(grid_frame(60, 50));
+  std::string plain, live;
+  request.SerializeToString(&plain);
+  request.mutable_ingest_frame()->set_live(true);
+  request.SerializeToString(&live);
+  EXPECT_FALSE(handler.is_live_frame(plain));
+  EXPECT_TRUE(handler.is_live_frame(live));
+  EXPECT_FALSE(handler.is_live_frame(live.substr(0, live.size() / 2))) << "truncated";
+  EXPECT_FALSE(handler.is_live_frame("garbage bytes"));
+  proto::Request health;
+  health.mutable_health();
+  std::string health_bytes;
+  health.SerializeToString(&health_bytes);
+  EXPECT_FALSE(handler.is_live_frame(health_bytes));
+
+  const Reply reply = handler.skip_live_frame(live);
+  proto::Response response;
+  ASSERT_TRUE(response.ParseFromString(reply.payload));
+  EXPECT_EQ(response.id(), 77u);
+  EXPECT_EQ(response.status().code(), proto::Status::OK);
+  EXPECT_TRUE(response.ingest().skipped());
+  EXPECT_EQ(response.ingest().frames_skipped(), 1u);
+  EXPECT_EQ(frames_processed(), 0u) << "a skipped frame changes nothing";
+  proto::Request stats;
+  stats.mutable_stats();
+  EXPECT_EQ(call(handler, stats).stats().frames_skipped(), 1u);
+}
+
 TEST_F(RequestHandlerTest, MosdPairGivesPlanesObjectsAndPushedEvents) {
   // learn12 -> learn13 of mOSD: the same Kinect, unmoved, an object put on the table.
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn13.pcd");

@@ -7,6 +7,7 @@
 #include <exception>
 #include <optional>
 
+#include "live_frame.h"
 #include "proto_convert.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/core/files.h"
@@ -97,6 +98,7 @@ struct RequestHandler::Impl {
   Executor mutate, query;
   std::function<std::size_t()> connections;
   std::atomic<bool> stopping{false};
+  std::atomic<std::uint64_t> frames_skipped{0};  // live frames superseded by newer ones
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
 
   Impl(pipeline::WorkingMemory& m, HandlerConfig c, Executor mu, Executor q)
@@ -209,6 +211,7 @@ struct RequestHandler::Impl {
     out->set_keyframes(s.keyframes);
     out->set_mesh_triangles(s.mesh_triangles);
     out->set_appearance_memory_bytes(s.appearance_memory_bytes);
+    out->set_frames_skipped(frames_skipped.load());
     out->set_connections(connections ? static_cast<std::uint32_t>(connections()) : 0);
     out->set_uptime_s(uptime_s());
     return {};
@@ -350,6 +353,7 @@ struct RequestHandler::Impl {
     out->set_segment_ms(result->segment_ms);
     out->set_insert_ms(result->insert_ms);
     out->set_total_ms(result->total_ms);
+    out->set_frames_skipped(frames_skipped.load());
     return {};
   }
 
@@ -476,6 +480,17 @@ RequestHandler::~RequestHandler() = default;
 
 void RequestHandler::handle(std::string payload, SessionContext& context, std::function<void(Reply)> done) {
   impl_->handle(std::move(payload), context, std::move(done), /*use_executors=*/true);
+}
+
+bool RequestHandler::is_live_frame(std::string_view payload) const { return peek_live_frame(payload).live; }
+
+Reply RequestHandler::skip_live_frame(std::string_view payload) {
+  proto::Response response;
+  response.set_id(peek_live_frame(payload).id);
+  auto* out = response.mutable_ingest();
+  out->set_skipped(true);
+  out->set_frames_skipped(++impl_->frames_skipped);
+  return finish(response, "ingest_frame (live, skipped: a newer frame was waiting)");
 }
 
 Reply RequestHandler::handle_now(const std::string& payload, SessionContext& context) {

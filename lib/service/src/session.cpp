@@ -1,5 +1,7 @@
 #include "session.h"
 
+#include <algorithm>
+
 #include <boost/asio/post.hpp>
 #include <boost/asio/write.hpp>
 
@@ -197,6 +199,7 @@ void Session::resume_reading() {
 
 void Session::dispatch_next() {
   if (in_flight_ || pending_.empty() || closing_ || closed_) return;
+  skip_superseded_live_frames();
   in_flight_ = true;
   std::string payload = std::move(pending_.front());
   pending_.pop_front();
@@ -206,6 +209,22 @@ void Session::dispatch_next() {
     // Possibly on a worker thread: continue on the strand.
     asio::post(self->executor_, [self, reply = std::move(reply)]() mutable { self->on_reply(std::move(reply)); });
   });
+}
+
+// A live stream that outpaces the model: a live frame with a newer live frame waiting behind it
+// is answered "skipped" without being processed, so the model works on the newest frame and the
+// queue never holds more than the frames that arrived during one frame's processing.
+void Session::skip_superseded_live_frames() {
+  auto newer_live_waiting = [&] {
+    return std::any_of(pending_.begin() + 1, pending_.end(), [&](const std::string& p) { return handler_.is_live_frame(p); });
+  };
+  while (pending_.size() >= 2 && handler_.is_live_frame(pending_.front()) && newer_live_waiting()) {
+    Reply reply = handler_.skip_live_frame(pending_.front());
+    pending_bytes_ -= pending_.front().size();
+    pending_.pop_front();
+    log(LogLevel::kDebug, reply.call);
+    enqueue(std::move(reply.payload));
+  }
 }
 
 void Session::on_reply(Reply reply) {

@@ -73,6 +73,8 @@ class Session : public std::enable_shared_from_this<Session> {
   /// No request waiting or running and nothing left to send.
   bool idle() const;
   void dispatch_next();
+  /// Answers the live frames that a newer waiting live frame supersedes (see IngestFrame.live).
+  void skip_superseded_live_frames();
   void on_reply(Reply reply);
   void push_event(std::string payload);
   void enqueue(std::string payload);

@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "scenewatch/core/result.h"
@@ -62,6 +63,11 @@ class RequestHandler {
   /// executor's thread. `context` is only used before handle() returns.
   void handle(std::string payload, SessionContext& context, std::function<void(Reply)> done);
 
+  /// True when the payload is a live IngestFrame (IngestFrame.live), read without decoding it.
+  bool is_live_frame(std::string_view payload) const;
+  /// The answer to a live frame that a newer live frame of its connection supersedes: OK with
+  /// IngestReply.skipped, nothing processed; counted in Stats.frames_skipped. Thread safe.
+  Reply skip_live_frame(std::string_view payload);
   /// Handles one request synchronously on the calling thread, ignoring the executors.
   Reply handle_now(const std::string& payload, SessionContext& context);
 
