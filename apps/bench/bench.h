@@ -45,5 +45,6 @@ int run_surprise(const Options& o);
 int run_change(const Options& o);
 int run_stream(const Options& o);
 int run_pipeline(const Options& o);
+int run_memory(const Options& o);
 
 }  // namespace scenewatch::bench
