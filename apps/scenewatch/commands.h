@@ -49,6 +49,7 @@ struct SurpriseOptions {
   std::string out_png;                  ///< heatmap over the observed image
   std::string raw_tiff;                 ///< float32 surprise per pixel
   std::string expected_png;             ///< the expected (virtual) image
+  std::string panel_png;                ///< observed | expected | heatmap side by side
   std::string mesh_ply;                 ///< the references' textured mesh
   std::string intrinsics;               ///< 3x3 K file for cloud files (else recovered)
   std::string config;                   ///< YAML: its appearance and surprise sections

@@ -193,6 +193,8 @@ int main(int argc, char** argv) {
   surprise->add_option("--out,-o", surprise_options.out_png, "write the surprise as a heatmap over the observed image (PNG)");
   surprise->add_option("--raw", surprise_options.raw_tiff, "write the total surprise per pixel, KL in nats, as 32-bit float TIFF (NaN: unknown)");
   surprise->add_option("--expected", surprise_options.expected_png, "offline: write the expected (virtual) image (PNG)");
+  surprise->add_option("--panel", surprise_options.panel_png,
+                       "offline: write the observed image, the expected image and the surprise heatmap side by side (PNG)");
   surprise->add_option("--mesh", surprise_options.mesh_ply, "offline: write the references' textured mesh (PLY)");
   surprise->add_option("--intrinsics", surprise_options.intrinsics, "3x3 camera matrix file for cloud files");
   surprise->add_option("--config", surprise_options.config, "YAML config (its appearance and surprise sections are used)");

@@ -2,6 +2,7 @@
 // reference frames (the appearance memory is built here, no daemon), or from the daemon.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
@@ -29,13 +30,40 @@ struct Outcome {
   std::size_t keyframes = 0, references_read = 0, reference_views = 0;
   double compute_ms = 0;
   std::optional<ColorImage> observed_color;
+  std::optional<ColorImage> expected_color;  ///< offline only: the memory's view from the observed pose
 };
+
+// Images of one height side by side, left to right.
+ColorImage side_by_side(const std::vector<const ColorImage*>& images) {
+  ColorImage out;
+  out.height = images.front()->height;
+  for (const ColorImage* im : images) out.width += im->width;
+  out.rgb.resize(static_cast<std::size_t>(3) * out.width * out.height);
+  int left = 0;
+  for (const ColorImage* im : images) {
+    for (int y = 0; y < out.height; ++y)
+      std::copy_n(im->rgb.begin() + static_cast<std::ptrdiff_t>(3) * y * im->width, 3 * im->width,
+                  out.rgb.begin() + static_cast<std::ptrdiff_t>(3) * (static_cast<std::ptrdiff_t>(y) * out.width + left));
+    left += im->width;
+  }
+  return out;
+}
 
 Status write_outputs(const SurpriseOptions& o, const Outcome& out, std::vector<std::string>& written) {
   if (!o.out_png.empty()) {
     const ColorImage background = out.observed_color.value_or(ColorImage{});
     if (auto st = io::write_color_png(o.out_png, surprise::heatmap_overlay(out.map, background, o.saturation)); !st) return st;
     written.push_back(o.out_png);
+  }
+  if (!o.panel_png.empty()) {
+    // Observed | expected | surprise, the picture of the seed's experiment.
+    if (!out.observed_color || !out.expected_color || out.observed_color->height != out.expected_color->height) {
+      return invalid_argument("--panel: the observed or the expected image is missing");
+    }
+    const ColorImage heat = surprise::heatmap_overlay(out.map, *out.observed_color, o.saturation);
+    const ColorImage panel = side_by_side({&*out.observed_color, &*out.expected_color, &heat});
+    if (auto st = io::write_color_png(o.panel_png, panel); !st) return st;
+    written.push_back(o.panel_png);
   }
   if (!o.raw_tiff.empty()) {
     if (auto st = surprise::write_surprise_tiff(o.raw_tiff, out.map); !st) return st;
@@ -134,8 +162,9 @@ Result<Outcome> offline(const SurpriseOptions& o) {
   out.reference_views = view.reference_views;
   out.map = std::move(*map);
   out.observed_color = observed->color;
+  out.expected_color = surprise::expected_color(view);
   if (!o.expected_png.empty()) {
-    if (auto st = io::write_color_png(o.expected_png, surprise::expected_color(view)); !st) return st.error();
+    if (auto st = io::write_color_png(o.expected_png, *out.expected_color); !st) return st.error();
   }
   if (!o.mesh_ply.empty()) {
     if (auto st = io::write_mesh_ply(o.mesh_ply, memory.mesh()); !st) return st.error();
@@ -175,6 +204,7 @@ Result<Outcome> remote(const SurpriseOptions& o, const RemoteOptions& r) {
 int run_surprise(const SurpriseOptions& o, const RemoteOptions& r) {
   if (!o.expected_png.empty() && o.references.empty()) return fail("--expected needs --reference (offline)");
   if (!o.mesh_ply.empty() && o.references.empty()) return fail("--mesh needs --reference (offline)");
+  if (!o.panel_png.empty() && o.references.empty()) return fail("--panel needs --reference (offline: the expected image is rendered here)");
   if (!o.references.empty() && o.observed.empty()) return fail("an observed frame is needed with --reference");
   auto out = o.references.empty() ? remote(o, r) : offline(o);
   if (!out) return fail(out.error().message);

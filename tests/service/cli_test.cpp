@@ -201,7 +201,8 @@ TEST_F(CliTest, SurpriseOfflineOnAnMosdPair) {
   // learn12 -> learn13: same camera, an object is added.
   const auto result = cli({"surprise", (learn / "learn13.pcd").string(), "--reference", (learn / "learn12.pcd").string(),
                            "--out", (tmp_ / "heat.png").string(), "--raw", (tmp_ / "kl.tiff").string(), "--expected",
-                           (tmp_ / "expected.png").string(), "--mesh", (tmp_ / "mesh.ply").string(), "--json"});
+                           (tmp_ / "expected.png").string(), "--mesh", (tmp_ / "mesh.ply").string(), "--panel",
+                           (tmp_ / "panel.png").string(), "--json"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   const json j = parse(result.out);
   EXPECT_EQ(j.at("width"), 640);
@@ -212,6 +213,23 @@ TEST_F(CliTest, SurpriseOfflineOnAnMosdPair) {
   EXPECT_TRUE(j.at("regions")[0].at("evidence").contains("kl_peak_luminance"));
   for (const char* name : {"heat.png", "expected.png", "mesh.ply"}) EXPECT_GT(fs::file_size(tmp_ / name), 1000u) << name;
   EXPECT_GE(fs::file_size(tmp_ / "kl.tiff"), 640u * 480u * 4u);
+  // The panel: observed | expected | heatmap, the last two the very images of --expected and --out.
+  auto panel = io::read_color_png(tmp_ / "panel.png");
+  auto expected = io::read_color_png(tmp_ / "expected.png");
+  auto heat = io::read_color_png(tmp_ / "heat.png");
+  ASSERT_TRUE(panel.ok() && expected.ok() && heat.ok());
+  ASSERT_EQ(panel->width, 3 * 640);
+  ASSERT_EQ(panel->height, 480);
+  std::size_t same_expected = 0, same_heat = 0;
+  for (int y = 0; y < 480; ++y)
+    for (int x = 0; x < 640; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const std::size_t row = static_cast<std::size_t>(y) * 3 * 640;
+        same_expected += panel->rgb[3 * (row + 640 + x) + c] == expected->rgb[3 * (static_cast<std::size_t>(y) * 640 + x) + c];
+        same_heat += panel->rgb[3 * (row + 1280 + x) + c] == heat->rgb[3 * (static_cast<std::size_t>(y) * 640 + x) + c];
+      }
+  EXPECT_EQ(same_expected, 640u * 480u * 3u);
+  EXPECT_EQ(same_heat, 640u * 480u * 3u);
   auto mesh = io::read_mesh_ply(tmp_ / "mesh.ply");
   ASSERT_TRUE(mesh.ok()) << mesh.error().message;
   EXPECT_GT(mesh->triangles.size(), 10000u);
