@@ -32,6 +32,10 @@ int run_stats(const RemoteOptions& options);
 /// `depth_scale_m`: metres per depth unit of sequence folders (unset: the folder's or layout's).
 int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side,
                const std::optional<double>& depth_scale_m);
+/// Sequence folders streamed as a live sensor would: `fps` frames per second without waiting for
+/// replies, each frame marked live (the daemon skips frames it cannot keep up with).
+int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,
+                    const std::optional<double>& depth_scale_m);
 int run_planes(const RemoteOptions& options);
 int run_objects(const RemoteOptions& options);
 /// `points`: x y z triples; `box`: empty or min x y z, max x y z.

@@ -93,6 +93,7 @@ nlohmann::json to_json(const proto::HealthReply& health) {
 
 nlohmann::json to_json(const proto::StatsReply& s) {
   return {{"frames_processed", s.frames_processed()},
+          {"frames_skipped", s.frames_skipped()},
           {"points_processed", s.points_processed()},
           {"events_emitted", s.events_emitted()},
           {"map_leaf_nodes", s.map_leaf_nodes()},
@@ -122,7 +123,9 @@ nlohmann::json to_json(const proto::IngestReply& ingest) {
           {"events", std::move(events)},
           {"segment_ms", ingest.segment_ms()},
           {"insert_ms", ingest.insert_ms()},
-          {"total_ms", ingest.total_ms()}};
+          {"total_ms", ingest.total_ms()},
+          {"skipped", ingest.skipped()},
+          {"frames_skipped", ingest.frames_skipped()}};
 }
 
 std::string occupancy_name(proto::OccupancyState state) {

@@ -59,9 +59,22 @@ int main(int argc, char** argv) {
   ingest->add_option("paths", ingest_paths, "cloud files and/or sequence folders")->required();
   ingest->add_flag("--server-side", server_side,
                    "let the daemon read the files itself (absolute paths under its data roots)");
+  std::optional<double> live_fps;
+  ingest->add_option("--live", live_fps,
+                     "stream sequence folders as a live sensor: FPS frames per second without waiting for replies; "
+                     "the daemon skips a frame when a newer one is already waiting, and the summary counts them")
+      ->check(CLI::Range(0.1, 1000.0));
   add_depth_scale_option(ingest, ingest_depth_scale);
   add_remote_options(ingest, remote);
-  ingest->callback([&] { action = [&] { return run_ingest(remote, ingest_paths, server_side, ingest_depth_scale); }; });
+  ingest->callback([&] {
+    action = [&] {
+      if (live_fps) {
+        if (server_side) return fail("--live and --server-side do not go together");
+        return run_live_ingest(remote, ingest_paths, *live_fps, ingest_depth_scale);
+      }
+      return run_ingest(remote, ingest_paths, server_side, ingest_depth_scale);
+    };
+  });
 
   auto* planes = app.add_subcommand("planes", "supporting planes of the last frame");
   add_remote_options(planes, remote);

@@ -2,10 +2,12 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <functional>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 #include "commands.h"
 #include "format.h"
@@ -132,6 +134,7 @@ int run_stats(const RemoteOptions& options) {
     if (options.json) return print_json(to_json(r.stats()));
     const auto& s = r.stats();
     std::cout << "frames processed   " << s.frames_processed() << "\n"
+              << "frames skipped     " << s.frames_skipped() << " (live frames a newer one superseded)\n"
               << "points processed   " << s.points_processed() << "\n"
               << "events emitted     " << s.events_emitted() << "\n"
               << "tracked objects    " << s.tracked_objects() << "\n"
@@ -223,6 +226,72 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
     proto::Request request;
     *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
     if (!send(std::move(request), path, nullptr)) return kExitError;
+  }
+  return failures == 0 ? kExitOk : kExitError;
+}
+
+int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,
+                    const std::optional<double>& depth_scale_m) {
+  auto client = connect(options);
+  if (!client) return fail(client.error().message);
+  // A live sensor: frames leave at `fps` whether or not the daemon has answered; the daemon skips
+  // a frame when a newer one is already waiting (IngestFrame.live). Replies are read as they come.
+  std::uint64_t sent = 0, answered = 0, processed = 0, skipped = 0, events = 0;
+  std::vector<std::string> sources(1);  // by request id
+  int failures = 0;
+  auto take_reply = [&](double timeout_s) {
+    auto reply = client->receive(timeout_s);
+    if (!reply) return false;
+    if (reply->id() == 0) return true;  // a pushed event or notice: not an answer
+    ++answered;
+    if (reply->status().code() != proto::Status::OK) {
+      fail("frame " + std::to_string(reply->id()) + ": " + service::to_string(reply->status().code()) + ": " +
+           reply->status().message());
+      ++failures;
+    } else if (reply->ingest().skipped()) {
+      ++skipped;
+    } else {
+      ++processed;
+      events += static_cast<std::uint64_t>(reply->ingest().events_size());
+      print_ingest(options, reply->id() < sources.size() ? sources[reply->id()] : std::string(), reply->ingest());
+    }
+    return true;
+  };
+  const auto start = std::chrono::steady_clock::now();
+  for (const std::string& path : paths) {
+    const io::SequenceOptions sequence_options = cli::sequence_options(depth_scale_m);
+    auto sequence = io::open_sequence(path, sequence_options);
+    if (!sequence) return fail(naming(path, sequence.error().message + " (--live takes RGB-D sequence folders)"));
+    for (std::size_t i = 0; i < sequence->frames.size(); ++i) {
+      auto frame = io::load_sequence_frame(*sequence, i);
+      if (!frame) {
+        fail(naming((fs::path(path) / sequence->frames[i].name).string(), frame.error().message));
+        ++failures;
+        continue;
+      }
+      std::this_thread::sleep_until(start + std::chrono::duration<double>(sent / fps));
+      proto::Request request;
+      *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+      request.mutable_ingest_frame()->set_live(true);
+      request.set_id(++sent);
+      sources.push_back((fs::path(path) / sequence->frames[i].name).string());
+      if (auto st = client->send(request); !st) return fail(st.error().message);
+      while (answered < sent && take_reply(0.001)) {
+      }
+    }
+  }
+  while (answered < sent) {
+    if (!take_reply(options.timeout_s > 0 ? options.timeout_s : 0)) return fail("the daemon stopped answering");
+  }
+  const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (options.json) {
+    std::cout << json{{"sent", sent}, {"processed", processed}, {"skipped", skipped}, {"events", events},
+                      {"fps_sent", fps}, {"seconds", wall_s}}
+                     .dump()
+              << std::endl;
+  } else {
+    std::cout << sent << " frames sent live at " << fps << " frames/s in " << wall_s << " s: " << processed
+              << " processed, " << skipped << " skipped (a newer frame was waiting), " << plural(events, "event") << "\n";
   }
   return failures == 0 ? kExitOk : kExitError;
 }

@@ -195,6 +195,30 @@ TEST_F(CliTest, DaemonCommands) {
   EXPECT_NE(result.err.find("INVALID_ARGUMENT"), std::string::npos) << result.err;
 }
 
+TEST_F(CliTest, IngestLiveKeepsUpWithTheNewestFrame) {
+  // 50 VGA kitchen frames sent as a live sensor at 1000 frames/s: far faster than a room frame is
+  // processed, so the daemon skips most of them; every frame is answered and counted.
+  SCENEWATCH_REQUIRE_DATA("redkitchen/frame-000150.color.png");
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "  model_dir: " + (tmp_ / "model").string() + "\n"));
+  auto result = remote({"ingest", "--live", "1000", (data_dir() / "redkitchen").string(), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::istringstream lines(result.out);
+  std::string line, last;
+  while (std::getline(lines, line)) last = line;
+  const json summary = parse(last);
+  std::printf("--live 1000 on 50 kitchen frames: %s\n", last.c_str());
+  EXPECT_EQ(summary.at("sent").get<int>(), 50);
+  EXPECT_EQ(summary.at("processed").get<int>() + summary.at("skipped").get<int>(), 50);
+  EXPECT_GE(summary.at("skipped").get<int>(), 25) << "frames arrive every 1 ms, a room frame takes tens of ms";
+  auto stats = remote({"stats", "--json"});
+  ASSERT_EQ(stats.exit_code, 0) << stats.err;
+  EXPECT_EQ(parse(stats.out).at("frames_processed").get<int>(), summary.at("processed").get<int>());
+
+  auto bad = remote({"ingest", "--live", "30", "--server-side", (data_dir() / "redkitchen").string()});
+  EXPECT_EQ(bad.exit_code, 1);
+  EXPECT_NE(bad.err.find("--live and --server-side"), std::string::npos) << bad.err;
+}
+
 TEST_F(CliTest, SurpriseOfflineOnAnMosdPair) {
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn12.pcd");
   const fs::path learn = data_dir() / "mosd/learn";
