@@ -62,6 +62,7 @@ json to_json(const ontology::CylinderFit& c, const Eigen::Vector3d& up) {
           {"radius_m", c.radius_m},          {"height_m", c.height_m},
           {"rms_m", c.rms_m},                {"coverage_deg", c.coverage_deg},
           {"inliers", c.inliers},            {"axis_fixed_upright", c.axis_fixed},
+          {"source", c.from_detection ? "detection" : "upright_circle_fit"},
           {"tilt_from_support_deg", angle_deg(c.axis, up)}};
 }
 
@@ -120,7 +121,7 @@ int run_fit(const FitOptions& options) {
     lines += ", " + fixed(fit_ms, 1) + " ms\n";
     for (std::size_t s = 1; s < fit->shapes.size(); ++s) lines += "      also " + text(fit->shapes[s]) + "\n";
     if (const auto& c = fit->cylinder) {
-      lines += "      cylinder refined: radius " + fixed(c->radius_m * 1000, 1) + " mm, height " + fixed(c->height_m * 1000, 1) +
+      lines += std::string("      cylinder refined") + (c->from_detection ? "" : " (from an upright circle fit)") + ": radius " + fixed(c->radius_m * 1000, 1) + " mm, height " + fixed(c->height_m * 1000, 1) +
                " mm, axis " + direction(c->axis) + " (" + fixed(angle_deg(c->axis, up), 1) + " deg from the support's normal" +
                (c->axis_fixed ? ", held upright" : "") + "), rms " + fixed(c->rms_m * 1000, 2) + " mm, coverage " +
                fixed(c->coverage_deg, 0) + " deg, " + std::to_string(c->inliers) + " points\n";

@@ -89,6 +89,38 @@ TEST(FitTest, AnExactHalfSphereIsASphereOfItsRadius) {
   EXPECT_LT(best.rms_m, 0.001);
 }
 
+TEST(FitTest, TwoFacesOfABoxAreTwoPlanesWithTheirPoints) {
+  // A box corner seen from the camera at the origin: faces x = 0.05 and z = 1.0, 1 mm noise.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> a(-0.05, 0.05), b(0.0, 0.1);
+  std::normal_distribution<double> noise(0, 0.001);
+  Cloud cloud;
+  for (int i = 0; i < 2000; ++i) {
+    PointT p;
+    p.getVector3fMap() = Eigen::Vector3f(static_cast<float>(a(rng)), static_cast<float>(a(rng)), static_cast<float>(1.0 + noise(rng)));
+    cloud.push_back(p);
+    p.getVector3fMap() = Eigen::Vector3f(static_cast<float>(0.05 + b(rng) * 0.0 + noise(rng)), static_cast<float>(a(rng)),
+                                         static_cast<float>(1.0 + b(rng)));
+    cloud.push_back(p);
+  }
+  FitConfig planes_only;
+  planes_only.detect_cylinder = planes_only.detect_sphere = planes_only.detect_cone = false;
+  const auto fit = fit_object(cloud, all(cloud), planes_only);
+  ASSERT_TRUE(fit.ok()) << fit.error().message;
+  ASSERT_EQ(fit->shapes.size(), 2u);
+  for (const auto& plane : fit->shapes) {
+    EXPECT_EQ(plane.kind, PrimitiveKind::kPlane);
+    EXPECT_GT(plane.indices.size(), 1500u);
+    EXPECT_LT(plane.rms_m, 0.0015) << plane.direction.transpose();
+    const bool front = std::abs(plane.direction.z()) > 0.99, side = std::abs(plane.direction.x()) > 0.99;
+    EXPECT_TRUE(front || side) << plane.direction.transpose();
+    // Its points are its face's: even indices the front, odd ones the side.
+    std::size_t own = 0;
+    for (const int i : plane.indices) own += (i % 2 == 0) == front;
+    EXPECT_GT(own, plane.indices.size() * 95 / 100);
+  }
+}
+
 TEST(FitTest, SameSeedSameShapes) {
   const Cloud cloud = sphere_cloud(Eigen::Vector3d(0, 0, 1), 0.05, 3000);
   const auto a = fit_object(cloud, all(cloud)), b = fit_object(cloud, all(cloud));

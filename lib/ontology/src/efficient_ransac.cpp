@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
 #include <CGAL/Random.h>
@@ -15,10 +16,13 @@ namespace scenewatch::ontology::detail {
 namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
-using PointWithNormal = std::pair<Kernel::Point_3, Kernel::Vector_3>;
+// The third element is the point's position in the caller's vector: the detection reorders its
+// input in place (Efficient_RANSAC::preprocess swaps points into random subsets), so the indices
+// of assigned points are positions in the reordered vector.
+using PointWithNormal = std::tuple<Kernel::Point_3, Kernel::Vector_3, std::size_t>;
 using PointVector = std::vector<PointWithNormal>;
-using PointMap = CGAL::First_of_pair_property_map<PointWithNormal>;
-using NormalMap = CGAL::Second_of_pair_property_map<PointWithNormal>;
+using PointMap = CGAL::Nth_of_tuple_property_map<0, PointWithNormal>;
+using NormalMap = CGAL::Nth_of_tuple_property_map<1, PointWithNormal>;
 using Traits = CGAL::Shape_detection::Efficient_RANSAC_traits<Kernel, PointVector, PointMap, NormalMap>;
 using EfficientRansac = CGAL::Shape_detection::Efficient_RANSAC<Traits>;
 using CgalPlane = CGAL::Shape_detection::Plane<Traits>;
@@ -37,7 +41,7 @@ std::vector<Primitive> detect_shapes(const std::vector<Eigen::Vector3d>& points,
   input.reserve(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     input.emplace_back(Kernel::Point_3(points[i].x(), points[i].y(), points[i].z()),
-                       Kernel::Vector_3(normals[i].x(), normals[i].y(), normals[i].z()));
+                       Kernel::Vector_3(normals[i].x(), normals[i].y(), normals[i].z()), i);
   }
   // Reproducible: the detection draws from CGAL's (thread-local) default generator.
   CGAL::get_default_random() = CGAL::Random(config.seed);
@@ -64,8 +68,13 @@ std::vector<Primitive> detect_shapes(const std::vector<Eigen::Vector3d>& points,
     Primitive p;
     if (const auto* plane = dynamic_cast<const CgalPlane*>(shape.get())) {
       p.kind = PrimitiveKind::kPlane;
+      // Not -d() n: after its final least-squares update, CGAL 5.5's Plane keeps the d of the
+      // unnormalized Plane_3 beside the normalized normal (Plane.h, update()). The inliers'
+      // centroid lies on the fitted plane.
       p.direction = eigen(plane->plane_normal()).normalized();
-      p.point = -plane->d() * eigen(plane->plane_normal()) / eigen(plane->plane_normal()).squaredNorm();
+      p.point.setZero();
+      for (const std::size_t i : shape->indices_of_assigned_points()) p.point += points[std::get<2>(input[i])];
+      p.point /= static_cast<double>(std::max<std::size_t>(1, shape->indices_of_assigned_points().size()));
     } else if (const auto* cylinder = dynamic_cast<const CgalCylinder*>(shape.get())) {
       p.kind = PrimitiveKind::kCylinder;
       p.point = eigen(cylinder->axis().point(0));
@@ -83,8 +92,7 @@ std::vector<Primitive> detect_shapes(const std::vector<Eigen::Vector3d>& points,
     } else {
       continue;  // a factory we did not add
     }
-    const auto& assigned = shape->indices_of_assigned_points();
-    p.indices.assign(assigned.begin(), assigned.end());
+    for (const std::size_t i : shape->indices_of_assigned_points()) p.indices.push_back(static_cast<int>(std::get<2>(input[i])));
     out.push_back(std::move(p));
   }
   return out;

@@ -131,7 +131,10 @@ Result<ObjectFit> fit_object(const Cloud& cloud, const std::vector<int>& indices
     if (fix) guess.axis = up_unit;
     cylinder = refine_cylinder(points, normals, guess, fix, config);
   } else if (upright && config.detect_cylinder) {
-    if (auto guess = upright_guess(points, normals, up_unit, config)) cylinder = refine_cylinder(points, normals, *guess, true, config);
+    if (auto guess = upright_guess(points, normals, up_unit, config)) {
+      cylinder = refine_cylinder(points, normals, *guess, true, config);
+      if (cylinder) cylinder->from_detection = false;
+    }
   }
   if (cylinder) {
     if (up && cylinder->axis.dot(up_unit) < 0) cylinder->axis = -cylinder->axis;

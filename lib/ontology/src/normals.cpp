@@ -13,12 +13,16 @@ namespace scenewatch::ontology::detail {
 
 std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vector<int>& indices, int k,
                                               const Eigen::Vector3d& sensor_origin) {
-  // Non-owning: the cloud outlives the estimation.
-  const CloudConstPtr input(&cloud, [](const Cloud*) {});
-  auto subset = std::make_shared<pcl::Indices>(indices.begin(), indices.end());
+  // A copy of the object's points: with setIndices on the whole cloud, PCL builds its search tree
+  // over every point of the frame (33 ms for VGA) and takes neighbours from other objects.
+  auto object = std::make_shared<Cloud>();
+  object->points.reserve(indices.size());
+  for (const int i : indices) object->points.push_back(cloud.points[static_cast<std::size_t>(i)]);
+  object->width = static_cast<std::uint32_t>(object->points.size());
+  object->height = 1;
+  object->is_dense = true;
   pcl::NormalEstimation<PointT, pcl::Normal> estimation;
-  estimation.setInputCloud(input);
-  estimation.setIndices(subset);
+  estimation.setInputCloud(object);
   estimation.setSearchMethod(std::make_shared<pcl::search::KdTree<PointT>>());
   estimation.setKSearch(k);
   estimation.setViewPoint(static_cast<float>(sensor_origin.x()), static_cast<float>(sensor_origin.y()),

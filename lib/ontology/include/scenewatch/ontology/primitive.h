@@ -39,6 +39,10 @@ struct CylinderFit {
   double coverage_deg = 0.0;  ///< angular extent of the seen arc about the axis (360 - largest gap)
   std::size_t inliers = 0;
   bool axis_fixed = false;    ///< true: the axis was held to the upright prior, not fitted
+  /// true: started from a cylinder (or straight cone) of the shape detection; false: from the
+  /// upright circle fit, tried on every object without one (a box gets a poor cylinder this way:
+  /// judge it by rms_m and coverage_deg)
+  bool from_detection = true;
   int iterations = 0;         ///< Levenberg-Marquardt iterations, summed over the rounds
   std::vector<int> indices;   ///< the inliers, indices into the input cloud
 };
