@@ -136,7 +136,7 @@ TEST_F(CliTest, FitPrintsThePrimitivesOfEachObject) {
   // Text: one line per object, the refined cylinder with its coverage.
   result = cli({"fit", frame, "--depth-scale", "0.0001", "--config", config.string()});
   ASSERT_EQ(result.exit_code, 0) << result.err;
-  EXPECT_NE(result.out.find("cylinder refined: radius 33.6 mm"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("cylinder refined (from an upright circle fit): radius 33.6 mm"), std::string::npos) << result.out;
   EXPECT_NE(result.out.find("coverage"), std::string::npos) << result.out;
   // Bad input: a missing file, a folder of several frames, a cloud without a valid point.
   result = cli({"fit", (tmp_ / "absent.pcd").string()});
