@@ -12,7 +12,7 @@ target_include_directories(scenewatch_pcl SYSTEM INTERFACE ${PCL_INCLUDE_DIRS})
 target_link_libraries(scenewatch_pcl INTERFACE
   ${PCL_COMMON_LIBRARIES} ${PCL_IO_LIBRARIES} ${PCL_SEARCH_LIBRARIES} ${PCL_KDTREE_LIBRARIES}
   ${PCL_FILTERS_LIBRARIES} ${PCL_SAMPLE_CONSENSUS_LIBRARIES} ${PCL_SEGMENTATION_LIBRARIES}
-  ${PCL_OCTREE_LIBRARIES} Eigen3::Eigen)
+  ${PCL_OCTREE_LIBRARIES} ${PCL_FEATURES_LIBRARIES} Eigen3::Eigen)
 add_library(scenewatch::pcl ALIAS scenewatch_pcl)
 
 find_package(octomap 1.9 REQUIRED)
@@ -20,6 +20,14 @@ add_library(scenewatch_octomap INTERFACE)
 target_include_directories(scenewatch_octomap SYSTEM INTERFACE ${OCTOMAP_INCLUDE_DIRS})
 target_link_libraries(scenewatch_octomap INTERFACE ${OCTOMAP_LIBRARIES})
 add_library(scenewatch::octomap ALIAS scenewatch_octomap)
+
+# CGAL 5 is header-only (Debian: libcgal-dev, which pulls GMP and MPFR). Only lib/ontology links it,
+# and only src/efficient_ransac.cpp includes it. Its Shape_detection package is GPL-3.0-or-later.
+set(CGAL_DO_NOT_WARN_ABOUT_CMAKE_BUILD_TYPE TRUE)
+find_package(CGAL 5 REQUIRED)
+add_library(scenewatch_cgal INTERFACE)
+target_link_libraries(scenewatch_cgal INTERFACE CGAL::CGAL)
+add_library(scenewatch::cgal ALIAS scenewatch_cgal)
 
 find_package(OpenCV 4 REQUIRED COMPONENTS core imgproc imgcodecs)
 add_library(scenewatch_opencv INTERFACE)

@@ -46,5 +46,6 @@ int run_change(const Options& o);
 int run_stream(const Options& o);
 int run_pipeline(const Options& o);
 int run_memory(const Options& o);
+int run_fit(const Options& o);
 
 }  // namespace scenewatch::bench

@@ -86,6 +86,15 @@ struct SegmentOptions {
 /// Offline: segments a cloud file and prints planes and objects (no daemon involved).
 int run_segment(const SegmentOptions& options);
 
+struct FitOptions {
+  std::string file;                     ///< a cloud file or one sequence frame (see frame_spec.h)
+  bool json = false;
+  std::string config;                   ///< YAML config: its segmentation section is used
+  std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
+};
+/// Offline: segments one frame and fits primitives (plane, cylinder, sphere, cone) to each object.
+int run_fit(const FitOptions& options);
+
 struct DiffOptions {
   std::string before, after;  ///< cloud files or sequence frames (DIR/frame-NNNNNN)
   bool json = false;

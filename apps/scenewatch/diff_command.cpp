@@ -26,26 +26,6 @@ std::string fixed(double value, int decimals = 3) {
 
 std::string text(const Eigen::Vector3d& v) { return "(" + fixed(v.x()) + ", " + fixed(v.y()) + ", " + fixed(v.z()) + ")"; }
 
-// One frame: a cloud file or a frame of an RGB-D sequence (see frame_spec.h).
-Result<Frame> load_observation(const std::string& spec, const io::SequenceOptions& sequence) {
-  auto n = count_frames(spec, sequence);
-  if (!n) return n.error();
-  if (*n != 1) {
-    return invalid_argument("'" + spec + "' names " + std::to_string(*n) + " frames: name one, e.g. '" + spec +
-                            ":0' or '" + (fs::path(spec) / "frame-000000").string() + "'");
-  }
-  std::optional<Frame> frame;
-  auto st = for_each_frame(
-      spec, std::nullopt,
-      [&](Frame f) -> Status {
-        frame = std::move(f);
-        return {};
-      },
-      sequence);
-  if (!st) return st.error();
-  return std::move(*frame);
-}
-
 }  // namespace
 
 int run_diff(const DiffOptions& options) {
@@ -59,9 +39,9 @@ int run_diff(const DiffOptions& options) {
   }
   if (options.resolution_m > 0) diff_options.map.resolution_m = options.resolution_m;
   diff_options.force_map = options.force_map;
-  auto before = load_observation(options.before, sequence_options(options.depth_scale_m));
+  auto before = load_one_frame(options.before, sequence_options(options.depth_scale_m));
   if (!before) return fail("BEFORE: " + before.error().message);
-  auto after = load_observation(options.after, sequence_options(options.depth_scale_m));
+  auto after = load_one_frame(options.after, sequence_options(options.depth_scale_m));
   if (!after) return fail("AFTER: " + after.error().message);
   before->source = options.before;
   after->source = options.after;

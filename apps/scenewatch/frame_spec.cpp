@@ -122,4 +122,23 @@ Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& 
   return {};
 }
 
+Result<Frame> load_one_frame(const std::string& spec, const io::SequenceOptions& sequence) {
+  auto n = count_frames(spec, sequence);
+  if (!n) return n.error();
+  if (*n != 1) {
+    return invalid_argument("'" + spec + "' names " + std::to_string(*n) + " frames: name one, e.g. '" + spec +
+                            ":0' or '" + (fs::path(spec) / "frame-000000").string() + "'");
+  }
+  std::optional<Frame> frame;
+  auto st = for_each_frame(
+      spec, std::nullopt,
+      [&](Frame f) -> Status {
+        frame = std::move(f);
+        return {};
+      },
+      sequence);
+  if (!st) return st.error();
+  return std::move(*frame);
+}
+
 }  // namespace scenewatch::cli

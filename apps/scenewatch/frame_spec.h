@@ -26,6 +26,10 @@ Result<std::size_t> count_frames(const std::string& spec, const io::SequenceOpti
 Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& intrinsics,
                       const std::function<Status(Frame)>& each, const io::SequenceOptions& sequence = {});
 
+/// Exactly one frame (a cloud file or one frame of a sequence); a spec naming several is an error
+/// that shows how to name one.
+Result<Frame> load_one_frame(const std::string& spec, const io::SequenceOptions& sequence = {});
+
 /// The SequenceOptions of a command's --depth-scale (unset: the folder's or the layout's unit).
 io::SequenceOptions sequence_options(const std::optional<double>& depth_scale_m);
 

@@ -144,6 +144,20 @@ int main(int argc, char** argv) {
   segment->add_flag("--plane-indices", segment_options.plane_indices, "with --json: also list plane inlier indices");
   segment->callback([&] { action = [&] { return run_segment(segment_options); }; });
 
+  FitOptions fit_options;
+  auto* fit = app.add_subcommand(
+      "fit", "offline: segment one frame and fit primitives (plane, cylinder, sphere, cone) to each object (no daemon)");
+  fit->footer(
+      "FILE: a .pcd/.ply cloud, or one frame of an RGB-D sequence folder (DIR:N, DIR/frame-NNNNNN).\n"
+      "Shapes by CGAL's Efficient RANSAC on the object's normals; the largest cylinder is refined by\n"
+      "least squares, held upright along the support's normal when it stands within 25 degrees of it.\n"
+      "Example: scenewatch fit ../shared/data/ycb/frame-000003 --depth-scale 0.0001");
+  fit->add_option("file", fit_options.file, "cloud file or sequence frame")->required();
+  fit->add_flag("--json", fit_options.json, "print JSON (each object's shapes, refined cylinder and timings)");
+  fit->add_option("--config", fit_options.config, "YAML config (its segmentation section is used)");
+  add_depth_scale_option(fit, fit_options.depth_scale_m);
+  fit->callback([&] { action = [&] { return run_fit(fit_options); }; });
+
   DiffOptions diff_options;
   auto* diff = app.add_subcommand(
       "diff",

@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <filesystem>
+#include <fstream>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
@@ -89,7 +91,7 @@ TEST_F(CliTest, SegmentPrintsPlanesAndObjectsWithIndices) {
 TEST_F(CliTest, HelpAndUsageErrors) {
   EXPECT_EQ(cli({"--help"}).exit_code, 0);
   for (const char* command : {"health", "stats", "ingest", "planes", "objects", "occupancy", "clear-box", "reset",
-                              "save", "load", "events", "watch", "segment"}) {
+                              "save", "load", "events", "watch", "segment", "fit"}) {
     const auto result = cli({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;
     EXPECT_NE(result.out.find("--json"), std::string::npos) << command << ":\n" << result.out;
@@ -97,6 +99,7 @@ TEST_F(CliTest, HelpAndUsageErrors) {
   EXPECT_EQ(cli({}).exit_code, 2);
   EXPECT_EQ(cli({"bogus"}).exit_code, 2);
   EXPECT_EQ(cli({"segment"}).exit_code, 2);
+  EXPECT_EQ(cli({"fit"}).exit_code, 2);
   EXPECT_EQ(cli({"occupancy", "1", "2"}).exit_code, 2);
   EXPECT_EQ(cli({"clear-box", "1", "2", "3"}).exit_code, 2);
 }
@@ -106,6 +109,53 @@ TEST_F(CliTest, MissingFileIsAnErrorNamingIt) {
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.err.find("no-such-cloud.pcd"), std::string::npos) << result.err;
   EXPECT_TRUE(result.out.empty()) << result.out;
+}
+
+TEST_F(CliTest, FitPrintsThePrimitivesOfEachObject) {
+  SCENEWATCH_REQUIRE_DATA("ycb/frame-000003.depth.png");
+  // The writing tablet the soup can stands on is smaller than the default support.
+  const fs::path config = tmp_ / "small-support.yaml";
+  std::ofstream(config) << "segmentation:\n  min_plane_area_m2: 0.03\n";
+  const std::string frame = (data_dir() / "ycb/frame-000003").string();
+  auto result = cli({"fit", frame, "--depth-scale", "0.0001", "--config", config.string(), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json j = parse(result.out);
+  ASSERT_GE(j.at("objects").size(), 3u);
+  EXPECT_GE(j.at("planes").size(), 1u);
+  std::size_t cans = 0;
+  for (const auto& o : j.at("objects")) {
+    ASSERT_TRUE(o.contains("shapes")) << o.dump();
+    EXPECT_TRUE(o.at("timing_ms").contains("detection"));
+    if (o.at("cylinder").is_null()) continue;
+    const double radius_mm = o.at("cylinder").at("radius_m").get<double>() * 1000;
+    EXPECT_GT(o.at("cylinder").at("coverage_deg").get<double>(), 0.0);
+    // The soup can (r 32.9 mm) stands upright on the tablet.
+    if (std::abs(radius_mm - 32.9) < 1.0 && o.at("cylinder").at("axis_fixed_upright").get<bool>()) ++cans;
+  }
+  EXPECT_EQ(cans, 1u) << result.out;
+  // Text: one line per object, the refined cylinder with its coverage.
+  result = cli({"fit", frame, "--depth-scale", "0.0001", "--config", config.string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("cylinder refined (from an upright circle fit): radius 33.6 mm"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("coverage"), std::string::npos) << result.out;
+  // Bad input: a missing file, a folder of several frames, a cloud without a valid point.
+  result = cli({"fit", (tmp_ / "absent.pcd").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("absent.pcd"), std::string::npos) << result.err;
+  result = cli({"fit", (data_dir() / "ycb").string(), "--depth-scale", "0.0001"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("names 3 frames"), std::string::npos) << result.err;
+  Cloud empty;
+  PointT nan_point;
+  nan_point.x = nan_point.y = nan_point.z = std::numeric_limits<float>::quiet_NaN();
+  empty.points.assign(10, nan_point);
+  empty.width = 10;
+  empty.height = 1;
+  empty.is_dense = false;
+  ASSERT_TRUE(io::write_pcd(tmp_ / "nan.pcd", empty).ok());
+  result = cli({"fit", (tmp_ / "nan.pcd").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("no valid"), std::string::npos) << result.err;
 }
 
 TEST_F(CliTest, NoDaemonIsAnErrorNamingTheEndpoint) {

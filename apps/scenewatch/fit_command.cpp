@@ -1,0 +1,144 @@
+// scenewatch fit: primitives fitted to each object of a scene (offline, no daemon): the
+// segmentation module finds the objects, the ontology module fits them.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "config_file.h"
+#include "frame_spec.h"
+#include "scenewatch/ontology/fit.h"
+#include "scenewatch/segmentation/tabletop.h"
+
+namespace scenewatch::cli {
+namespace {
+
+using nlohmann::json;
+
+json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
+
+std::string fixed(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string direction(const Eigen::Vector3d& v) {
+  return "(" + fixed(v.x(), 3) + ", " + fixed(v.y(), 3) + ", " + fixed(v.z(), 3) + ")";
+}
+
+double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / M_PI;
+}
+
+json to_json(const ontology::Primitive& p) {
+  json j = {{"kind", ontology::to_string(p.kind)}, {"points", p.indices.size()}, {"rms_m", p.rms_m}};
+  switch (p.kind) {
+    case ontology::PrimitiveKind::kPlane: j["point"] = vec(p.point); j["normal"] = vec(p.direction); break;
+    case ontology::PrimitiveKind::kCylinder: j["axis_point"] = vec(p.point); j["axis"] = vec(p.direction); j["radius_m"] = p.radius_m; break;
+    case ontology::PrimitiveKind::kSphere: j["center"] = vec(p.point); j["radius_m"] = p.radius_m; break;
+    case ontology::PrimitiveKind::kCone: j["apex"] = vec(p.point); j["axis"] = vec(p.direction); j["half_angle_deg"] = p.half_angle_deg; break;
+  }
+  return j;
+}
+
+std::string text(const ontology::Primitive& p) {
+  std::string s = std::string(ontology::to_string(p.kind)) + " (" + std::to_string(p.indices.size()) + " points, rms " +
+                  fixed(p.rms_m * 1000, 1) + " mm)";
+  switch (p.kind) {
+    case ontology::PrimitiveKind::kPlane: return s + ": normal " + direction(p.direction);
+    case ontology::PrimitiveKind::kCylinder: return s + ": radius " + fixed(p.radius_m * 1000, 1) + " mm, axis " + direction(p.direction);
+    case ontology::PrimitiveKind::kSphere: return s + ": radius " + fixed(p.radius_m * 1000, 1) + " mm";
+    case ontology::PrimitiveKind::kCone: return s + ": half angle " + fixed(p.half_angle_deg, 1) + " deg, axis " + direction(p.direction);
+  }
+  return s;
+}
+
+json to_json(const ontology::CylinderFit& c, const Eigen::Vector3d& up) {
+  return {{"center", vec(c.center)},         {"axis", vec(c.axis)},
+          {"radius_m", c.radius_m},          {"height_m", c.height_m},
+          {"rms_m", c.rms_m},                {"coverage_deg", c.coverage_deg},
+          {"inliers", c.inliers},            {"axis_fixed_upright", c.axis_fixed},
+          {"source", c.from_detection ? "detection" : "upright_circle_fit"},
+          {"tilt_from_support_deg", angle_deg(c.axis, up)}};
+}
+
+}  // namespace
+
+int run_fit(const FitOptions& options) {
+  auto loaded = read_config_file(options.config);
+  if (!loaded) return fail(loaded.error().message);
+  auto frame = load_one_frame(options.file, sequence_options(options.depth_scale_m));
+  if (!frame) {
+    const std::string& message = frame.error().message;
+    return fail(message.find(options.file) != std::string::npos ? message : options.file + ": " + message);
+  }
+  const Cloud& cloud = *frame->cloud;
+  if (count_valid(cloud) == 0) return fail(options.file + ": the cloud has no valid (finite) point");
+  // In the camera frame, as `scenewatch segment`: the sensor at the origin.
+  const auto t0 = std::chrono::steady_clock::now();
+  const segmentation::Segmentation scene = segmentation::segment(cloud, loaded->segmentation);
+  const double segment_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+  json objects = json::array(), planes = json::array();
+  std::string lines;
+  for (const Plane& plane : scene.planes) {
+    planes.push_back({{"id", plane.id}, {"normal", vec(plane.normal)}, {"d", plane.d}, {"area_m2", plane.area_m2},
+                      {"centroid", vec(plane.centroid)}});
+    lines += "  plane " + std::to_string(plane.id) + ": normal " + direction(plane.normal) + ", area " +
+             fixed(plane.area_m2, 2) + " m2, centroid " + direction(plane.centroid) + "\n";
+  }
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    const ObjectCluster& object = scene.objects[i];
+    Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    for (const Plane& plane : scene.planes)
+      if (plane.id == object.plane_id) up = plane.normal;
+    const auto t1 = std::chrono::steady_clock::now();
+    auto fit = ontology::fit_object(cloud, object.indices, ontology::FitConfig{}, up);
+    const double fit_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
+    json j = {{"id", i}, {"plane_id", object.plane_id}, {"points", object.point_count}, {"centroid", vec(object.centroid)},
+              {"fit_ms", fit_ms}};
+    lines += "  object " + std::to_string(i) + " (" + std::to_string(object.point_count) + " points, at " +
+             direction(object.centroid) + "):";
+    if (!fit) {
+      j["error"] = fit.error().message;
+      lines += " no fit: " + fit.error().message + "\n";
+      objects.push_back(std::move(j));
+      continue;
+    }
+    json shapes = json::array();
+    for (const auto& s : fit->shapes) shapes.push_back(to_json(s));
+    j["shapes"] = std::move(shapes);
+    j["best"] = fit->best >= 0 ? json(ontology::to_string(fit->shapes[static_cast<std::size_t>(fit->best)].kind)) : json(nullptr);
+    j["cylinder"] = fit->cylinder ? to_json(*fit->cylinder, up) : json(nullptr);
+    j["timing_ms"] = {{"normals", fit->normals_ms}, {"detection", fit->detection_ms}, {"refinement", fit->refinement_ms}};
+    objects.push_back(std::move(j));
+
+    lines += fit->best >= 0 ? " best " + text(fit->shapes[static_cast<std::size_t>(fit->best)]) : std::string(" no primitive found");
+    lines += ", " + fixed(fit_ms, 1) + " ms\n";
+    for (std::size_t s = 1; s < fit->shapes.size(); ++s) lines += "      also " + text(fit->shapes[s]) + "\n";
+    if (const auto& c = fit->cylinder) {
+      lines += std::string("      cylinder refined") + (c->from_detection ? "" : " (from an upright circle fit)") + ": radius " + fixed(c->radius_m * 1000, 1) + " mm, height " + fixed(c->height_m * 1000, 1) +
+               " mm, axis " + direction(c->axis) + " (" + fixed(angle_deg(c->axis, up), 1) + " deg from the support's normal" +
+               (c->axis_fixed ? ", held upright" : "") + "), rms " + fixed(c->rms_m * 1000, 2) + " mm, coverage " +
+               fixed(c->coverage_deg, 0) + " deg, " + std::to_string(c->inliers) + " points\n";
+    }
+  }
+
+  if (options.json) {
+    const json j = {{"file", options.file},           {"points", cloud.points.size()}, {"planes", std::move(planes)},
+                    {"segment_ms", segment_ms},       {"objects", std::move(objects)}};
+    std::cout << j.dump() << std::endl;
+    return kExitOk;
+  }
+  std::cout << options.file << ": " << cloud.points.size() << " points, " << scene.planes.size()
+            << (scene.planes.size() == 1 ? " plane, " : " planes, ") << scene.objects.size()
+            << (scene.objects.size() == 1 ? " object" : " objects") << " (segmentation " << fixed(segment_ms, 0) << " ms)\n"
+            << lines << std::flush;
+  return kExitOk;
+}
+
+}  // namespace scenewatch::cli

@@ -1,0 +1,72 @@
+#pragma once
+/// Primitive fitting of one object: normals on its points, CGAL's Efficient RANSAC shape
+/// detection over plane, cylinder, sphere and cone (Schnabel, Wahl & Klein 2007), then a
+/// least-squares refinement of the largest cylinder (or nearly straight cone) that copes with a
+/// single partial view.
+#include <optional>
+#include <vector>
+
+#include "scenewatch/core/cloud.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/ontology/primitive.h"
+
+namespace scenewatch::ontology {
+
+/// How the axis of a cylinder may be constrained.
+enum class AxisPrior {
+  kNone,     ///< the axis is fitted freely
+  kUpright,  ///< when `up` is given and the detected axis is within upright_tolerance_deg of it,
+             ///< the axis is held along `up` (objects standing on their support); without any
+             ///< detected cylinder, an upright one is started from a circle fit of the side points
+};
+
+struct FitConfig {
+  int normal_neighbours = 24;        ///< k nearest neighbours of the normal estimation
+  /// Objects with more valid points are subsampled (every n-th point) to about this many for the
+  /// normals, the shape detection and the refinement (fit time stays bounded).
+  int max_points = 6000;
+  int min_points = 50;               ///< fewer valid points: an error, nothing to fit
+  // Efficient RANSAC (CGAL::Shape_detection::Efficient_RANSAC::Parameters).
+  double epsilon_m = 0.004;          ///< max point-to-shape distance of an inlier
+  double cluster_epsilon_m = 0.012;  ///< max gap between connected inliers of one shape
+  double normal_threshold = 0.85;    ///< min |cos| between point normal and shape normal
+  double min_shape_fraction = 0.1;   ///< a shape explains at least this fraction of the points
+  double probability = 0.05;         ///< probability to miss the largest shape
+  unsigned seed = 42;                ///< same seed, same shapes
+  bool detect_plane = true, detect_cylinder = true, detect_sphere = true, detect_cone = true;
+  // Cylinder refinement.
+  /// A detected cone with a half angle up to this is refined as a cylinder (CGAL explains some
+  /// straight cups as cones of about 1 degree).
+  double cylinder_max_cone_deg = 3.0;
+  AxisPrior axis_prior = AxisPrior::kUpright;
+  double upright_tolerance_deg = 25.0;
+  double refine_band_m = 0.01;       ///< points within this radial distance of the cylinder are refitted
+  /// and their normal (oriented to the sensor) within acos(this) of the outward radial direction
+  double refine_min_normal_cos = 0.6;
+  int refine_rounds = 3;             ///< re-select the band around the refined cylinder this often
+  double huber_m = 0.003;            ///< Huber threshold of the robust least squares
+};
+
+/// Validates ranges; the message names the key (e.g. "ontology.epsilon_m").
+Status validate(const FitConfig& config);
+
+/// Everything fitted to one object.
+struct ObjectFit {
+  std::vector<Primitive> shapes;        ///< shape detection's, most points first
+  std::optional<CylinderFit> cylinder;  ///< the refined cylinder, when there is one
+  int best = -1;                        ///< index in shapes of the best primitive (most points); -1: none
+  std::size_t points = 0;               ///< valid points of the object
+  std::size_t points_detected = 0;      ///< points given to the shape detection (after subsampling)
+  double normals_ms = 0, detection_ms = 0, refinement_ms = 0;
+};
+
+/// Fits primitives to cloud[indices] (camera or world frame). `up`, when given, is the normal of
+/// the supporting plane (the upright axis prior); the sensor at `sensor_origin` orients normals.
+/// Errors: indices out of range, fewer than config.min_points valid points, an invalid config.
+/// Reproducible for a given config.seed. Thread safe: CGAL's shape detection draws from CGAL's
+/// default random generator, which is thread-local and which fit_object reseeds on each call.
+Result<ObjectFit> fit_object(const Cloud& cloud, const std::vector<int>& indices, const FitConfig& config = {},
+                             const std::optional<Eigen::Vector3d>& up = std::nullopt,
+                             const Eigen::Vector3d& sensor_origin = Eigen::Vector3d::Zero());
+
+}  // namespace scenewatch::ontology
