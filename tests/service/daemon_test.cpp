@@ -521,6 +521,15 @@ TEST_F(DaemonTest, AtTheConnectionLimitTheQuietestMakesRoom) {
     }
   }
   ASSERT_EQ(subscribers.size(), 2u);
+  // Connections closed above may still hold a slot until the daemon has seen them go (one of them
+  // would then be evicted to make room, and nobody turned away): wait until only the two remain.
+  std::uint32_t connected = 0;
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    connected = call(subscribers.front(), request([](proto::Request& r) { r.mutable_stats(); })).stats().connections();
+    if (connected == 2) break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(connected, 2u);
   Client turned_away = daemon_.connect();
   auto reply = turned_away.receive(kCallTimeoutS);
   ASSERT_TRUE(reply.ok()) << reply.error().message;
