@@ -20,8 +20,29 @@ namespace {
 
 constexpr double kConnectTimeoutS = 5.0;
 
+/// Why the token could not be read (empty when it was), for the message of a refused call.
+std::string g_token_problem;
+
+/// Connects and, when the token file can be read, sends its token with the calls that need it.
 Result<service::Client> connect(const RemoteOptions& options) {
-  return service::Client::connect(options.host, static_cast<std::uint16_t>(options.port), kConnectTimeoutS);
+  auto client = service::Client::connect(options.host, static_cast<std::uint16_t>(options.port), kConnectTimeoutS);
+  if (!client) return client;
+  auto token = service::read_token_file(options.token_file);
+  if (token) {
+    client->set_token(std::move(*token));
+  } else {
+    g_token_problem = token.error().message;
+  }
+  return client;
+}
+
+/// The daemon's message, with why no token was sent when it asked for one.
+std::string refusal(const proto::Status& status) {
+  std::string message = service::to_string(status.code()) + ": " + status.message();
+  if (status.code() == proto::Status::PERMISSION_DENIED && !g_token_problem.empty()) {
+    message += " (no token sent: " + g_token_problem + ")";
+  }
+  return message;
 }
 
 /// Sends one request; prints the problem and returns nothing on a transport error or an error
@@ -33,7 +54,7 @@ std::optional<proto::Response> call(service::Client& client, proto::Request requ
     return std::nullopt;
   }
   if (response->status().code() != proto::Status::OK) {
-    fail(service::to_string(response->status().code()) + ": " + response->status().message());
+    fail(refusal(response->status()));
     return std::nullopt;
   }
   return std::move(*response);
@@ -160,7 +181,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       return false;
     }
     if (response->status().code() != proto::Status::OK) {
-      fail(naming(source, service::to_string(response->status().code()) + ": " + response->status().message()));
+      fail(naming(source, refusal(response->status())));
       ++failures;
       return true;
     }

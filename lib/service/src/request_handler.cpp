@@ -10,6 +10,7 @@
 #include "proto_convert.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/core/files.h"
+#include "scenewatch/service/access_token.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/pipeline/working_memory.h"
 
@@ -128,6 +129,16 @@ struct RequestHandler::Impl {
     }
     payload = std::string();  // an ingest payload can be large: free it before the work is queued
     const Route route = route_of(request->call_case());
+    if (route == Route::kMutate && !config.token.empty() && !tokens_equal(request->token(), config.token)) {
+      const std::string call = call_name(*request);
+      done(error_reply(request->id(), proto::Status::PERMISSION_DENIED,
+                       call + ": this call changes the model and needs the daemon's token (Request.token, the "
+                       "contents of the daemon's token file; the CLI reads it with --token-file): " +
+                           (request->token().empty() ? std::string("the request carries none")
+                                                     : std::string("the request's token is wrong")),
+                       call));
+      return;
+    }
     const Executor& executor = route == Route::kMutate ? mutate : query;
     if (!use_executors || route == Route::kInline || !executor) {
       done(execute(*request, &context));

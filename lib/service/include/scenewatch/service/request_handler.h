@@ -23,6 +23,9 @@ struct HandlerConfig {
   std::filesystem::path model_dir;                ///< SaveModel / LoadModel target (empty: none)
   std::uint64_t max_file_bytes = 512ull << 20;    ///< IngestFile refuses larger files unread
   std::size_t keep_snapshots = 3;                 ///< SaveModel keeps this many snapshots
+  /// Calls that change the model (ingest, clear, reset, save, load) must carry this token; empty:
+  /// they need none (in-process use only: scenewatchd always sets one).
+  std::string token;
 };
 
 /// The answer to one request.
