@@ -169,6 +169,7 @@ TEST_F(IoTest, FilesTheFuzzersFoundAreErrors) {
       {"size_dot_binary.pcd", "line 10: DATA must name"},  // SIZE '.', DATA of two words: PCL read past its buffers
       {"vertex_list.ply", "'idx' is a list"},             // PCL asserted on a vertex list
       {"blue_only.ply", "red, green, blue"},              // PCL asserted on colour without red
+      {"header_in_data.pcd", "begins like a header line"},  // PCL sized the cloud from data: 42 GB
   };
   int files = 0;
   for (const char* target : {"fuzz_pcd", "fuzz_ply"}) {
@@ -200,6 +201,13 @@ TEST_F(IoTest, FilesTheFuzzersFoundAreErrors) {
       "two_fields.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n"
                         "FIELDS a b c\n1 2 3\n"));
   ASSERT_FALSE(fields_after_data.ok()) << "a second FIELDS line is data, not header";
+  // PCL reads on after DATA while lines begin with a keyword: data that does is refused before
+  // PCL allocates WIDTH x HEIGHT points from it.
+  auto huge = read_cloud(write_text(
+      "width_in_data.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n"
+                           "\n# comment\nWIDTH 4000000000\nHEIGHT 4000000000\n1 2 3\n"));
+  ASSERT_FALSE(huge.ok());
+  expect_error_mentions(huge.error(), {"width_in_data.pcd", "'WIDTH'"});
   auto k = read_intrinsics(regressions / "fuzz_poses" / "infinite_focal.txt");
   ASSERT_FALSE(k.ok());
   expect_error_mentions(k.error(), {"infinite_focal.txt", "5.85000000e502", "non-finite"});

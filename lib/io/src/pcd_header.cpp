@@ -20,6 +20,33 @@ bool parse_count(const std::string& word, std::uint64_t& out) {
   return true;
 }
 
+/// PCL's header parser does not stop at DATA: it goes on reading lines as header lines while
+/// they begin with a keyword (skipping blank lines and comments), so data that happens to begin
+/// with "WIDTH 99999999" is taken as header, and PCL sizes the cloud from it before anything can
+/// be compared (found by fuzz_pcd: a 42 GB allocation). Such data is refused.
+Status check_data_start(std::istream& in, const fs::path& path) {
+  static const char* const kKeywords[] = {"VERSION", "FIELDS", "COLUMNS", "SIZE", "TYPE", "COUNT",
+                                          "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA"};
+  constexpr std::size_t kMaxLookahead = 64 * 1024;
+  std::string data(kMaxLookahead, '\0');
+  in.read(data.data(), static_cast<std::streamsize>(data.size()));
+  data.resize(static_cast<std::size_t>(in.gcount()));
+  std::istringstream lines(data);
+  for (std::string line; std::getline(lines, line);) {
+    std::istringstream words(line);
+    std::string first;
+    if (!(words >> first) || first[0] == '#') continue;  // PCL skips these and reads on
+    for (const char* keyword : kKeywords) {
+      if (first.rfind(keyword, 0) == 0) {
+        return invalid_argument(quoted(path) + ": the data after the DATA line begins like a header line ('" +
+                                first.substr(0, 16) + "'), which PCL would read as one");
+      }
+    }
+    return {};
+  }
+  return {};
+}
+
 }  // namespace
 
 Result<PcdHeader> read_pcd_header(const fs::path& path) {
@@ -71,6 +98,7 @@ Result<PcdHeader> read_pcd_header(const fs::path& path) {
       h.data_type = t == "ascii" ? 0 : t == "binary" ? 1 : t == "binary_compressed" ? 2 : -1;
       if (h.data_type < 0) return invalid_argument(where + "unknown DATA type '" + t + "'");
       h.data_offset = offset;
+      if (Status s = check_data_start(in, path); !s) return s.error();
       break;
     } else {
       return invalid_argument(where + "unknown header keyword '" + key + "'");
