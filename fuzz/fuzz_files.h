@@ -12,10 +12,16 @@
 
 namespace scenewatch::fuzz {
 
-/// The process's scratch folder, made on first use.
+/// The process's scratch folder, made on first use: in $SCENEWATCH_FUZZ_SCRATCH when set
+/// (scripts/fuzz sets it and removes it after each target: libFuzzer ends with _Exit when its
+/// time is up, so the atexit clean-up does not always run), else in /dev/shm or /tmp.
 inline const std::filesystem::path& scratch_dir() {
   static const std::filesystem::path dir = [] {
-    std::string pattern = (std::filesystem::is_directory("/dev/shm") ? "/dev/shm" : "/tmp") + std::string("/scenewatch-fuzz-XXXXXX");
+    const char* parent = std::getenv("SCENEWATCH_FUZZ_SCRATCH");
+    std::string pattern = (parent != nullptr && *parent != '\0'   ? std::string(parent)
+                           : std::filesystem::is_directory("/dev/shm") ? std::string("/dev/shm")
+                                                                    : std::string("/tmp")) +
+                          "/scenewatch-fuzz-XXXXXX";
     if (::mkdtemp(pattern.data()) == nullptr) std::abort();
     static const std::filesystem::path made(pattern);
     std::atexit([] {
