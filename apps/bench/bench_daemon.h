@@ -10,6 +10,8 @@
 #include <filesystem>
 #include <string>
 
+#include "scenewatch/service/access_token.h"
+
 namespace scenewatch::bench {
 
 // scenewatchd on a free port; stops it (SIGTERM) when destroyed.
@@ -26,8 +28,9 @@ class Daemon {
       ::dup2(out[1], STDOUT_FILENO);
       ::close(out[0]);
       const std::string dir = model_dir.string();
+      const std::string token = token_file_of(model_dir).string();
       ::execl(binary.c_str(), binary.c_str(), "--config", config.c_str(), "--port", "0", "--model-dir", dir.c_str(),
-              static_cast<char*>(nullptr));
+              "--token-file", token.c_str(), static_cast<char*>(nullptr));
       std::_Exit(127);
     }
     ::close(out[1]);
@@ -42,6 +45,9 @@ class Daemon {
     const std::string prefix = "listening on 127.0.0.1:";
     if (line.rfind(prefix, 0) != 0) return false;
     port_ = static_cast<std::uint16_t>(std::stoi(line.substr(prefix.size())));
+    auto token = service::read_token_file(token_file_of(model_dir));
+    if (!token) return false;
+    token_ = *token;
     return true;
   }
   ~Daemon() {
@@ -51,10 +57,18 @@ class Daemon {
     }
   }
   std::uint16_t port() const { return port_; }
+  /// The daemon's access token (ingest needs it).
+  const std::string& token() const { return token_; }
 
  private:
   pid_t pid_ = -1;
   std::uint16_t port_ = 0;
+  std::string token_;
+
+  /// Beside the model directory, so that a benchmark never touches ~/.scenewatch/token.
+  static std::filesystem::path token_file_of(const std::filesystem::path& model_dir) {
+    return model_dir.string() + ".token";
+  }
 };
 
 

@@ -26,6 +26,7 @@ int run_latency(const Options& o) {
     std::fprintf(stderr, "latency: %s\n", client.error().message.c_str());
     return 1;
   }
+  client->set_token(daemon.token());
   auto frame = io::load_cloud_frame(o.data_dir / "mosd/learn/learn13.pcd");
   if (!frame) {
     std::fprintf(stderr, "latency: %s\n", frame.error().message.c_str());

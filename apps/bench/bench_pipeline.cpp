@@ -104,6 +104,7 @@ void stream(const Sequence& s, const std::filesystem::path& model_dir) {
   }
   auto client = service::Client::connect("127.0.0.1", daemon.port());
   if (!client) return;
+  client->set_token(daemon.token());
   std::vector<proto::Request> requests(s.frames.size());
   for (std::size_t i = 0; i < s.frames.size(); ++i) *requests[i].mutable_ingest_frame() = service::make_ingest_frame(s.frames[i]);
   std::size_t events = 0;

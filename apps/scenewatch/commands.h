@@ -8,6 +8,7 @@
 #include "scenewatch.pb.h"
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
+#include "scenewatch/service/access_token.h"
 #include "scenewatch/service/server_config.h"
 
 namespace scenewatch::cli {
@@ -25,6 +26,8 @@ struct RemoteOptions {
   int port = service::kDefaultPort;
   bool json = false;
   double timeout_s = 30.0;  ///< per call; 0 = wait forever
+  /// The daemon's access token file (calls that change the model need the token).
+  std::string token_file = service::default_token_path().string();
 };
 
 int run_health(const RemoteOptions& options);

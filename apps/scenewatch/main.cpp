@@ -18,6 +18,9 @@ void add_remote_options(CLI::App* command, RemoteOptions& options) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command->add_flag("--json", options.json, "print machine-readable JSON");
+  command->add_option("--token-file", options.token_file,
+                      "the daemon's access token, needed by ingest, clear, reset, save and load")
+      ->capture_default_str();
 }
 
 /// --depth-scale for every command that reads RGB-D sequence folders.

@@ -23,8 +23,29 @@ namespace {
 
 constexpr double kConnectTimeoutS = 5.0;
 
+/// Why the token could not be read (empty when it was), for the message of a refused call.
+std::string g_token_problem;
+
+/// Connects and, when the token file can be read, sends its token with the calls that need it.
 Result<service::Client> connect(const RemoteOptions& options) {
-  return service::Client::connect(options.host, static_cast<std::uint16_t>(options.port), kConnectTimeoutS);
+  auto client = service::Client::connect(options.host, static_cast<std::uint16_t>(options.port), kConnectTimeoutS);
+  if (!client) return client;
+  auto token = service::read_token_file(options.token_file);
+  if (token) {
+    client->set_token(std::move(*token));
+  } else {
+    g_token_problem = token.error().message;
+  }
+  return client;
+}
+
+/// The daemon's message, with why no token was sent when it asked for one.
+std::string refusal(const proto::Status& status) {
+  std::string message = service::to_string(status.code()) + ": " + status.message();
+  if (status.code() == proto::Status::PERMISSION_DENIED && !g_token_problem.empty()) {
+    message += " (no token sent: " + g_token_problem + ")";
+  }
+  return message;
 }
 
 /// Sends one request; prints the problem and returns nothing on a transport error or an error
@@ -36,7 +57,7 @@ std::optional<proto::Response> call(service::Client& client, proto::Request requ
     return std::nullopt;
   }
   if (response->status().code() != proto::Status::OK) {
-    fail(service::to_string(response->status().code()) + ": " + response->status().message());
+    fail(refusal(response->status()));
     return std::nullopt;
   }
   return std::move(*response);
@@ -165,7 +186,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       return false;
     }
     if (response->status().code() != proto::Status::OK) {
-      fail(naming(source, service::to_string(response->status().code()) + ": " + response->status().message()));
+      fail(naming(source, refusal(response->status())));
       ++failures;
       return true;
     }
@@ -273,6 +294,7 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
       proto::Request request;
       *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
       request.mutable_ingest_frame()->set_live(true);
+      request.set_token(client->token());
       request.set_id(++sent);
       sources.push_back((fs::path(path) / sequence->frames[i].name).string());
       if (auto st = client->send(request); !st) return fail(st.error().message);

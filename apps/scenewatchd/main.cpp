@@ -11,6 +11,7 @@
 #include <string>
 
 #include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/service/access_token.h"
 #include "scenewatch/service/daemon_config.h"
 #include "scenewatch/service/log.h"
 #include "scenewatch/service/server.h"
@@ -58,11 +59,15 @@ int main(int argc, char** argv) {
   std::optional<int> port;
   std::optional<std::string> address;
   std::optional<std::string> model_dir;
+  std::optional<std::string> token_file;
   std::string log_level = "info";
   app.add_option("--config", config_path, "YAML config file (see config/scenewatchd.yaml); default: built-in defaults");
   app.add_option("--port", port, "TCP port, 0 = pick a free one (overrides server.port)")->check(CLI::Range(0, 65535));
   app.add_option("--address", address, "listen address (overrides server.address)");
   app.add_option("--model-dir", model_dir, "model directory, '' = none (overrides server.model_dir)");
+  app.add_option("--token-file", token_file,
+                 "access token file, created (mode 0600) when missing (overrides server.token_file; "
+                 "default ~/.scenewatch/token)");
   app.add_option("--log-level", log_level, "debug, info, warn or error")
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}));
   try {
@@ -90,6 +95,8 @@ int main(int argc, char** argv) {
   if (port) config.server.port = static_cast<std::uint16_t>(*port);
   if (address) config.server.address = *address;
   if (model_dir) config.server.model_dir = *model_dir;
+  if (token_file) config.server.token_file = *token_file;
+  if (config.server.token_file.empty()) config.server.token_file = scenewatch::service::default_token_path();
   if (auto s = scenewatch::service::validate(config.server); !s) {
     log(LogLevel::kError, "config: " + s.error().message);
     return 1;
@@ -98,6 +105,15 @@ int main(int argc, char** argv) {
     log(LogLevel::kError, "config: " + s.error().message);
     return 1;
   }
+
+  // Calls that change the model need the token of this file (README "Access token").
+  auto token = scenewatch::service::ensure_token_file(config.server.token_file);
+  if (!token) {
+    log(LogLevel::kError, "access token: " + token.error().message);
+    return 1;
+  }
+  config.server.access_token = std::move(*token);
+  log(LogLevel::kInfo, "calls that change the model need the token in " + config.server.token_file.string());
 
   scenewatch::pipeline::WorkingMemory memory(config.pipeline);
   const std::filesystem::path& model = config.server.model_dir;

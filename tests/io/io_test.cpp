@@ -1,6 +1,8 @@
 // Ingestion: PCD/PLY in every encoding, PNG, RGB-D, intrinsics, poses, TUM, sequences; and every
 // kind of bad file, each with a message that names the file and the problem.
 #include <gtest/gtest.h>
+
+#include <map>
 #include <pcl/io/pcd_io.h>
 #include <pcl/io/ply_io.h>
 
@@ -158,6 +160,64 @@ TEST_F(IoTest, HeaderThatDisagreesWithData) {
   auto s = read_cloud(q);
   ASSERT_FALSE(s.ok()) << "2 of 4 declared points must not pass";
   expect_error_mentions(s.error(), {"short.pcd"});
+}
+
+// Inputs the fuzzers found (fuzz/regressions/TARGET/): PCL's readers threw, asserted (abort) or
+// read past their buffers on them, which aborted `scenewatch segment` and `diff` and made
+// IngestFile answer INTERNAL; an infinite focal length was accepted. Each is now an error that
+// names the file and the problem.
+TEST_F(IoTest, FilesTheFuzzersFoundAreErrors) {
+  const fs::path regressions = fs::path(SCENEWATCH_SOURCE_DIR) / "fuzz" / "regressions";
+  const std::map<std::string, std::string> problem = {
+      {"no_data_type.pcd", "DATA must name"},           // DATA without its type: std::out_of_range
+      {"size_dot_binary.pcd", "line 10: DATA must name"},  // SIZE '.', DATA of two words: PCL read past its buffers
+      {"vertex_list.ply", "'idx' is a list"},             // PCL asserted on a vertex list
+      {"blue_only.ply", "red, green, blue"},              // PCL asserted on colour without red
+      {"header_in_data.pcd", "begins like a header line"},  // PCL sized the cloud from data: 42 GB
+  };
+  int files = 0;
+  for (const char* target : {"fuzz_pcd", "fuzz_ply"}) {
+    for (const auto& entry : fs::directory_iterator(regressions / target)) {
+      const fs::path& path = entry.path();
+      const std::string name = path.filename().string();
+      ASSERT_EQ(problem.count(name), 1u) << "say what " << name << " shows";
+      ++files;
+      auto cloud = read_cloud(path);
+      ASSERT_FALSE(cloud.ok()) << name;
+      expect_error_mentions(cloud.error(), {name, problem.at(name)});
+      EXPECT_FALSE(load_cloud_frame(path).ok()) << name;
+      if (path.extension() == ".pcd") {
+        EXPECT_FALSE(read_pcd_labels(path).ok()) << name;
+      } else {
+        auto mesh = read_mesh_ply(path);
+        ASSERT_FALSE(mesh.ok()) << name;
+        expect_error_mentions(mesh.error(), {name});
+      }
+    }
+  }
+  EXPECT_EQ(files, static_cast<int>(problem.size()));
+  // The strict header reading names each malformed line on its own.
+  const std::string head = "VERSION 0.7\nFIELDS x y z\nSIZE 4 . 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\nHEIGHT 1\nPOINTS 1\n";
+  auto dot = read_cloud(write_text("size_dot.pcd", head + "DATA binary\n" + std::string(12, '\0')));
+  ASSERT_FALSE(dot.ok());
+  expect_error_mentions(dot.error(), {"size_dot.pcd", "field 'y' has SIZE '.'"});
+  auto fields_after_data = read_cloud(write_text(
+      "two_fields.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n"
+                        "FIELDS a b c\n1 2 3\n"));
+  ASSERT_FALSE(fields_after_data.ok()) << "a second FIELDS line is data, not header";
+  // PCL reads on after DATA while lines begin with a keyword: data that does is refused before
+  // PCL allocates WIDTH x HEIGHT points from it.
+  auto huge = read_cloud(write_text(
+      "width_in_data.pcd", "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nPOINTS 1\nDATA ascii\n"
+                           "\n# comment\nWIDTH 4000000000\nHEIGHT 4000000000\n1 2 3\n"));
+  ASSERT_FALSE(huge.ok());
+  expect_error_mentions(huge.error(), {"width_in_data.pcd", "'WIDTH'"});
+  auto k = read_intrinsics(regressions / "fuzz_poses" / "infinite_focal.txt");
+  ASSERT_FALSE(k.ok());
+  expect_error_mentions(k.error(), {"infinite_focal.txt", "5.85000000e502", "non-finite"});
+  auto pose = read_pose_matrix(write_text("nan_pose.txt", "1 0 0 0\n0 1 0 0\n0 0 1 nan\n0 0 0 1\n"));
+  ASSERT_FALSE(pose.ok());
+  expect_error_mentions(pose.error(), {"nan_pose.txt", "'nan' is non-finite"});
 }
 
 TEST_F(IoTest, GarbageAndEmptyFiles) {

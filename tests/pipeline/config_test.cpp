@@ -62,6 +62,13 @@ TEST_F(ConfigTest, ErrorsNameTheKey) {
   EXPECT_NE(error_of("tracking: 5\n").find("tracking: must be a mapping"), std::string::npos);
   EXPECT_NE(error_of("background:\n  resolution_m: [1\n").find("line"), std::string::npos) << "syntax errors name the line";
   EXPECT_NE(error_of("- a\n- b\n").find("top level"), std::string::npos);
+  // Keys that are not plain names (found by fuzz_config: converting them threw, and the daemon
+  // ended in std::terminate instead of naming the problem).
+  EXPECT_NE(error_of("? [a, b]\n: 1\n").find("a key must be a plain name, got '[a, b]'"), std::string::npos)
+      << error_of("? [a, b]\n: 1\n");
+  EXPECT_NE(error_of("background:\n  ? {x: 1}\n  : 2\n").find("background: a key must be a plain name"),
+            std::string::npos)
+      << error_of("background:\n  ? {x: 1}\n  : 2\n");
   auto missing = load_yaml_file(dir_ / "absent.yaml", pipeline_sections());
   ASSERT_FALSE(missing.ok());
   EXPECT_NE(missing.error().message.find("absent.yaml"), std::string::npos);

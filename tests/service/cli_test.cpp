@@ -41,6 +41,8 @@ class CliTest : public ::testing::Test {
   CommandResult remote(std::vector<std::string> args) {
     args.push_back("--port");
     args.push_back(std::to_string(daemon_.port()));
+    args.push_back("--token-file");
+    args.push_back(daemon_.token_file().string());
     return cli(std::move(args));
   }
 
@@ -501,6 +503,23 @@ TEST_F(CliTest, SurpriseFromTheDaemon) {
   EXPECT_GT(parse(result.out).at("known_pixels").get<std::size_t>(), 10000u);
   result = remote({"stats", "--json"});
   EXPECT_EQ(parse(result.out).at("frames_processed"), 2);
+}
+
+// The CLI sends the token of --token-file (default ~/.scenewatch/token) with the commands that
+// change the model; without a readable token file they are refused with a message that says why.
+TEST_F(CliTest, CommandsThatChangeTheModelNeedTheTokenFile) {
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, ""));
+  const std::string port = std::to_string(daemon_.port());
+  const fs::path missing = tmp_ / "no-such-token";
+  auto result = cli({"reset", "--port", port, "--token-file", missing.string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("PERMISSION_DENIED"), std::string::npos) << result.err;
+  EXPECT_NE(result.err.find(missing.string()), std::string::npos) << "names the token file it tried: " << result.err;
+  result = cli({"save", "--port", port, "--token-file", missing.string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("PERMISSION_DENIED"), std::string::npos) << result.err;
+  EXPECT_EQ(cli({"health", "--port", port, "--token-file", missing.string()}).exit_code, 0) << "reading needs none";
+  EXPECT_EQ(remote({"reset"}).exit_code, 0) << "with the daemon's token file";
 }
 
 TEST_F(CliTest, WatchPrintsEventsUntilInterrupted) {

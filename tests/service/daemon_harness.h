@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "child_process.h"
+#include "scenewatch/service/access_token.h"
 #include "scenewatch/service/client.h"
 #include "test_data.h"
 
@@ -24,11 +25,14 @@ inline constexpr double kCallTimeoutS = 60.0;
 
 class Daemon {
  public:
-  /// `server_yaml`: lines of the server section (indented by two spaces), `port: 0` is added.
+  /// `server_yaml`: lines of the server section (indented by two spaces), `port: 0` is added, and
+  /// `token_file: WORK_DIR/token` unless it names one.
   void start(const std::filesystem::path& work_dir, const std::string& server_yaml) {
     work_dir_ = work_dir;
+    if (server_yaml.find("token_file:") == std::string::npos) token_file_ = work_dir / "token";
     const auto config = work_dir / ("scenewatchd-" + std::to_string(++starts_) + ".yaml");
-    std::ofstream(config) << "server:\n  address: 127.0.0.1\n  port: 0\n" << server_yaml;
+    std::ofstream(config) << "server:\n  address: 127.0.0.1\n  port: 0\n"
+                          << (token_file_.empty() ? "" : "  token_file: " + token_file_.string() + "\n") << server_yaml;
     auto child = ChildProcess::start({daemon_binary().string(), "--config", config.string(), "--port", "0"},
                                      work_dir / ("scenewatchd-" + std::to_string(starts_) + ".log"));
     ASSERT_TRUE(child.has_value()) << "cannot start " << daemon_binary();
@@ -39,6 +43,11 @@ class Daemon {
     ASSERT_EQ(line->rfind(prefix, 0), 0u) << *line;
     port_ = static_cast<std::uint16_t>(std::stoi(line->substr(prefix.size())));
     ASSERT_GT(port_, 0);
+    if (!token_file_.empty()) {
+      auto token = service::read_token_file(token_file_);
+      ASSERT_TRUE(token.ok()) << token.error().message;
+      token_ = *token;
+    }
   }
 
   /// SIGTERM, then waits; returns the exit code (nothing if it did not exit).
@@ -52,10 +61,25 @@ class Daemon {
   bool running() { return process_ && !process_->wait(0.0).has_value(); }
 
   std::uint16_t port() const { return port_; }
+  /// The daemon's process id (0 before start).
+  pid_t pid() const { return process_ ? process_->pid() : 0; }
   std::string log() const { return process_ ? process_->stderr_text() : std::string(); }
 
-  /// A connected client (the test fails when connecting fails).
+  /// The daemon's access token (read from its token file after start).
+  const std::string& token() const { return token_; }
+
+  /// The token file the daemon was given (empty when the test's yaml named its own).
+  const std::filesystem::path& token_file() const { return token_file_; }
+
+  /// A connected client that sends the daemon's token (the test fails when connecting fails).
   service::Client connect() const {
+    service::Client client = connect_without_token();
+    client.set_token(token_);
+    return client;
+  }
+
+  /// A connected client that sends no token: calls that change the model are refused.
+  service::Client connect_without_token() const {
     auto client = service::Client::connect("127.0.0.1", port_, 10.0);
     EXPECT_TRUE(client.ok()) << client.error().message;
     if (!client.ok()) throw std::runtime_error(client.error().message);
@@ -66,6 +90,8 @@ class Daemon {
   std::filesystem::path work_dir_;
   std::optional<ChildProcess> process_;
   std::uint16_t port_ = 0;
+  std::filesystem::path token_file_;
+  std::string token_;
   int starts_ = 0;
 };
 

@@ -1,6 +1,8 @@
 // Integration: the real scenewatchd binary on a loopback port, driven through the protocol.
 #include <gtest/gtest.h>
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <atomic>
 #include <filesystem>
@@ -220,6 +222,7 @@ TEST_F(DaemonTest, ALiveStreamThatOutpacesTheModelSkipsToTheNewestFrame) {
     Client client = daemon_.connect();
     for (auto& r : requests) {
       r.mutable_ingest_frame()->set_live(live);
+      r.set_token(daemon_.token());
       EXPECT_TRUE(client.send(r).ok());
     }
     std::vector<bool> skipped;
@@ -456,6 +459,7 @@ TEST_F(DaemonTest, ManyClientsAreServedWhileFramesAreProcessed) {
       ++failures;
       return;
     }
+    client->set_token(daemon_.token());
     for (int i = 0; i < 3; ++i) {
       auto r = client->call(mug, kCallTimeoutS);
       if (!r.ok() || r->status().code() != proto::Status::OK) ++failures;
@@ -577,6 +581,71 @@ TEST_F(DaemonTest, UnfinishedFramesShareOneMemoryBudget) {
   ASSERT_TRUE(parsed.ok()) << parsed.error().message;
   EXPECT_EQ(parsed->status().code(), proto::Status::INVALID_ARGUMENT) << "read whole, then refused as no request: "
                                                                        << parsed->status().message();
+}
+
+// Who may change the model: only a client holding the token of the daemon's token file. Any
+// other local client may read, but its Reset, SaveModel, IngestFile, IngestFrame, ClearBox and
+// LoadModel are refused and change nothing, neither in memory nor on disk.
+TEST_F(DaemonTest, OnlyTheTokenHolderChangesTheModel) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+  struct stat st {};
+  ASSERT_EQ(::stat(daemon_.token_file().c_str(), &st), 0) << daemon_.token_file();
+  EXPECT_EQ(st.st_mode & 07777, 0600u) << "the token file is readable by the daemon's user only";
+  EXPECT_EQ(daemon_.token().size(), 64u);
+  EXPECT_NE(daemon_.log().find(daemon_.token_file().string()), std::string::npos) << "the log says where it is";
+  EXPECT_EQ(daemon_.log().find(daemon_.token()), std::string::npos) << "the log never shows the token";
+
+  Client owner = daemon_.connect();
+  ASSERT_EQ(call(owner, ingest_mug()).status().code(), proto::Status::OK);
+  ASSERT_EQ(call(owner, request([](proto::Request& r) { r.mutable_save_model(); })).status().code(), proto::Status::OK);
+  const auto objects_before = call(owner, get_objects());
+  ASSERT_EQ(objects_before.objects().frames_processed(), 1u);
+  const fs::path saved_before = fs::read_symlink(model_dir_ / "current");
+
+  Client stranger = daemon_.connect_without_token();
+  EXPECT_EQ(call(stranger, health()).status().code(), proto::Status::OK) << "reading stays open";
+  EXPECT_EQ(call(stranger, get_objects()).objects().objects_size(), objects_before.objects().objects_size());
+  const std::vector<proto::Request> changes = {
+      request([](proto::Request& r) { r.mutable_reset(); }),
+      request([](proto::Request& r) { r.mutable_save_model(); }),
+      request([](proto::Request& r) { r.mutable_load_model(); }),
+      ingest_file(data_dir() / kMug),
+      ingest_mug(),
+      request([](proto::Request& r) {
+        auto* box = r.mutable_clear_box()->mutable_box();
+        box->mutable_min()->set_x(-10), box->mutable_min()->set_y(-10), box->mutable_min()->set_z(-10);
+        box->mutable_max()->set_x(10), box->mutable_max()->set_y(10), box->mutable_max()->set_z(10);
+      })};
+  for (const std::string& token : {std::string(), std::string(64, 'a'), daemon_.token().substr(0, 63)}) {
+    for (proto::Request change : changes) {
+      change.set_token(token);
+      const auto refused = call(stranger, change);
+      EXPECT_EQ(refused.status().code(), proto::Status::PERMISSION_DENIED) << change.call_case();
+      EXPECT_NE(refused.status().message().find("needs the daemon's token"), std::string::npos)
+          << refused.status().message();
+    }
+  }
+  const auto objects_after = call(stranger, get_objects());
+  EXPECT_EQ(objects_after.objects().frames_processed(), 1u) << "the model is unchanged";
+  EXPECT_EQ(objects_after.objects().SerializeAsString(), objects_before.objects().SerializeAsString());
+  EXPECT_EQ(fs::read_symlink(model_dir_ / "current"), saved_before) << "nothing was saved";
+
+  // The token holder's Reset forgets the frame.
+  ASSERT_EQ(call(owner, request([](proto::Request& r) { r.mutable_reset(); })).status().code(), proto::Status::OK);
+  EXPECT_EQ(call(stranger, health()).health().frames_processed(), 0u);
+  ASSERT_EQ(daemon_.terminate(), std::optional<int>(0));
+
+  // A token file others may read is refused at start (the daemon does not quietly use it).
+  const fs::path open_token = tmp_ / "open-token";
+  std::ofstream(open_token) << "0123456789abcdef0123456789abcdef\n";
+  fs::permissions(open_token, fs::perms::owner_read | fs::perms::owner_write | fs::perms::others_read,
+                  fs::perm_options::replace);
+  const auto refused = run_command(
+      {daemon_binary().string(), "--port", "0", "--token-file", open_token.string(), "--model-dir", ""}, tmp_);
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("chmod 600"), std::string::npos) << refused.err;
+  EXPECT_NE(refused.err.find(open_token.string()), std::string::npos) << refused.err;
 }
 
 TEST_F(DaemonTest, StartsEmptyWithoutAModelAndRefusesABadConfig) {

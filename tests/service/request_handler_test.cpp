@@ -522,6 +522,65 @@ TEST_F(RequestHandlerTest, AfterShutdownModelChangesAreRefused) {
   EXPECT_EQ(call(handler, health).status().code(), proto::Status::OK);
 }
 
+TEST_F(RequestHandlerTest, CallsThatChangeTheModelNeedTheToken) {
+  const std::string token = "0123456789abcdef0123456789abcdef";
+  HandlerConfig config;
+  config.model_dir = tmp_ / "model";
+  config.token = token;
+  RequestHandler handler(memory_, config);
+  ASSERT_EQ(ingest(handler, make_ingest_frame(grid_frame(4, 3))).status().code(), proto::Status::PERMISSION_DENIED);
+  EXPECT_EQ(frames_processed(), 0u);
+
+  // With the token a frame goes in; then every call that changes the model is refused without it,
+  // or with a wrong one (also one that is a prefix of it), and the model stays as it was.
+  proto::Request first;
+  first.set_token(token);
+  *first.mutable_ingest_frame() = make_ingest_frame(grid_frame(4, 3));
+  ASSERT_EQ(call(handler, first).status().code(), proto::Status::OK);
+  ASSERT_EQ(frames_processed(), 1u);
+  std::vector<proto::Request> changes(6);
+  *changes[0].mutable_ingest_frame() = make_ingest_frame(grid_frame(4, 3));
+  changes[1].mutable_ingest_file()->set_path("/etc/passwd");
+  auto* box = changes[2].mutable_clear_box()->mutable_box();
+  box->mutable_min()->set_x(-5), box->mutable_min()->set_y(-5), box->mutable_min()->set_z(-5);
+  box->mutable_max()->set_x(5), box->mutable_max()->set_y(5), box->mutable_max()->set_z(5);
+  changes[3].mutable_reset();
+  changes[4].mutable_save_model();
+  changes[5].mutable_load_model();
+  for (const std::string& wrong : {std::string(), token.substr(0, 31), token + "0", std::string(32, '0')}) {
+    for (auto request : changes) {
+      request.set_id(7);
+      request.set_token(wrong);
+      const auto response = call(handler, request);
+      EXPECT_EQ(response.id(), 7u);
+      EXPECT_EQ(response.status().code(), proto::Status::PERMISSION_DENIED) << request.ShortDebugString();
+      EXPECT_NE(response.status().message().find("token"), std::string::npos) << response.status().message();
+      EXPECT_NE(response.status().message().find(wrong.empty() ? "carries none" : "is wrong"), std::string::npos)
+          << response.status().message();
+      EXPECT_FALSE(response.has_reset() || response.has_ingest() || response.has_save_model());
+    }
+  }
+  EXPECT_EQ(frames_processed(), 1u);
+  EXPECT_FALSE(fs::exists(tmp_ / "model")) << "SaveModel ran without the token";
+
+  // Read-only calls need no token.
+  proto::Request objects;
+  objects.mutable_get_objects();
+  const auto listed = call(handler, objects);
+  EXPECT_EQ(listed.status().code(), proto::Status::OK);
+  EXPECT_EQ(listed.objects().frames_processed(), 1u);
+  proto::Request occupancy;
+  occupancy.mutable_query_occupancy()->add_points()->set_z(1.0);
+  EXPECT_EQ(call(handler, occupancy).status().code(), proto::Status::OK);
+
+  // And with it, Reset forgets the frame.
+  proto::Request reset;
+  reset.set_token(token);
+  reset.mutable_reset();
+  EXPECT_EQ(call(handler, reset).status().code(), proto::Status::OK);
+  EXPECT_EQ(frames_processed(), 0u);
+}
+
 TEST_F(RequestHandlerTest, ConnectionErrorPayloadHasNoId) {
   RequestHandler handler(memory_, {});
   const auto response = parse(handler.error_payload(ErrorCode::kInvalidArgument, "broken framing"));

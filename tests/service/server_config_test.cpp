@@ -42,6 +42,7 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
   EXPECT_EQ(s.io_threads, defaults.io_threads);
   EXPECT_TRUE(s.data_roots.empty());
   EXPECT_TRUE(s.model_dir.empty());
+  EXPECT_TRUE(s.token_file.empty()) << "empty: the daemon and the CLI use ~/.scenewatch/token";
   const pipeline::Config pipeline_defaults;
   EXPECT_DOUBLE_EQ(loaded->pipeline.background.resolution_m, pipeline_defaults.background.resolution_m);
   EXPECT_DOUBLE_EQ(loaded->pipeline.segmentation.voxel_size_m, pipeline_defaults.segmentation.voxel_size_m);
@@ -51,8 +52,10 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
 
 TEST_F(ServerConfigTest, RelativePathsAreRelativeToTheConfigFile) {
   fs::create_directories(tmp_ / "data");
-  auto loaded = load_daemon_config(write("server:\n  data_roots: [data]\n  model_dir: state/model\n  port: 0\n"));
+  auto loaded = load_daemon_config(
+      write("server:\n  data_roots: [data]\n  model_dir: state/model\n  token_file: state/token\n  port: 0\n"));
   ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  EXPECT_EQ(loaded->server.token_file, tmp_ / "state" / "token");
   ASSERT_EQ(loaded->server.data_roots.size(), 1u);
   EXPECT_EQ(loaded->server.data_roots[0], tmp_ / "data");
   EXPECT_EQ(loaded->server.model_dir, tmp_ / "state" / "model");

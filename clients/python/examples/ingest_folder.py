@@ -33,10 +33,11 @@ def main():
     parser.add_argument("--port", type=int, default=7878)
     parser.add_argument("--timeout", type=float, default=60.0, help="seconds per call")
     parser.add_argument("--depth-scale", type=float, help="metres per depth unit (default: depth-scale.txt, or mm)")
+    parser.add_argument("--token-file", help="the daemon's access token file (default ~/.scenewatch/token)")
     args = parser.parse_args()
     failures = 0
     try:
-        with scenewatch.Client(args.host, args.port, timeout_s=args.timeout) as client:
+        with scenewatch.Client(args.host, args.port, timeout_s=args.timeout, token_file=args.token_file) as client:
             if any(name.endswith(".color.png") for name in os.listdir(args.folder)):
                 sequence = Sequence(args.folder, depth_scale_m=args.depth_scale)
                 for i in range(len(sequence)):

@@ -10,6 +10,7 @@ for its subscription).
 """
 
 import collections
+import os
 import socket
 import struct
 import time
@@ -93,6 +94,19 @@ class Subscription:
         return self.next()
 
 
+DEFAULT_TOKEN_FILE = os.path.join("~", ".scenewatch", "token")
+
+
+def read_token_file(path=None):
+    """The access token in ``path`` (default ~/.scenewatch/token), or None when it cannot be read:
+    read-only calls need none, and a refused call says PERMISSION_DENIED."""
+    try:
+        with open(os.path.expanduser(path or DEFAULT_TOKEN_FILE)) as f:
+            return f.read().strip() or None
+    except OSError:
+        return None
+
+
 class Client:
     """One connection to scenewatchd.
 
@@ -102,8 +116,12 @@ class Client:
     time and ``ConnectionLost`` when the connection is gone.
     """
 
-    def __init__(self, host="127.0.0.1", port=7878, timeout_s=30.0, max_message_bytes=DEFAULT_MAX_MESSAGE_BYTES):
+    def __init__(self, host="127.0.0.1", port=7878, timeout_s=30.0, max_message_bytes=DEFAULT_MAX_MESSAGE_BYTES,
+                 token=None, token_file=None):
         self.host, self.port = host, int(port)
+        # Calls that change the model (ingest, clear_box, reset, save, load) need the daemon's
+        # access token: given, or read from its file (default ~/.scenewatch/token, as the CLI).
+        self.token = token if token is not None else read_token_file(token_file)
         self.timeout_s = timeout_s
         self.max_message_bytes = max_message_bytes
         self._buffer = bytearray()
@@ -215,6 +233,8 @@ class Client:
     # -- transport ------------------------------------------------------------------------------
     def _call(self, call, message, result=None):
         request = pb.Request(id=self._next_id)
+        if self.token:
+            request.token = self.token
         self._next_id += 1
         getattr(request, call).CopyFrom(message)
         self._send(request)

@@ -29,10 +29,11 @@ class Daemon:
         self.dir = tempfile.mkdtemp(prefix="scenewatch-py-")
         self.model_dir = os.path.join(self.dir, "model")
         config = os.path.join(self.dir, "scenewatchd.yaml")
+        self.token_file = os.path.join(self.dir, "token")  # the daemon creates it (mode 0600)
         roots = ", ".join(data_roots)
         with open(config, "w") as f:
             f.write(f"server:\n  address: 127.0.0.1\n  port: 0\n  model_dir: {self.model_dir}\n"
-                    f"  data_roots: [{roots}]\n" + extra_yaml)
+                    f"  data_roots: [{roots}]\n  token_file: {self.token_file}\n" + extra_yaml)
         self.log_path = os.path.join(self.dir, "scenewatchd.log")
         self._log = open(self.log_path, "w")
         self.process = subprocess.Popen([binary("SCENEWATCHD"), "--config", config, "--port", "0"],

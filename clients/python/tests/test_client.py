@@ -48,7 +48,7 @@ class ClientTest(unittest.TestCase):
     def setUp(self):
         self.daemon = Daemon(UP, data_roots=[SAMPLE_DIR])
         self.addCleanup(self.daemon.cleanup)
-        self.client = scenewatch.Client("127.0.0.1", self.daemon.port, timeout_s=60)
+        self.client = scenewatch.Client("127.0.0.1", self.daemon.port, timeout_s=60, token_file=self.daemon.token_file)
         self.addCleanup(self.client.close)
 
     def test_every_call_on_the_sample_tabletop(self):
@@ -171,6 +171,15 @@ class ClientTest(unittest.TestCase):
         with self.assertRaises(scenewatch.StatusError) as caught:
             self.client.get_surprise_map()
         self.assertEqual(caught.exception.code, pb.Status.NOT_FOUND)
+
+        # Without the daemon's token, calls that change the model are refused; reading is open.
+        with scenewatch.Client("127.0.0.1", self.daemon.port, timeout_s=60, token="") as stranger:
+            self.assertEqual(stranger.token, "")
+            with self.assertRaises(scenewatch.StatusError) as caught:
+                stranger.reset()
+            self.assertEqual(caught.exception.code, pb.Status.PERMISSION_DENIED)
+            self.assertIn("token", caught.exception.message)
+            self.assertIsInstance(stranger.stats(), pb.StatsReply)
 
         with self.assertRaises(ValueError):
             self.client.ingest_frame(cloud=bad.cloud, pose=[1, 0, 0])

@@ -34,7 +34,7 @@ class ExamplesTest(unittest.TestCase):
     def test_the_planner_sees_the_table_and_the_cup_the_ingest_script_adds(self):
         render("cup_added", self.tmp, frames=12)
         port = self.start_daemon()
-        before = example("ingest_folder.py", os.path.join(self.tmp, "before"), "--port", port)
+        before = example("ingest_folder.py", os.path.join(self.tmp, "before"), "--port", port, "--token-file", self.daemon.token_file)
         self.assertEqual(before.returncode, 0, before.stderr)
         self.assertEqual(before.stdout.count("frame-"), 12)
         self.assertIn("frame-000011: ", before.stdout)
@@ -57,7 +57,7 @@ class ExamplesTest(unittest.TestCase):
         self.assertRegex(lines[0], r"^table: plane \d+ \(height 0\.75\d m\), (\d+) of \1 objects stand on it")
         self.assertGreaterEqual(sum(1 for line in lines if line.startswith("  object ")), 3, "box, can and ball")
 
-        after = example("ingest_folder.py", os.path.join(self.tmp, "after"), "--port", port)
+        after = example("ingest_folder.py", os.path.join(self.tmp, "after"), "--port", port, "--token-file", self.daemon.token_file)
         self.assertEqual(after.returncode, 0, after.stderr)
         self.assertIn("OBJECT_ADDED", after.stdout)
         self.assertEqual(planner.wait(120), 0, planner.stderr.read())
@@ -74,13 +74,13 @@ class ExamplesTest(unittest.TestCase):
     def test_ingest_folder_of_cloud_files_goes_through_ingest_file(self):
         # The PCD is in its camera frame (no pose), so no up vector for the world either.
         port = self.start_daemon(extra_yaml="")
-        result = example("ingest_folder.py", os.path.join(SOURCE_DIR, "sample_clouds"), "--port", port)
+        result = example("ingest_folder.py", os.path.join(SOURCE_DIR, "sample_clouds"), "--port", port, "--token-file", self.daemon.token_file)
         self.assertEqual(result.returncode, 0, result.stderr)
         self.assertRegex(result.stdout, r"^tabletop\.pcd: \d+ points, \d+ planes, 4 objects, 0 events")
 
     def test_the_examples_name_what_went_wrong(self):
         port = self.start_daemon()
-        outside = example("ingest_folder.py", self.tmp, "--port", port)
+        outside = example("ingest_folder.py", self.tmp, "--port", port, "--token-file", self.daemon.token_file)
         self.assertEqual(outside.returncode, 1)
         self.assertIn("no frame-NNNNNN.color.png, .pcd or .ply files", outside.stderr)
         self.daemon.stop()

@@ -18,6 +18,8 @@
 #include "scenewatch/core/files.h"
 #include "scenewatch/io/cloud_io.h"
 
+#include "pcd_header.h"
+
 namespace scenewatch::io {
 namespace fs = std::filesystem;
 
@@ -77,6 +79,26 @@ Status check_pcd_body(const fs::path& path, const pcl::PCLPointCloud2& header, i
 // binary (a list property takes at least its count's size).
 constexpr std::uint64_t kMaxPlyHeaderBytes = 64 * 1024;  // real headers are a few hundred bytes
 
+// PCL's reader packs a vertex's colour when it reads `blue`, at the place it saw `red`: colour
+// properties in another order, or one missing, made it assert (abort; found by fuzz_ply).
+Status check_ply_vertex_colour(const fs::path& path, const std::vector<std::string>& properties) {
+  std::vector<std::string> names;
+  for (const auto& p : properties) names.push_back(p.rfind("diffuse_", 0) == 0 ? p.substr(8) : p);
+  const std::vector<std::string> rgba = {"red", "green", "blue", "alpha"};
+  const auto first = std::find_first_of(names.begin(), names.end(), rgba.begin(), rgba.end());
+  if (first == names.end()) return {};
+  const auto colours = static_cast<std::size_t>(
+      std::count_if(names.begin(), names.end(), [&](const std::string& n) { return std::count(rgba.begin(), rgba.end(), n) > 0; }));
+  const auto at = static_cast<std::size_t>(first - names.begin());
+  bool ok = (colours == 3 || colours == 4) && at + colours <= names.size();
+  for (std::size_t k = 0; ok && k < colours; ++k) ok = names[at + k] == rgba[k];
+  if (!ok) {
+    return invalid_argument(quoted(path) + ": PLY vertex colour must be the properties red, green, blue (then alpha), "
+                            "one after the other");
+  }
+  return {};
+}
+
 Status check_ply_header(const fs::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::string line, format;
@@ -93,6 +115,8 @@ Status check_ply_header(const fs::path& path) {
     return 0;
   };
   bool ended = false;
+  std::string element;
+  std::vector<std::string> vertex_properties;
   while (std::getline(in, line)) {
     header_bytes += line.size() + 1;
     if (header_bytes > kMaxPlyHeaderBytes) break;
@@ -102,8 +126,9 @@ Status check_ply_header(const fs::path& path) {
     if (word == "format") words >> format;
     if (word == "element") {
       flush();
-      std::string name, count;
-      words >> name >> count;
+      std::string count;
+      words >> element >> count;
+      const std::string& name = element;
       if (count.empty() || count.find_first_not_of("0123456789") != std::string::npos || count.size() > 18) {
         return invalid_argument(quoted(path) + ": PLY element '" + name + "' has a count that is not a whole number: '" +
                                 count + "'");
@@ -118,8 +143,18 @@ Status check_ply_header(const fs::path& path) {
     if (word == "property") {
       std::string type;
       words >> type;
+      // PCL's reader takes a vertex list's length from its first vertex and asserts (aborts) when
+      // a later one differs; clouds and meshes have none.
+      if (type == "list" && element == "vertex") {
+        std::string count_type, item_type, name;
+        words >> count_type >> item_type >> name;
+        return invalid_argument(quoted(path) + ": PLY vertex property '" + name +
+                                "' is a list; vertices must have scalar properties only");
+      }
       if (type == "list") words >> type;  // the count's type: a list holds at least its count
       item_bytes += scalar_size(type);
+      std::string name;
+      if (element == "vertex" && words >> name) vertex_properties.push_back(name);
     }
     if (word == "end_header") {
       ended = true;
@@ -128,6 +163,7 @@ Status check_ply_header(const fs::path& path) {
   }
   if (!ended) return invalid_argument(quoted(path) + ": PLY header has no end_header within its first " +
                                       std::to_string(kMaxPlyHeaderBytes) + " bytes");
+  if (auto st = check_ply_vertex_colour(path, vertex_properties); !st) return st;
   flush();
   const std::uint64_t body = fs::file_size(path) - std::min<std::uint64_t>(fs::file_size(path), header_bytes);
   // In ascii every item takes at least one character; binary items take their full size.
@@ -139,7 +175,8 @@ Status check_ply_header(const fs::path& path) {
   return {};
 }
 
-Result<pcl::PCLPointCloud2> read_blob(const fs::path& path, Eigen::Vector4f& origin, Eigen::Quaternionf& orientation) {
+Result<pcl::PCLPointCloud2> read_blob_unguarded(const fs::path& path, Eigen::Vector4f& origin,
+                                                Eigen::Quaternionf& orientation) {
   quiet_pcl();
   if (auto st = check_readable_file(path); !st) return st.error();
   std::string ext = path.extension().string();
@@ -151,12 +188,22 @@ Result<pcl::PCLPointCloud2> read_blob(const fs::path& path, Eigen::Vector4f& ori
     int version = 0, data_type = 0;
     unsigned int data_idx = 0;
     if (fs::file_size(path) == 0) return invalid_argument(quoted(path) + ": empty file");
+    auto strict = read_pcd_header(path);
+    if (!strict) return strict.error();
     if (reader.readHeader(path.string(), header, origin, orientation, version, data_type, data_idx) < 0) {
       return invalid_argument(quoted(path) + ": not a valid PCD header (fields, sizes, width x height = points?)");
     }
     // PCL's readHeader accepts some garbage as an empty header, and read() then crashes on it.
     if (header.fields.empty() || header.point_step == 0) {
       return invalid_argument(quoted(path) + ": not a PCD file (no FIELDS/SIZE in the header)");
+    }
+    // PCL's header parser accepts malformed lines (a SIZE of '.', a second FIELDS line after DATA)
+    // and then reads past its buffers (found by fuzz_pcd): what it made of the header must be
+    // what a strict reading says.
+    if (header.fields.size() != strict->fields.size() || header.point_step != strict->point_step ||
+        static_cast<std::uint64_t>(header.width) * header.height != strict->points || data_type != strict->data_type ||
+        data_idx != strict->data_offset) {
+      return invalid_argument(quoted(path) + ": malformed PCD header (it can be read in more than one way)");
     }
     if (static_cast<std::uint64_t>(header.width) * header.height == 0) {
       return invalid_argument(quoted(path) + ": header declares no points (WIDTH x HEIGHT = 0)");
@@ -183,6 +230,21 @@ Result<pcl::PCLPointCloud2> read_blob(const fs::path& path, Eigen::Vector4f& ori
                             std::to_string(blob.data.size()) + " bytes for " + std::to_string(points) + " points)");
   }
   return blob;
+}
+
+/// PCL's readers throw on some malformed headers (std::out_of_range for a PCD `DATA` line without
+/// its type): a bad file is an error naming it, never an abort of the CLI or INTERNAL from the daemon.
+template <typename Read>
+auto guard_pcl(const fs::path& path, Read&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const std::exception& e) {
+    return invalid_argument(quoted(path) + ": not a readable " + path.extension().string() + " file (" + e.what() + ")");
+  }
+}
+
+Result<pcl::PCLPointCloud2> read_blob(const fs::path& path, Eigen::Vector4f& origin, Eigen::Quaternionf& orientation) {
+  return guard_pcl(path, [&] { return read_blob_unguarded(path, origin, orientation); });
 }
 
 }  // namespace
@@ -290,9 +352,13 @@ Result<ColoredMesh> read_mesh_ply(const fs::path& path) {
   if (auto st = check_readable_file(path); !st) return st.error();
   pcl::PolygonMesh in;
   if (auto st = check_ply_header(path); !st) return st.error();
-  if (pcl::io::loadPLYFile(path.string(), in) < 0) return invalid_argument(quoted(path) + ": not a readable PLY mesh");
   Cloud vertices;
-  pcl::fromPCLPointCloud2(in.cloud, vertices);
+  const Status loaded = guard_pcl(path, [&]() -> Status {
+    if (pcl::io::loadPLYFile(path.string(), in) < 0) return invalid_argument(quoted(path) + ": not a readable PLY mesh");
+    pcl::fromPCLPointCloud2(in.cloud, vertices);
+    return {};
+  });
+  if (!loaded) return loaded.error();
   ColoredMesh mesh;
   mesh.vertices.reserve(vertices.size());
   for (const auto& p : vertices.points) {

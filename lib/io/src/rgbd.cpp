@@ -42,6 +42,12 @@ Result<std::vector<double>> read_numbers(const fs::path& path) {
       if (end == token.c_str() || *end != '\0') {
         return invalid_argument(quoted(path) + " line " + std::to_string(line_no) + ": '" + token + "' is not a number");
       }
+      // "inf", "nan" and overflowing numbers (5e502) parse, but no camera matrix or pose holds them
+      // (found by fuzz_poses: an infinite focal length was accepted).
+      if (!std::isfinite(v)) {
+        return invalid_argument(quoted(path) + " line " + std::to_string(line_no) + ": '" + token +
+                                "' is non-finite (no camera matrix or pose holds one)");
+      }
       values.push_back(v);
     }
     return {};

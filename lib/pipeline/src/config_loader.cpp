@@ -5,6 +5,17 @@
 namespace scenewatch::pipeline {
 namespace fs = std::filesystem;
 
+namespace {
+/// A mapping key as text. YAML allows any node as a key (`? [a, b]: 1`); converting such a key
+/// to a string threw out of the config reader and ended the daemon (found by fuzz_config).
+Result<std::string> key_name(const YAML::Node& key, const std::string& where) {
+  if (key.IsScalar()) return key.Scalar();
+  YAML::Emitter flow;
+  flow << YAML::Flow << key;
+  return invalid_argument(where + ": a key must be a plain name, got '" + std::string(flow.c_str()) + "'");
+}
+}  // namespace
+
 YamlSection::YamlSection(const YAML::Node& node, std::string name) : node_(node), name_(std::move(name)) {}
 
 Status YamlSection::check_is_map() const {
@@ -15,8 +26,9 @@ Status YamlSection::check_is_map() const {
 Status YamlSection::finish() const {
   if (!node_.IsDefined() || node_.IsNull() || !node_.IsMap()) return {};
   for (const auto& kv : node_) {
-    const std::string key = kv.first.as<std::string>();
-    if (seen_.count(key) == 0) return invalid_argument(path(key) + ": unknown key");
+    auto key = key_name(kv.first, name_);
+    if (!key) return key.error();
+    if (seen_.count(*key) == 0) return invalid_argument(path(*key) + ": unknown key");
   }
   return {};
 }
@@ -192,9 +204,10 @@ Result<YAML::Node> load_yaml_file(const fs::path& path, const std::vector<std::s
   if (root.IsNull()) return root;  // an empty file means all defaults
   if (!root.IsMap()) return invalid_argument("'" + path.string() + "': the top level must be a mapping of sections");
   for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    if (std::find(known_sections.begin(), known_sections.end(), key) == known_sections.end()) {
-      return invalid_argument("'" + path.string() + "': unknown section '" + key + "'");
+    auto key = key_name(kv.first, "'" + path.string() + "'");
+    if (!key) return key.error();
+    if (std::find(known_sections.begin(), known_sections.end(), *key) == known_sections.end()) {
+      return invalid_argument("'" + path.string() + "': unknown section '" + *key + "'");
     }
   }
   return root;

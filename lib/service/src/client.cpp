@@ -114,6 +114,7 @@ Client::Client(Client&& other) noexcept
       endpoint_(std::move(other.endpoint_)),
       parser_(std::move(other.parser_)),
       next_id_(other.next_id_),
+      token_(std::move(other.token_)),
       events_(std::move(other.events_)) {}
 
 Client& Client::operator=(Client&& other) noexcept {
@@ -123,6 +124,7 @@ Client& Client::operator=(Client&& other) noexcept {
     endpoint_ = std::move(other.endpoint_);
     parser_ = std::move(other.parser_);
     next_id_ = other.next_id_;
+    token_ = std::move(other.token_);
     events_ = std::move(other.events_);
   }
   return *this;
@@ -202,6 +204,7 @@ Result<proto::Response> Client::receive(double timeout_s) {
 
 Result<proto::Response> Client::call(proto::Request request, double timeout_s) {
   request.set_id(next_id_++);
+  if (request.token().empty() && !token_.empty()) request.set_token(token_);
   if (Status s = send(request); !s) return s.error();
   const auto deadline = deadline_after(timeout_s);
   for (;;) {

@@ -10,8 +10,10 @@ namespace {
 using google::protobuf::io::CodedInputStream;
 using google::protobuf::internal::WireFormatLite;
 
-// Field numbers of scenewatch.proto: Request.id, Request.ingest_frame, IngestFrame.live.
+// Field numbers of scenewatch.proto: Request.id, Request.token, Request.ingest_frame, IngestFrame.live.
 constexpr int kRequestId = 1;
+constexpr int kRequestToken = 2;
+constexpr std::uint32_t kMaxTokenBytes = 1024;
 constexpr int kRequestIngestFrame = 12;
 constexpr int kIngestFrameLive = 6;
 
@@ -41,6 +43,9 @@ LiveFramePeek peek_live_frame(std::string_view payload) {
     const auto type = WireFormatLite::GetTagWireType(tag);
     if (field == kRequestId && type == WireFormatLite::WIRETYPE_VARINT) {
       if (!in.ReadVarint64(&peek.id)) return {};
+    } else if (field == kRequestToken && type == WireFormatLite::WIRETYPE_LENGTH_DELIMITED) {
+      std::uint32_t length = 0;
+      if (!in.ReadVarint32(&length) || length > kMaxTokenBytes || !in.ReadString(&peek.token, static_cast<int>(length))) return {};
     } else if (field == kRequestIngestFrame && type == WireFormatLite::WIRETYPE_LENGTH_DELIMITED) {
       std::uint32_t length = 0;
       if (!in.ReadVarint32(&length)) return {};

@@ -11,6 +11,7 @@
 #include "proto_convert.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/core/files.h"
+#include "scenewatch/service/access_token.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/pipeline/working_memory.h"
 
@@ -130,6 +131,16 @@ struct RequestHandler::Impl {
     }
     payload = std::string();  // an ingest payload can be large: free it before the work is queued
     const Route route = route_of(request->call_case());
+    if (route == Route::kMutate && !config.token.empty() && !tokens_equal(request->token(), config.token)) {
+      const std::string call = call_name(*request);
+      done(error_reply(request->id(), proto::Status::PERMISSION_DENIED,
+                       call + ": this call changes the model and needs the daemon's token (Request.token, the "
+                       "contents of the daemon's token file; the CLI reads it with --token-file): " +
+                           (request->token().empty() ? std::string("the request carries none")
+                                                     : std::string("the request's token is wrong")),
+                       call));
+      return;
+    }
     const Executor& executor = route == Route::kMutate ? mutate : query;
     if (!use_executors || route == Route::kInline || !executor) {
       done(execute(*request, &context));
@@ -482,7 +493,11 @@ void RequestHandler::handle(std::string payload, SessionContext& context, std::f
   impl_->handle(std::move(payload), context, std::move(done), /*use_executors=*/true);
 }
 
-bool RequestHandler::is_live_frame(std::string_view payload) const { return peek_live_frame(payload).live; }
+bool RequestHandler::is_live_frame(std::string_view payload) const {
+  // A frame without the right token is not skipped: it is refused like any other.
+  const LiveFramePeek peek = peek_live_frame(payload);
+  return peek.live && (impl_->config.token.empty() || tokens_equal(peek.token, impl_->config.token));
+}
 
 Reply RequestHandler::skip_live_frame(std::string_view payload) {
   proto::Response response;

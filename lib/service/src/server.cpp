@@ -54,7 +54,8 @@ struct Server::Impl {
       : config(std::move(c)),
         memory(m),
         log(std::move(l)),
-        handler(m, HandlerConfig{config.data_roots, config.model_dir, config.max_file_bytes, config.keep_snapshots},
+        handler(m, HandlerConfig{config.data_roots, config.model_dir, config.max_file_bytes, config.keep_snapshots,
+                                    config.access_token},
                 [this](std::function<void()> task) { asio::post(model_strand, std::move(task)); },
                 [this](std::function<void()> task) { asio::post(workers, std::move(task)); }) {
     handler.set_connection_counter([this] { return registry.size(); });
@@ -133,6 +134,10 @@ Server::~Server() = default;
 
 Status Server::listen() {
   Impl& s = *impl_;
+  if (s.config.access_token.empty()) {
+    return invalid_argument("no access token: calls that change the model would be open to every local user "
+                            "(read server.token_file into ServerConfig::access_token)");
+  }
   boost::system::error_code ec;
   const auto address = asio::ip::make_address(s.config.address, ec);
   if (ec) return invalid_argument("server.address: '" + s.config.address + "' is not an IP address");

@@ -118,6 +118,10 @@ Status read_server_config(const YAML::Node& root, const fs::path& base_dir, Serv
   config.data_roots.clear();
   for (const auto& r : roots) config.data_roots.push_back(resolve(base_dir, r));
 
+  std::string token_file = config.token_file.string();
+  if (Status s = section.read("token_file", token_file); !s) return s;
+  config.token_file = token_file.empty() ? fs::path() : resolve(base_dir, token_file);
+
   std::string model_dir = config.model_dir.string();
   if (Status s = section.read("model_dir", model_dir); !s) return s;
   config.model_dir = model_dir.empty() ? fs::path() : resolve(base_dir, model_dir);

@@ -31,6 +31,11 @@ class Client {
   Client& operator=(const Client&) = delete;
   ~Client();
 
+  /// The access token call() puts in requests that carry none (see access_token.h).
+  void set_token(std::string token) { token_ = std::move(token); }
+  /// The token set with set_token() (send() leaves requests as they are: put it in yourself).
+  const std::string& token() const { return token_; }
+
   /// Sends a request (its id is set to the next free one) and waits for the response with that
   /// id; events pushed meanwhile are kept for next_event(). timeout_s <= 0: wait forever.
   Result<proto::Response> call(proto::Request request, double timeout_s = 0);
@@ -60,6 +65,7 @@ class Client {
   std::string endpoint_;
   FrameParser parser_;
   std::uint64_t next_id_ = 1;
+  std::string token_;
   std::deque<proto::Event> events_;
 };
 

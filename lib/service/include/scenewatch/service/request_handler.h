@@ -24,6 +24,9 @@ struct HandlerConfig {
   std::filesystem::path model_dir;                ///< SaveModel / LoadModel target (empty: none)
   std::uint64_t max_file_bytes = 512ull << 20;    ///< IngestFile refuses larger files unread
   std::size_t keep_snapshots = 3;                 ///< SaveModel keeps this many snapshots
+  /// Calls that change the model (ingest, clear, reset, save, load) must carry this token; empty:
+  /// they need none (in-process use only: scenewatchd always sets one).
+  std::string token;
 };
 
 /// The answer to one request.
@@ -63,7 +66,8 @@ class RequestHandler {
   /// executor's thread. `context` is only used before handle() returns.
   void handle(std::string payload, SessionContext& context, std::function<void(Reply)> done);
 
-  /// True when the payload is a live IngestFrame (IngestFrame.live), read without decoding it.
+  /// True when the payload is a live IngestFrame (IngestFrame.live) carrying the right token, read
+  /// without decoding it.
   bool is_live_frame(std::string_view payload) const;
   /// The answer to a live frame that a newer live frame of its connection supersedes: OK with
   /// IngestReply.skipped, nothing processed; counted in Stats.frames_skipped. Thread safe.

@@ -30,6 +30,11 @@ struct ServerConfig {
   std::uint64_t max_file_bytes = 512ull << 20;  ///< larger files under the data roots are refused unread
   std::filesystem::path model_dir;              ///< loaded at start, saved by SaveModel and at exit (empty: none)
   std::size_t keep_snapshots = 3;               ///< saved models kept in model_dir (the newest is `current`)
+  /// The access token's file, created at start when missing (empty: default_token_path()).
+  std::filesystem::path token_file;
+  /// Not read from YAML: the token itself (the contents of token_file), which calls that change
+  /// the model must carry. Server::listen() refuses to serve without one.
+  std::string access_token;
 };
 
 /// Checks ranges; the message names the key ("server.read_timeout_s: must be > 0, got 0").
