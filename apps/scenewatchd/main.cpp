@@ -118,9 +118,11 @@ int main(int argc, char** argv) {
   scenewatch::pipeline::WorkingMemory memory(config.pipeline);
   const std::filesystem::path& model = config.server.model_dir;
   if (!model.empty()) {
-    if (auto s = memory.load(model); s) {
-      log(LogLevel::kInfo, "loaded the model from " + model.string() + " (" +
-                               std::to_string(memory.snapshot()->objects.size()) + " objects)");
+    if (auto s = memory.load_newest_good(model); s) {
+      for (const auto& refused : s->refused) log(LogLevel::kError, "refused a damaged snapshot: " + refused);
+      log(s->refused.empty() ? LogLevel::kInfo : LogLevel::kWarning,
+          "loaded the model from " + s->folder.string() + " (" + std::to_string(memory.snapshot()->objects.size()) +
+              " objects)" + (s->refused.empty() ? "" : "; the newer snapshot stays on disk as it is, unused"));
     } else if (s.error().code == scenewatch::ErrorCode::kNotFound) {
       log(LogLevel::kInfo, "no model in " + model.string() + " yet; starting empty");
     } else {

@@ -339,6 +339,42 @@ TEST(WorkingMemory, TruncatedBackgroundIsRefused) {
   EXPECT_EQ(fs::file_size(map), bytes / 2) << "nothing is written over the damaged file";
 }
 
+// At start-up a damaged newest snapshot is refused and the one before it is used; the damaged
+// one and the `current` link stay as they are (nothing is deleted or written over).
+TEST(WorkingMemory, StartUpFallsBackToTheNewestGoodSnapshot) {
+  const test::TempDir dir("model");
+  {
+    WorkingMemory wm(test_config());
+    for (int i = 0; i < 2; ++i) ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, 1.0 + i)).ok());
+    ASSERT_TRUE(wm.save(dir, 3).ok());
+    ASSERT_TRUE(wm.process(make_frame({kCube, kTall}, 3.0)).ok());
+    ASSERT_TRUE(wm.save(dir, 3).ok());
+  }
+  const fs::path newest = dir / fs::read_symlink(dir / "current");
+  const auto bytes = fs::file_size(newest / "background.ot");
+  fs::resize_file(newest / "background.ot", bytes / 2);
+
+  WorkingMemory wm(test_config());
+  EXPECT_FALSE(wm.load(dir).ok()) << "the strict load (LoadModel) still refuses the damaged current snapshot";
+  auto loaded = wm.load_newest_good(dir);
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  EXPECT_NE(loaded->folder.filename(), newest.filename());
+  ASSERT_EQ(loaded->refused.size(), 1u);
+  EXPECT_NE(loaded->refused[0].find("damaged"), std::string::npos) << loaded->refused[0];
+  EXPECT_EQ(wm.stats().frames_processed, 2u) << "the older snapshot's model";
+  EXPECT_EQ(dir / fs::read_symlink(dir / "current"), newest) << "current is left as it was";
+  EXPECT_EQ(fs::file_size(newest / "background.ot"), bytes / 2) << "nothing is written over the damaged file";
+
+  // No snapshot loads: an error naming each refusal. No model at all: kNotFound.
+  fs::resize_file(loaded->folder / "background.ot", 10);
+  WorkingMemory none(test_config());
+  auto failed = none.load_newest_good(dir);
+  ASSERT_FALSE(failed.ok());
+  EXPECT_NE(failed.error().message.find("no snapshot loads"), std::string::npos) << failed.error().message;
+  const test::TempDir empty("empty-model");
+  EXPECT_EQ(none.load_newest_good(empty).error().code, ErrorCode::kNotFound);
+}
+
 TEST(WorkingMemory, ReadersRunWhileFramesAreProcessed) {
   WorkingMemory wm(test_config());
   std::atomic<bool> done{false};

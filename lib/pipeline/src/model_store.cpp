@@ -145,17 +145,25 @@ Status commit_snapshot(const fs::path& model_dir, const std::function<Status(con
   fs::rename(link_tmp, model_dir / "current", ec);  // atomic replacement of the link
   if (ec) return io_error("'" + (model_dir / "current").string() + "': cannot replace link: " + ec.message());
   if (auto st = fsync_path(model_dir, true); !st) return st;
-  // Snapshots beyond the newest `keep` are no longer kept (names sort by number: snap-%06d).
-  std::vector<std::string> snapshots;
-  for (const auto& entry : fs::directory_iterator(model_dir, ec)) {
-    const std::string n = entry.path().filename().string();
-    if (n.rfind("snap-", 0) == 0 && n.find(".tmp") == std::string::npos) snapshots.push_back(n);
-  }
-  std::sort(snapshots.begin(), snapshots.end(), std::greater<>());
+  // Snapshots beyond the newest `keep` are no longer kept.
+  const std::vector<fs::path> snapshots = snapshots_newest_first(model_dir);
   for (std::size_t i = std::max<std::size_t>(1, keep); i < snapshots.size(); ++i) {
-    if (snapshots[i] != name) fs::remove_all(model_dir / snapshots[i], ec);
+    if (snapshots[i].filename() != name) fs::remove_all(snapshots[i], ec);
   }
   return {};
+}
+
+std::vector<fs::path> snapshots_newest_first(const fs::path& model_dir) {
+  std::error_code ec;
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(model_dir, ec)) {
+    const std::string n = entry.path().filename().string();
+    if (n.rfind("snap-", 0) == 0 && n.find(".tmp") == std::string::npos) names.push_back(n);
+  }
+  std::sort(names.begin(), names.end(), std::greater<>());  // names sort by number: snap-%06d
+  std::vector<fs::path> out;
+  for (const auto& n : names) out.push_back(model_dir / n);
+  return out;
 }
 
 }  // namespace scenewatch::pipeline

@@ -8,6 +8,7 @@
 
 #include <filesystem>
 #include <functional>
+#include <vector>
 
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/result.h"
@@ -27,6 +28,9 @@ Status commit_snapshot(const std::filesystem::path& model_dir,
 
 /// The folder `current` points at; kNotFound when there is no saved model.
 Result<std::filesystem::path> current_snapshot(const std::filesystem::path& model_dir);
+
+/// The snapshot folders of a model directory (snap-NNNNNN), newest first.
+std::vector<std::filesystem::path> snapshots_newest_first(const std::filesystem::path& model_dir);
 
 /// Writes text to a file and fsyncs it.
 Status write_file_synced(const std::filesystem::path& path, const std::string& text);

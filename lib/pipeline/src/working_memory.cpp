@@ -480,6 +480,34 @@ Status WorkingMemory::save(const fs::path& model_dir, std::size_t keep_snapshots
 Status WorkingMemory::load(const fs::path& model_dir) {
   auto dir = current_snapshot(model_dir);
   if (!dir) return dir.error();
+  return load_snapshot(*dir);
+}
+
+Result<LoadedSnapshot> WorkingMemory::load_newest_good(const fs::path& model_dir) {
+  auto current = current_snapshot(model_dir);
+  if (!current && current.error().code == ErrorCode::kNotFound) return current.error();
+  LoadedSnapshot report;
+  std::vector<fs::path> candidates;
+  if (current) candidates.push_back(*current);
+  for (const auto& snap : snapshots_newest_first(model_dir)) {
+    if (!current || snap.filename() != current->filename()) candidates.push_back(snap);
+  }
+  for (const auto& snap : candidates) {
+    if (auto st = load_snapshot(snap); !st) {
+      report.refused.push_back(st.error().message);
+      continue;
+    }
+    report.folder = snap;
+    return report;
+  }
+  if (!current) report.refused.insert(report.refused.begin(), current.error().message);
+  std::string why;
+  for (const auto& r : report.refused) why += (why.empty() ? "" : "; ") + r;
+  return invalid_argument("'" + model_dir.string() + "': no snapshot loads: " + why);
+}
+
+Status WorkingMemory::load_snapshot(const fs::path& snapshot_dir) {
+  const std::optional<fs::path> dir = snapshot_dir;
   // Build everything aside first: a bad file leaves the model as it was.
   std::ifstream in(*dir / "scene.json");
   if (!in) return io_error("'" + (*dir / "scene.json").string() + "': cannot open");

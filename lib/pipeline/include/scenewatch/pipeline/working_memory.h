@@ -97,6 +97,12 @@ struct Stats {
 
 using EventCallback = std::function<void(const Event&)>;
 
+/// Which snapshot load_newest_good() loaded, and why newer ones were refused.
+struct LoadedSnapshot {
+  std::filesystem::path folder;
+  std::vector<std::string> refused;  ///< one message per snapshot tried before it
+};
+
 /// Thread safe: process() calls are serialised; queries may run concurrently with them.
 class WorkingMemory {
  public:
@@ -121,6 +127,11 @@ class WorkingMemory {
   Status save(const std::filesystem::path& model_dir, std::size_t keep_snapshots = 1) const;
   /// Loads the model that `current` points at. A missing directory is an error of kind kNotFound.
   Status load(const std::filesystem::path& model_dir);
+  /// At start-up: the snapshot `current` points at or, when it does not load (damaged, missing),
+  /// the newest older snapshot that does; `current` is left as it is and nothing is deleted (the
+  /// next save adds a new snapshot). kNotFound when there is no saved model; an error naming every
+  /// refusal when no snapshot loads.
+  Result<LoadedSnapshot> load_newest_good(const std::filesystem::path& model_dir);
 
   /// Events are delivered on the thread that runs process(); callbacks must be quick.
   int subscribe(EventCallback callback);
@@ -139,6 +150,8 @@ class WorkingMemory {
   const Config& config() const { return config_; }
 
  private:
+  /// Loads one snapshot folder; a bad file leaves the model as it was.
+  Status load_snapshot(const std::filesystem::path& snapshot_dir);
   struct Impl;
   Config config_;
   std::unique_ptr<Impl> impl_;
