@@ -3,10 +3,9 @@
 // WorkingMemory::process, with the resident size of this process and the model's own accounting
 // (map, keyframes and mesh against the appearance budget) printed as it goes.
 #include <cstdio>
-#include <fstream>
-#include <string>
 
 #include "bench.h"
+#include "scenewatch/core/memory.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"
@@ -15,21 +14,6 @@ namespace scenewatch::bench {
 namespace {
 
 constexpr int kFramesPerPhase = 500;
-
-// VmRSS of this process in MiB (Linux), or -1.
-double resident_mib() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      double kib = 0;
-      status >> kib;
-      return kib / 1024.0;
-    }
-    std::getline(status, key);
-  }
-  return -1.0;
-}
 
 }  // namespace
 

@@ -8,12 +8,12 @@
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
-#include <fstream>
 #include <mutex>
 #include <thread>
 #include <vector>
 
 #include "daemon_harness.h"
+#include "scenewatch/core/memory.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/io/sequence.h"
 
@@ -35,21 +35,6 @@ constexpr int kMaxConnections = kClients + kHostile + 16;
 /// the development machine (69 MiB at start; the mug frames being processed are most of the rise).
 constexpr double kMaxRssMiB = 200;
 
-/// VmRSS of a process in MiB (0 when it cannot be read).
-double rss_mib(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      double kib = 0;
-      status >> kib;
-      return kib / 1024.0;
-    }
-    std::string rest;
-    std::getline(status, rest);
-  }
-  return 0;
-}
 
 TEST(DaemonLoadTest, NoRequestLostUnderLoadWithHostileConnectionsHeld) {
   SCENEWATCH_REQUIRE_DATA(kMug);
@@ -60,7 +45,7 @@ TEST(DaemonLoadTest, NoRequestLostUnderLoadWithHostileConnectionsHeld) {
   ASSERT_TRUE(frame.ok()) << frame.error().message;
   proto::Request ingest;
   *ingest.mutable_ingest_frame() = service::make_ingest_frame(*frame);
-  const double rss_start_mib = rss_mib(daemon.pid());
+  const double rss_start_mib = resident_mib(daemon.pid());
 
   // Hostile connections first: they hold their slots for the whole run.
   std::vector<Client> hostile;
@@ -96,7 +81,7 @@ TEST(DaemonLoadTest, NoRequestLostUnderLoadWithHostileConnectionsHeld) {
   double peak_rss_mib = rss_start_mib;
   std::thread sampler([&] {
     while (!done) {
-      peak_rss_mib = std::max(peak_rss_mib, rss_mib(daemon.pid()));
+      peak_rss_mib = std::max(peak_rss_mib, resident_mib(daemon.pid()));
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   });

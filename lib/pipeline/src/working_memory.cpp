@@ -506,19 +506,18 @@ Result<LoadedSnapshot> WorkingMemory::load_newest_good(const fs::path& model_dir
   return invalid_argument("'" + model_dir.string() + "': no snapshot loads: " + why);
 }
 
-Status WorkingMemory::load_snapshot(const fs::path& snapshot_dir) {
-  const std::optional<fs::path> dir = snapshot_dir;
+Status WorkingMemory::load_snapshot(const fs::path& dir) {
   // Build everything aside first: a bad file leaves the model as it was.
-  std::ifstream in(*dir / "scene.json");
-  if (!in) return io_error("'" + (*dir / "scene.json").string() + "': cannot open");
+  std::ifstream in(dir / "scene.json");
+  if (!in) return io_error("'" + (dir / "scene.json").string() + "': cannot open");
   nlohmann::json scene;
   try {
     scene = nlohmann::json::parse(in);
   } catch (const std::exception& e) {
-    return invalid_argument("'" + (*dir / "scene.json").string() + "': " + e.what());
+    return invalid_argument("'" + (dir / "scene.json").string() + "': " + e.what());
   }
   background::OccupancyMap map(config_.background);
-  if (auto st = load_background(map, *dir / "background.ot", scene); !st) return st;
+  if (auto st = load_background(map, dir / "background.ot", scene); !st) return st;
   std::vector<TrackedObject> objects;
   std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples;
   std::vector<Plane> planes;
@@ -544,9 +543,9 @@ Status WorkingMemory::load_snapshot(const fs::path& snapshot_dir) {
       planes.push_back(*p);
     }
   } catch (const std::exception& e) {
-    return invalid_argument("'" + (*dir / "scene.json").string() + "': malformed: " + e.what());
+    return invalid_argument("'" + (dir / "scene.json").string() + "': malformed: " + e.what());
   }
-  std::ifstream log(*dir / "events.jsonl");
+  std::ifstream log(dir / "events.jsonl");
   std::string line;
   while (std::getline(log, line)) {
     if (line.empty()) continue;
@@ -555,14 +554,14 @@ Status WorkingMemory::load_snapshot(const fs::path& snapshot_dir) {
       if (!e) return e.error();
       events.push_back(*e);
     } catch (const std::exception& ex) {
-      return invalid_argument("'" + (*dir / "events.jsonl").string() + "': " + ex.what());
+      return invalid_argument("'" + (dir / "events.jsonl").string() + "': " + ex.what());
     }
   }
 
   std::lock_guard<std::mutex> lock(impl_->writer);
   Impl& m = *impl_;
   // Keyframes last among the reads: AppearanceStage::load changes nothing when it fails.
-  if (auto st = m.appearance.load(*dir); !st) return st;
+  if (auto st = m.appearance.load(dir); !st) return st;
   {
     std::unique_lock<std::shared_mutex> write(m.map_mutex);
     m.map = std::move(map);

@@ -10,4 +10,8 @@ namespace scenewatch {
 /// The price: the process keeps its peak heap. Call once at start-up; no-op outside glibc.
 void keep_frame_buffers_in_heap();
 
+/// Resident size (VmRSS) of process `pid` in MiB, read from /proc; 0 when it cannot be read.
+/// `pid` 0: this process.
+double resident_mib(int pid = 0);
+
 }  // namespace scenewatch

@@ -151,7 +151,7 @@ class WorkingMemory {
 
  private:
   /// Loads one snapshot folder; a bad file leaves the model as it was.
-  Status load_snapshot(const std::filesystem::path& snapshot_dir);
+  Status load_snapshot(const std::filesystem::path& dir);
   struct Impl;
   Config config_;
   std::unique_ptr<Impl> impl_;
