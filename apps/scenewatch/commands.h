@@ -41,6 +41,7 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
                     const std::optional<double>& depth_scale_m);
 int run_planes(const RemoteOptions& options);
 int run_objects(const RemoteOptions& options);
+int run_hands(const RemoteOptions& options);
 /// `points`: x y z triples; `box`: empty or min x y z, max x y z.
 int run_occupancy(const RemoteOptions& options, const std::vector<double>& points, const std::vector<double>& box);
 int run_clear_box(const RemoteOptions& options, const std::vector<double>& box);

@@ -47,7 +47,7 @@ nlohmann::json to_json(const proto::Cluster& cluster) {
 }
 
 nlohmann::json to_json(const proto::Object& object) {
-  return {{"id", object.id()},
+  nlohmann::json j = {{"id", object.id()},
           {"plane_id", object.plane_id()},
           {"centroid", to_json(object.centroid())},
           {"box", to_json(object.box())},
@@ -57,6 +57,19 @@ nlohmann::json to_json(const proto::Object& object) {
           {"last_seen_s", object.last_seen_s()},
           {"observations", object.observations()},
           {"supported_by", object.supported_by()}};
+  if (!object.foreground()) return j;
+  nlohmann::json handlings = nlohmann::json::array();
+  for (const auto& h : object.handlings()) {
+    handlings.push_back({{"start_s", h.start_s()}, {"end_s", h.end_s()},
+                         {"dof_range", std::vector<double>(h.dof_range().begin(), h.dof_range().end())},
+                         {"moved_dofs", std::vector<std::string>(h.moved_dofs().begin(), h.moved_dofs().end())}});
+  }
+  j["foreground"] = {{"pose", std::vector<double>(object.pose().matrix().begin(), object.pose().matrix().end())},
+                     {"free_dofs", std::vector<std::string>(object.free_dofs().begin(), object.free_dofs().end())},
+                     {"frozen_dofs", std::vector<std::string>(object.frozen_dofs().begin(), object.frozen_dofs().end())},
+                     {"handlings", handlings}, {"in_hand", object.in_hand()}, {"visible", object.visible()},
+                     {"promoted_s", object.promoted_s()}};
+  return j;
 }
 
 nlohmann::json to_json(const proto::Event& event) {
@@ -162,6 +175,16 @@ std::string text(const proto::Object& object) {
      << fixed(object.mean_rgb().x(), 0) << ", " << fixed(object.mean_rgb().y(), 0) << ", "
      << fixed(object.mean_rgb().z(), 0) << "), seen " << object.observations() << "x (first "
      << fixed(object.first_seen_s(), 2) << " s, last " << fixed(object.last_seen_s(), 2) << " s)";
+  if (object.foreground()) {
+    auto names = [](const auto& list) {
+      std::string s;
+      for (const auto& n : list) s += (s.empty() ? "" : " ") + n;
+      return s.empty() ? std::string("none") : s;
+    };
+    os << "\n    foreground since " << fixed(object.promoted_s(), 2) << " s" << (object.in_hand() ? ", in a hand" : "")
+       << (object.visible() ? "" : ", not seen now") << "; free DoFs: " << names(object.free_dofs())
+       << "; frozen: " << names(object.frozen_dofs()) << "; handled " << object.handlings_size() << "x";
+  }
   return os.str();
 }
 

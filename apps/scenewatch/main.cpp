@@ -87,6 +87,10 @@ int main(int argc, char** argv) {
   add_remote_options(objects, remote);
   objects->callback([&] { action = [&] { return run_objects(remote); }; });
 
+  auto* hands = app.add_subcommand("hands", "the hands and the person seen in the last frame (where not to reach)");
+  add_remote_options(hands, remote);
+  hands->callback([&] { action = [&] { return run_hands(remote); }; });
+
   std::vector<double> points, box;
   auto* occupancy = app.add_subcommand("occupancy", "occupancy of world points (X Y Z ...) and/or a box");
   occupancy->add_option("point", points, "X Y Z, possibly several points");

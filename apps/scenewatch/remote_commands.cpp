@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <iomanip>
 #include <iostream>
 #include <optional>
 #include <thread>
@@ -349,6 +350,33 @@ int run_objects(const RemoteOptions& options) {
     }
     std::cout << plural(objects.objects_size(), "tracked object") << "\n";
     for (const auto& o : objects.objects()) std::cout << text(o) << "\n";
+    std::cout << std::flush;
+  });
+}
+
+int run_hands(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_get_hands();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    const auto& hands = r.hands();
+    auto box_json = [](const proto::Box& b) { return json{{"min", to_json(b.min())}, {"max", to_json(b.max())}}; };
+    if (options.json) {
+      json list = json::array();
+      for (const auto& h : hands.hands()) {
+        list.push_back({{"box_world", box_json(h.box_world())}, {"tip_world", to_json(h.tip_world())}, {"score", h.score()},
+                        {"pixels", h.pixels()}, {"enters_from_border", h.enters_from_border()}});
+      }
+      json j = {{"frame_index", hands.frame_index()}, {"stamp_s", hands.stamp_s()}, {"hands", std::move(list)},
+                {"person_pixels", hands.person_pixels()}};
+      if (hands.has_person_box_world()) j["person_box_world"] = box_json(hands.person_box_world());
+      return print_json(j);
+    }
+    std::cout << plural(hands.hands_size(), "hand") << " in frame " << hands.frame_index() << "\n";
+    for (const auto& h : hands.hands()) {
+      std::cout << "  hand at " << text(h.tip_world()) << ", box " << text(h.box_world().min()) << " .. " << text(h.box_world().max())
+                << ", " << h.pixels() << " pixels, score " << std::setprecision(2) << h.score() << "\n";
+    }
+    if (hands.person_pixels() > 0) std::cout << "  person: " << hands.person_pixels() << " pixels\n";
     std::cout << std::flush;
   });
 }

@@ -45,6 +45,7 @@ const char* to_string(EventKind kind) {
     case EventKind::kObjectRemoved: return "OBJECT_REMOVED";
     case EventKind::kObjectMoved: return "OBJECT_MOVED";
     case EventKind::kFrozenDofMotion: return "FROZEN_DOF_MOTION";
+    case EventKind::kObjectPromoted: return "OBJECT_PROMOTED";
   }
   return "UNKNOWN";
 }

@@ -18,7 +18,7 @@ EventLevel event_level_from_string(const std::string& s) {
 }
 
 EventKind event_kind_from_string(const std::string& s) {
-  for (int k = 0; k <= static_cast<int>(EventKind::kFrozenDofMotion); ++k) {
+  for (int k = 0; k <= static_cast<int>(EventKind::kObjectPromoted); ++k) {
     if (s == to_string(static_cast<EventKind>(k))) return static_cast<EventKind>(k);
   }
   throw std::invalid_argument("unknown event kind '" + s + "'");

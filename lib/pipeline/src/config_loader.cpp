@@ -35,7 +35,7 @@ Status YamlSection::finish() const {
 
 const std::vector<std::string>& pipeline_sections() {
   static const std::vector<std::string> kSections = {"background", "segmentation", "tracking", "change",
-                                                     "appearance", "surprise", "events"};
+                                                     "appearance", "surprise", "events", "foreground"};
   return kSections;
 }
 
@@ -170,6 +170,30 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("align_radius_px", u.robust.align_radius_px); },
                            [&] { return s.read("align_min_kl", u.robust.align_min_kl); },
                            [&] { return s.read("familiar_after_frames", u.familiar_after_frames); });
+        !st)
+      return st;
+    if (auto st = s.finish(); !st) return st;
+  }
+  {
+    YamlSection s(root["foreground"], "foreground");
+    if (auto st = s.check_is_map(); !st) return st;
+    foreground::ForegroundConfig& f = c.foreground;
+    if (auto st = read_all([&] { return s.read("enabled", f.enabled); },
+                           [&] { return s.read("contact_m", f.contact_m); },
+                           [&] { return s.read("promote_translation_m", f.promote_translation_m); },
+                           [&] { return s.read("promote_rotation_deg", f.promote_rotation_deg); },
+                           [&] { return s.read("vacated_fraction", f.vacated_fraction); },
+                           [&] { return s.read("touch_timeout_frames", f.touch_timeout_frames); },
+                           [&] { return s.read("release_frames", f.release_frames); },
+                           [&] { return s.read("dof_translation_m", f.dof.translation_m); },
+                           [&] { return s.read("dof_rotation_deg", f.dof.rotation_deg); },
+                           [&] { return s.read("search_radius_m", f.search_radius_m); },
+                           [&] { return s.read("mask_m", f.mask_m); },
+                           [&] { return s.read("max_model_points", f.max_model_points); },
+                           [&] { return s.read("reacquire_radius_m", f.reacquire_radius_m); },
+                           [&] { return s.read("hands", f.hands.enabled); },
+                           [&] { return s.read("hand_min_area_m2", f.hands.min_hand_area_m2); },
+                           [&] { return s.read("hand_max_area_m2", f.hands.max_hand_area_m2); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

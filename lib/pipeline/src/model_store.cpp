@@ -30,6 +30,59 @@ OrientedBox box_from(const json& j) {
   return b;
 }
 
+json dofs_json(const DofVector& v) { return json(std::vector<double>(v.begin(), v.end())); }
+json flags_json(const DofFlags& f) {
+  json names = json::array();
+  for (int k = 0; k < kDofCount; ++k)
+    if (f[static_cast<std::size_t>(k)]) names.push_back(to_string(static_cast<Dof>(k)));
+  return names;
+}
+DofFlags flags_from(const json& j) {
+  DofFlags f{};
+  for (const auto& name : j) {
+    bool known = false;
+    for (int k = 0; k < kDofCount; ++k) {
+      if (name.get<std::string>() == to_string(static_cast<Dof>(k))) f[static_cast<std::size_t>(k)] = known = true;
+    }
+    if (!known) throw std::invalid_argument("unknown DoF '" + name.get<std::string>() + "'");
+  }
+  return f;
+}
+
+json foreground_json(const ForegroundState& s) {
+  json handlings = json::array();
+  for (const auto& h : s.handlings) {
+    handlings.push_back({{"start_s", h.start_s}, {"end_s", h.end_s}, {"range", dofs_json(h.range)}, {"moved", flags_json(h.moved)}});
+  }
+  const Eigen::Matrix4d& m = s.T_world_object.matrix();
+  return {{"T_world_object", std::vector<double>(m.data(), m.data() + 16)}, {"free", flags_json(s.free)},
+          {"handlings", handlings}, {"promoted_s", s.promoted_s}, {"model_points", s.model_points}};
+}
+
+ForegroundState foreground_from(const json& j) {
+  ForegroundState s;
+  const auto m = j.at("T_world_object").get<std::vector<double>>();
+  if (m.size() != 16) throw std::invalid_argument("T_world_object: 16 numbers expected");
+  Eigen::Matrix4d M = Eigen::Map<const Eigen::Matrix4d>(m.data());
+  if (auto st = validate_rigid(M); !st) throw std::invalid_argument("T_world_object: " + st.error().message);
+  s.T_world_object = pose_from_matrix(M);
+  s.free = flags_from(j.at("free"));
+  for (const auto& jh : j.at("handlings")) {
+    Handling h;
+    h.start_s = jh.at("start_s").get<double>();
+    h.end_s = jh.at("end_s").get<double>();
+    const auto r = jh.at("range").get<std::vector<double>>();
+    if (r.size() != h.range.size()) throw std::invalid_argument("handling range: 6 numbers expected");
+    std::copy(r.begin(), r.end(), h.range.begin());
+    h.moved = flags_from(jh.at("moved"));
+    s.handlings.push_back(h);
+  }
+  s.promoted_s = j.at("promoted_s").get<double>();
+  s.model_points = j.value("model_points", std::size_t{0});
+  s.visible = false;  // until a frame sees it again
+  return s;
+}
+
 template <typename T, typename F>
 Result<T> parse(const char* what, F&& f) {
   try {
@@ -49,10 +102,12 @@ json to_json(const Plane& p) {
 
 json to_json(const TrackedObject& o) {
   const ObjectCluster& c = o.cluster;
-  return {{"id", o.id}, {"plane_id", c.plane_id}, {"centroid", vec(c.centroid)}, {"box", box_json(c.box)},
+  json j = {{"id", o.id}, {"plane_id", c.plane_id}, {"centroid", vec(c.centroid)}, {"box", box_json(c.box)},
           {"point_count", c.point_count}, {"mean_rgb", {c.mean_rgb.x(), c.mean_rgb.y(), c.mean_rgb.z()}},
           {"first_seen_s", o.first_seen_s}, {"last_seen_s", o.last_seen_s}, {"observations", o.observations},
           {"supported_by", o.supported_by}};
+  if (o.foreground) j["foreground"] = foreground_json(*o.foreground);
+  return j;
 }
 
 Result<Plane> plane_from_json(const json& j) {
@@ -83,6 +138,7 @@ Result<TrackedObject> object_from_json(const json& j) {
     o.last_seen_s = j.at("last_seen_s").get<double>();
     o.supported_by = j.value("supported_by", std::uint64_t{0});  // absent in models saved before it existed
     o.observations = j.at("observations").get<int>();
+    if (j.contains("foreground")) o.foreground = foreground_from(j.at("foreground"));
     return o;
   });
 }

@@ -146,6 +146,11 @@ void ObjectTracker::restore(std::vector<TrackedObject> objects, std::map<std::ui
   for (const auto& t : tracks_) objects_.push_back(t.object);
 }
 
+void ObjectTracker::remove(std::uint64_t id) {
+  tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(), [&](const Track& t) { return t.object.id == id; }), tracks_.end());
+  objects_.erase(std::remove_if(objects_.begin(), objects_.end(), [&](const TrackedObject& o) { return o.id == id; }), objects_.end());
+}
+
 void ObjectTracker::reset() {
   // next_id_ stays: an id is never given twice, not even across a reset.
   tracks_.clear();

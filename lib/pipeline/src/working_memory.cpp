@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "appearance_stage.h"
+#include "foreground_stage.h"
 #include "model_store.h"
 #include "timing.h"
 #include "scenewatch/change/objects.h"
@@ -84,6 +85,25 @@ ObjectCluster to_world(ObjectCluster c, const Pose& T) {
 
 constexpr std::size_t kSamplesPerObject = 200;
 
+// World sample points of each cluster, for the tracker's free-space evidence; clusters the
+// foreground claimed are left out.
+std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectCluster>& objects, const Cloud& cloud,
+                                                     const Pose& T, const std::vector<std::size_t>& claimed) {
+  std::vector<TrackerObservation> observations;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    if (std::find(claimed.begin(), claimed.end(), i) != claimed.end()) continue;
+    TrackerObservation o;
+    const auto& idx = objects[i].indices;
+    const std::size_t step = std::max<std::size_t>(1, idx.size() / kSamplesPerObject);
+    for (std::size_t k = 0; k < idx.size(); k += step)
+      o.samples.push_back(T * cloud.points[static_cast<std::size_t>(idx[k])].getVector3fMap().cast<double>());
+    o.cluster = objects[i];
+    o.range_m = (objects[i].centroid - T.translation()).norm();
+    observations.push_back(std::move(o));
+  }
+  return observations;
+}
+
 // The frame without the points of unconfirmed change candidates: an added candidate's own points,
 // and every pixel in the region where a removed candidate was seen through (a few pixels wider).
 // Without this the insertion would erode a removed object's voxels frame by frame, and the
@@ -126,7 +146,7 @@ struct ChangeOutcome {
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
       : map(c.background), appearance(c.appearance, c.surprise), changes(c.change), tracker(c.tracking), fusion(c.fusion),
-        snapshot(std::make_shared<SceneSnapshot>()) {}
+        foreground(c.foreground), snapshot(std::make_shared<SceneSnapshot>()) {}
 
   // process() and the other writers hold this for their whole duration.
   mutable std::mutex writer;
@@ -139,6 +159,7 @@ struct WorkingMemory::Impl {
   change::PersistenceFilter changes;
   ObjectTracker tracker;
   EventFusion fusion;
+  ForegroundStage foreground;
   std::vector<Plane> planes;
   std::uint64_t frames = 0, points = 0;
   double total_ms = 0, last_ms = 0;
@@ -158,6 +179,8 @@ struct WorkingMemory::Impl {
     s->frames_processed = frames;
     s->planes = planes;
     s->objects = tracker.objects();
+    for (auto& o : foreground.tracker().objects()) s->objects.push_back(std::move(o));
+    s->hands = foreground.hands();
     s->last_stamp_s = last_stamp_s;
     std::atomic_store(&snapshot, std::shared_ptr<const SceneSnapshot>(std::move(s)));
   }
@@ -211,6 +234,33 @@ struct WorkingMemory::Impl {
     return changed;
   }
 
+  // One fact, one event: appearance regions where geometry changes are its evidence; others must
+  // persist. What the foreground explains (a carried object's old and new place) is not a change.
+  std::vector<Event> fuse(const FrameResult& result, const ChangeOutcome& changed, const std::vector<Aabb>& quiet,
+                          double stamp_s) {
+    auto explained = [&](const Aabb& box) {
+      return std::any_of(quiet.begin(), quiet.end(), [&](const Aabb& q) { return q.overlaps(box); });
+    };
+    std::vector<Event> geometric;
+    std::vector<Aabb> boxes;  // both places of a move
+    for (const auto& c : changed.confirmed) {
+      Event e = change::to_event(c);
+      if (explained(e.box_world)) continue;
+      e.stamp_s = stamp_s;
+      geometric.push_back(std::move(e));
+      if (c.before) boxes.push_back(c.before->box_world);
+      if (c.after) boxes.push_back(c.after->box_world);
+    }
+    std::vector<Event> appearance;
+    if (result.surprise) {
+      for (const auto& e : result.surprise->events)
+        if (!explained(e.box_world)) appearance.push_back(e);
+    }
+    const bool familiar = result.surprise && result.surprise->familiar_view;
+    return fusion.update(appearance, changed.pending, std::move(geometric), std::move(boxes), familiar, tracker.objects(),
+                         result.objects);
+  }
+
   void emit(std::vector<Event>& batch, std::size_t max_log) {
     std::vector<EventCallback> callbacks;
     {
@@ -244,6 +294,7 @@ Status validate(const Config& c) {
   if (auto st = background::validate(c.appearance); !st) return st;
   if (auto st = surprise::validate(c.surprise); !st) return st;
   if (auto st = change::validate(c.change); !st) return st;
+  if (auto st = foreground::validate(c.foreground); !st) return st;
   return {};
 }
 
@@ -260,6 +311,8 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   FrameResult result;
   result.frame_index = m.frames;
   result.points = *valid_points;
+  // Hands, the person and the foreground objects are blanked out of what the background sees.
+  const Frame seen = m.foreground.prepare(frame, m.frames, m.planes, config_.segmentation.up, result);
 
   // Three independent parts on the two cores, each against the memory as it stands before this
   // frame: the image surprise (keyframes and mesh), the geometric change detection with the map
@@ -267,53 +320,29 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   // writes; the tracker and the event fusion below need all three.
   auto surprise = std::async(std::launch::async, [&] {
     const auto t_surprise = Clock::now();
-    result.surprise = m.appearance.process(frame);  // then its keyframe update
+    result.surprise = m.appearance.process(seen);  // then its keyframe update
     result.surprise_ms = ms_since(t_surprise);
   });
-  auto map_update = std::async(std::launch::async, [&] { return m.update_map(frame, T, config_, result); });
+  auto map_update = std::async(std::launch::async, [&] { return m.update_map(seen, T, config_, result); });
 
   // Segment in the camera frame (indices stay those of the input cloud), then move to the world.
   segmentation::Config seg = config_.segmentation;
   if (seg.up) seg.up = T.linear().transpose() * *seg.up;
   const auto t_seg = Clock::now();
-  segmentation::Segmentation s = segmentation::segment(*frame.cloud, seg, Eigen::Vector3d::Zero());
+  segmentation::Segmentation s = segmentation::segment(*seen.cloud, seg, Eigen::Vector3d::Zero());
   result.segment_ms = ms_since(t_seg);
   for (auto& p : s.planes) result.planes.push_back(to_world(std::move(p), T));
   for (auto& o : s.objects) result.objects.push_back(to_world(std::move(o), T));
 
-  // World sample points of each cluster, for the tracker's free-space evidence.
-  std::vector<TrackerObservation> observations(result.objects.size());
-  for (std::size_t i = 0; i < result.objects.size(); ++i) {
-    const auto& idx = result.objects[i].indices;
-    const std::size_t step = std::max<std::size_t>(1, idx.size() / kSamplesPerObject);
-    for (std::size_t k = 0; k < idx.size(); k += step)
-      observations[i].samples.push_back(T * frame.cloud->points[idx[k]].getVector3fMap().cast<double>());
-    observations[i].cluster = result.objects[i];
-    observations[i].range_m = (result.objects[i].centroid - T.translation()).norm();
-  }
-
   surprise.get();  // each rethrows what its part threw
   const ChangeOutcome changed = map_update.get();
-  const auto& [pending, absorbed, confirmed, K_change] = changed;
-  // One fact, one event: appearance regions where geometry changes are its evidence; others must persist.
-  {
-    std::vector<Event> geometric;
-    std::vector<Aabb> boxes;  // both places of a move
-    for (const auto& c : confirmed) {
-      Event e = change::to_event(c);
-      e.stamp_s = frame.stamp_s;
-      geometric.push_back(std::move(e));
-      if (c.before) boxes.push_back(c.before->box_world);
-      if (c.after) boxes.push_back(c.after->box_world);
-    }
-    static const std::vector<Event> kNone;
-    const bool familiar = result.surprise && result.surprise->familiar_view;
-    result.events = m.fusion.update(result.surprise ? result.surprise->events : kNone, pending, std::move(geometric),
-                             std::move(boxes), familiar, m.tracker.objects(), result.objects);
-  }
+  foreground::ForegroundUpdate fg = m.foreground.update(result.objects, m.tracker.objects(), result);
+  result.events = m.fuse(result, changed, fg.quiet_boxes, frame.stamp_s);
 
-  // The object list (no events: a change is reported by the change detector, once).
+  // The object list (no events: a change is reported by the change detector, once); the
+  // foreground's objects are not background objects.
   {
+    std::vector<TrackerObservation> observations = tracker_observations(result.objects, *frame.cloud, T, fg.claimed_clusters);
     std::shared_lock<std::shared_mutex> read(m.map_mutex);
     m.tracker.update(std::move(observations), frame.stamp_s, [&](const std::vector<Eigen::Vector3d>& pts) {
       if (pts.empty()) return 0.0;
@@ -324,6 +353,13 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
       return static_cast<double>(n) / pts.size();
     });
   }
+  for (std::uint64_t id : fg.promoted) m.tracker.remove(id);
+  if (!fg.vacated.empty()) {
+    // A promoted object's old place is empty now: its removal is explained, not a surprise.
+    std::unique_lock<std::shared_mutex> write(m.map_mutex);
+    for (const auto& pts : fg.vacated) m.map.set_voxels(pts, background::Occupancy::kFree);
+  }
+  for (auto& e : fg.events) result.events.push_back(std::move(e));
 
   m.planes = result.planes;
   for (auto& p : m.planes) p.indices.clear();
@@ -389,6 +425,7 @@ void WorkingMemory::reset() {
   impl_->tracker.reset();
   impl_->changes.reset();
   impl_->fusion.reset();
+  impl_->foreground.reset();
   impl_->planes.clear();
   impl_->frames = impl_->points = 0;
   impl_->total_ms = impl_->last_ms = 0;
@@ -458,6 +495,17 @@ Status WorkingMemory::save(const fs::path& model_dir, std::size_t keep_snapshots
       j["samples"] = pts;
       scene["objects"].push_back(j);
     }
+    // Foreground objects with their point models (object frame: x y z r g b), so that a restarted
+    // daemon tracks them and keeps their learnt DoFs.
+    scene["foreground"] = nlohmann::json::array();
+    for (const auto& o : m.foreground.tracker().objects()) {
+      nlohmann::json j = to_json(o);
+      nlohmann::json pts = nlohmann::json::array();
+      if (auto model = m.foreground.tracker().model(o.id))
+        for (const auto& p : model->points) pts.push_back({p.x, p.y, p.z, p.r, p.g, p.b});
+      j["model"] = pts;
+      scene["foreground"].push_back(j);
+    }
     scene["planes"] = nlohmann::json::array();
     for (const auto& p : m.planes) scene["planes"].push_back(to_json(p));
     std::string log;
@@ -521,6 +569,7 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
   std::vector<TrackedObject> objects;
   std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples;
   std::vector<Plane> planes;
+  std::vector<std::pair<TrackedObject, CloudConstPtr>> foreground;
   std::deque<Event> events;
   std::uint64_t frames = 0, points = 0, next_object_id = 1, next_event_id = 1;
   double last_stamp_s = 0.0;
@@ -536,6 +585,20 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
       for (const auto& p : j.value("samples", nlohmann::json::array()))
         samples[o->id].emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
       objects.push_back(*o);
+    }
+    for (const auto& j : scene.value("foreground", nlohmann::json::array())) {
+      auto o = object_from_json(j);
+      if (!o) return o.error();
+      if (!o->foreground) return invalid_argument("'" + (dir / "scene.json").string() + "': foreground object " + std::to_string(o->id) + " has no foreground state");
+      auto model = std::make_shared<Cloud>();
+      for (const auto& p : j.at("model")) {
+        PointT q;
+        q.x = p.at(0).get<float>(), q.y = p.at(1).get<float>(), q.z = p.at(2).get<float>();
+        q.r = p.at(3).get<std::uint8_t>(), q.g = p.at(4).get<std::uint8_t>(), q.b = p.at(5).get<std::uint8_t>();
+        model->push_back(q);
+      }
+      if (model->empty()) return invalid_argument("'" + (dir / "scene.json").string() + "': foreground object " + std::to_string(o->id) + " has an empty model");
+      foreground.emplace_back(*o, std::move(model));
     }
     for (const auto& j : scene.at("planes")) {
       auto p = plane_from_json(j);
@@ -568,6 +631,8 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
   }
   config_.background.resolution_m = m.map.resolution();
   m.tracker.restore(std::move(objects), std::move(samples), next_object_id);
+  m.foreground.reset();
+  for (const auto& [object, model] : foreground) m.foreground.tracker().restore(object, model);
   m.changes.reset();
   m.fusion.reset();
   m.planes = std::move(planes);

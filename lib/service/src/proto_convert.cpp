@@ -65,6 +65,7 @@ proto::Event::Kind to_proto(EventKind kind) {
     case EventKind::kObjectRemoved: return proto::Event::OBJECT_REMOVED;
     case EventKind::kObjectMoved: return proto::Event::OBJECT_MOVED;
     case EventKind::kFrozenDofMotion: return proto::Event::FROZEN_DOF_MOTION;
+    case EventKind::kObjectPromoted: return proto::Event::OBJECT_PROMOTED;
   }
   return proto::Event::KIND_UNSPECIFIED;
 }
@@ -148,6 +149,27 @@ void to_proto(const TrackedObject& object, proto::Object* out) {
   out->set_last_seen_s(object.last_seen_s);
   out->set_observations(static_cast<std::uint32_t>(std::max(0, object.observations)));
   out->set_supported_by(object.supported_by);
+  if (!object.foreground) return;
+  const ForegroundState& f = *object.foreground;
+  out->set_foreground(true);
+  to_proto(f.T_world_object, out->mutable_pose());
+  for (int k = 0; k < kDofCount; ++k) {
+    const char* name = to_string(static_cast<Dof>(k));
+    if (f.free[static_cast<std::size_t>(k)]) out->add_free_dofs(name);
+    else out->add_frozen_dofs(name);
+  }
+  for (const auto& h : f.handlings) {
+    auto* ph = out->add_handlings();
+    ph->set_start_s(h.start_s);
+    ph->set_end_s(h.end_s);
+    for (int k = 0; k < kDofCount; ++k) {
+      ph->add_dof_range(h.range[static_cast<std::size_t>(k)]);
+      if (h.moved[static_cast<std::size_t>(k)]) ph->add_moved_dofs(to_string(static_cast<Dof>(k)));
+    }
+  }
+  out->set_in_hand(f.in_hand);
+  out->set_visible(f.visible);
+  out->set_promoted_s(f.promoted_s);
 }
 
 void to_proto(const Event& event, proto::Event* out) {

@@ -181,6 +181,7 @@ struct RequestHandler::Impl {
       case proto::Request::kIngestFile: return ingest_file(request.ingest_file(), response);
       case proto::Request::kGetPlanes: return get_planes(response);
       case proto::Request::kGetObjects: return get_objects(response);
+      case proto::Request::kGetHands: return get_hands(response);
       case proto::Request::kQueryOccupancy: return query_occupancy(request.query_occupancy(), response);
       case proto::Request::kClearBox: return clear_box(request.clear_box(), response);
       case proto::Request::kReset:
@@ -382,6 +383,25 @@ struct RequestHandler::Impl {
     auto* out = response.mutable_objects();
     out->set_frames_processed(snapshot->frames_processed);
     for (const auto& object : snapshot->objects) convert::to_proto(object, out->add_objects());
+    return {};
+  }
+
+  Status get_hands(proto::Response& response) {
+    const auto snapshot = memory.snapshot();
+    const pipeline::HandsSeen& seen = snapshot->hands;
+    auto* out = response.mutable_hands();
+    out->set_frame_index(seen.frame_index);
+    out->set_stamp_s(seen.stamp_s);
+    for (const auto& h : seen.hands) {
+      auto* o = out->add_hands();
+      convert::to_proto(h.box_world, o->mutable_box_world());
+      convert::to_proto(h.tip_world, o->mutable_tip_world());
+      o->set_score(h.score);
+      o->set_pixels(h.pixels);
+      o->set_enters_from_border(h.enters_from_border);
+    }
+    out->set_person_pixels(seen.person_pixels);
+    if (seen.person_box_world) convert::to_proto(*seen.person_box_world, out->mutable_person_box_world());
     return {};
   }
 

@@ -19,7 +19,8 @@ enum class EventKind {
   kObjectAdded,       ///< geometric change detection (issue 5)
   kObjectRemoved,
   kObjectMoved,
-  kFrozenDofMotion,   ///< implausible motion
+  kFrozenDofMotion,   ///< implausible motion of a foreground object (issue 12)
+  kObjectPromoted,    ///< a touched object moved by a hand became a foreground object (issue 12)
 };
 
 const char* to_string(EventLevel level);

@@ -2,8 +2,10 @@
 /// What segmentation finds and what the working memory keeps: planes and objects.
 #include <cstdint>
 #include <string>
+#include <optional>
 #include <vector>
 
+#include "scenewatch/core/dof.h"
 #include "scenewatch/core/geometry.h"
 
 namespace scenewatch {
@@ -35,7 +37,26 @@ struct ObjectCluster {
   Eigen::Vector3f mean_rgb = Eigen::Vector3f::Zero();  ///< 0..255
 };
 
-/// An object the working memory keeps track of across frames (cluster level for now).
+/// One episode of a person handling a foreground object, from the first touch to the release.
+struct Handling {
+  double start_s = 0.0;
+  double end_s = 0.0;      ///< 0 while it goes on
+  DofVector range{};       ///< max - min per DoF over the episode (m, degrees), in the support frame
+  DofFlags moved{};        ///< range above the noise level
+};
+
+/// What the foreground knows of an object a hand touched and moved (issue 12).
+struct ForegroundState {
+  Pose T_world_object = Pose::Identity();  ///< its model's frame (origin at its centroid when promoted)
+  DofFlags free{};                         ///< false: frozen (never seen moving while handled)
+  std::vector<Handling> handlings;         ///< oldest first
+  bool in_hand = false;
+  bool visible = true;                     ///< registered in the last frame
+  double promoted_s = 0.0;
+  std::size_t model_points = 0;
+};
+
+/// An object the working memory keeps track of across frames.
 struct TrackedObject {
   std::uint64_t id = 0;
   ObjectCluster cluster;              ///< last observation, in world coordinates
@@ -44,6 +65,7 @@ struct TrackedObject {
   int observations = 0;
   /// Id of the object it stands on (a box on a box); 0: it stands on its plane.
   std::uint64_t supported_by = 0;
+  std::optional<ForegroundState> foreground;  ///< set once a hand touched and moved it
 };
 
 }  // namespace scenewatch

@@ -56,6 +56,8 @@ class ObjectTracker {
   void restore(std::vector<TrackedObject> objects, std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples,
                std::uint64_t next_id);
   std::uint64_t next_id() const { return next_id_; }
+  /// Forgets a confirmed object (it became a foreground object, which the foreground tracks).
+  void remove(std::uint64_t id);
   void reset();
 
  private:

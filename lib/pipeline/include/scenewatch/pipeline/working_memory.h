@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <shared_mutex>
 #include <vector>
 
@@ -20,6 +21,7 @@
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
+#include "scenewatch/foreground/foreground_tracker.h"
 #include "scenewatch/pipeline/event_fusion.h"
 #include "scenewatch/pipeline/object_tracker.h"
 #include "scenewatch/segmentation/tabletop.h"
@@ -40,6 +42,7 @@ struct Config {
   surprise::SurpriseConfig surprise;        ///< image-based Bayesian surprise
   std::size_t max_event_log = 10000;  ///< events kept in memory for GetEvents
   FusionConfig fusion;                ///< one fact, one event (the `events:` section)
+  foreground::ForegroundConfig foreground;  ///< hands, promotion, tracking, DoFs (issue 12)
 };
 
 /// The image-based surprise of one observation against the appearance memory.
@@ -72,15 +75,36 @@ struct FrameResult {
   background::InsertStats insert_stats;
   std::shared_ptr<const SurpriseResult> surprise;  ///< null: the frame had no pose or no keyframes existed yet
   double segment_ms = 0, insert_ms = 0, surprise_ms = 0, change_ms = 0, total_ms = 0;
+  double hands_ms = 0, foreground_ms = 0;  ///< hand detection; foreground registration and promotion
+  std::size_t hands = 0;                   ///< hands found in the frame
   std::size_t change_candidates = 0;  ///< changes seen but not yet confirmed
 };
 
 /// An immutable view of the scene, swapped atomically after each frame: readers never wait for
 /// a frame being processed.
+/// A hand (with its forearm) as a planner sees it: where not to reach.
+struct HandSeen {
+  Aabb box_world;
+  Eigen::Vector3d tip_world = Eigen::Vector3d::Zero();
+  double score = 0.0;
+  std::size_t pixels = 0;
+  bool enters_from_border = false;
+};
+
+/// The hands and the person of the last frame that had colour.
+struct HandsSeen {
+  std::uint64_t frame_index = 0;
+  double stamp_s = 0.0;
+  std::vector<HandSeen> hands;
+  std::size_t person_pixels = 0;
+  std::optional<Aabb> person_box_world;
+};
+
 struct SceneSnapshot {
   std::uint64_t frames_processed = 0;
   std::vector<Plane> planes;            ///< from the last frame, world frame
-  std::vector<TrackedObject> objects;   ///< tracked objects, world frame
+  std::vector<TrackedObject> objects;   ///< background objects, then foreground ones (foreground set), world frame
+  HandsSeen hands;
   double last_stamp_s = 0.0;
 };
 

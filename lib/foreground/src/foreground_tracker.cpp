@@ -1,0 +1,534 @@
+// Touched objects, their promotion to the foreground, their tracking and their handlings.
+#include "scenewatch/foreground/foreground_tracker.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <unordered_set>
+
+#include "voxel_set.h"
+
+namespace scenewatch::foreground {
+namespace {
+
+constexpr double kDegPerRad = 180.0 / M_PI;
+constexpr double kQuietMarginM = 0.05;    // background changes this close to a foreground object are its doing
+constexpr double kSupportBandM = 0.012;   // frame points this close to a supporting plane are the plane's
+constexpr double kMaxObjectExtentM = 0.6;  // a touched cluster larger than this is furniture, not an object
+constexpr double kSeenThroughM = 0.02;     // a pixel this much deeper than a point sees through it
+
+Eigen::Vector3d world(const PointT& p, const Pose& T) { return T * p.getVector3fMap().cast<double>(); }
+
+// The support frame: z along `up`, x along the world x (or y) projected on the plane.
+Pose support_frame(const Eigen::Vector3d& up) {
+  const Eigen::Vector3d z = up.normalized();
+  Eigen::Vector3d x = Eigen::Vector3d::UnitX() - z.x() * z;
+  if (x.norm() < 0.3) x = Eigen::Vector3d::UnitY() - z.y() * z;
+  x.normalize();
+  Pose T = Pose::Identity();
+  T.linear().col(0) = x;
+  T.linear().col(1) = z.cross(x);
+  T.linear().col(2) = z;
+  return T;
+}
+
+double rotation_deg(const Pose& a, const Pose& b) {
+  return Eigen::AngleAxisd(a.linear() * b.linear().transpose()).angle() * kDegPerRad;
+}
+
+Aabb bounds(const std::vector<Eigen::Vector3d>& pts) {
+  Aabb box{Eigen::Vector3d::Constant(1e30), Eigen::Vector3d::Constant(-1e30)};
+  for (const auto& p : pts) {
+    box.min = box.min.cwiseMin(p);
+    box.max = box.max.cwiseMax(p);
+  }
+  return box;
+}
+
+// Keeps one point per voxel (the first), at most `max_points`.
+CloudPtr thinned(const Cloud& in, double voxel, std::size_t max_points) {
+  auto out = std::make_shared<Cloud>();
+  VoxelSet seen(voxel);
+  for (const auto& p : in.points) {
+    if (!seen.insert(p.getVector3fMap().cast<double>())) continue;
+    out->push_back(p);
+  }
+  if (out->size() > max_points) {
+    auto every = std::make_shared<Cloud>();
+    const double step = static_cast<double>(out->size()) / max_points;
+    for (double i = 0; i < out->size() && every->size() < max_points; i += step) every->push_back(out->points[static_cast<std::size_t>(i)]);
+    out = every;
+  }
+  out->width = static_cast<std::uint32_t>(out->size());
+  out->height = 1;
+  return out;
+}
+
+std::vector<Eigen::Vector3d> posed_points(const Cloud& model, const Pose& T) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(model.size());
+  for (const auto& p : model.points) out.push_back(world(p, T));
+  return out;
+}
+
+// The frame's points near a centre: thinned (registration target) and all of them (pixel index
+// and world position), without agents and without the supporting planes' surfaces.
+struct Crop {
+  Cloud target;
+  std::vector<int> pixels;
+  std::vector<Eigen::Vector3d> points;
+};
+
+Crop crop(const FrameView& f, const Eigen::Vector3d& centre_world, double radius, double voxel) {
+  Crop c;
+  const Pose& T = f.T_world_camera;
+  const Eigen::Vector3f centre_cam = (T.inverse() * centre_world).cast<float>();
+  const float r2 = static_cast<float>(radius * radius);
+  std::vector<const Plane*> supports;
+  if (f.planes) {
+    for (const auto& pl : *f.planes) {
+      if (pl.normal.dot(f.up_world) > 0.9) supports.push_back(&pl);
+    }
+  }
+  VoxelSet kept(voxel);
+  const Cloud& cloud = *f.cloud;
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const PointT& p = cloud.points[i];
+    if (!is_valid(p) || (p.getVector3fMap() - centre_cam).squaredNorm() > r2) continue;
+    if (f.hands && f.hands->is_agent(static_cast<int>(i))) continue;
+    const Eigen::Vector3d w = world(p, T);
+    bool on_support = false;
+    for (const Plane* pl : supports) on_support = on_support || std::abs(pl->signed_distance(w)) < kSupportBandM;
+    if (on_support) continue;
+    c.pixels.push_back(static_cast<int>(i));
+    c.points.push_back(w);
+    if (!kept.insert(w)) continue;
+    PointT q = p;
+    q.getVector3fMap() = w.cast<float>();
+    c.target.push_back(q);
+  }
+  c.target.width = static_cast<std::uint32_t>(c.target.size());
+  c.target.height = 1;
+  return c;
+}
+
+}  // namespace
+
+struct ForegroundTracker::Impl {
+  explicit Impl(ForegroundConfig c) : config(std::move(c)) {}
+
+  struct Object {
+    std::uint64_t id = 0;
+    bool promoted = false;
+    CloudPtr model;                       // object frame, with colour
+    Pose T = Pose::Identity();            // T_world_object now
+    Pose T_home = Pose::Identity();       // where it stood when first touched
+    Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // per frame
+    bool visible = true;
+    bool in_hand = false;
+    std::vector<int> pixels;              // this frame
+    std::optional<HandlingRecorder> handling;
+    bool handling_raised = false;
+    std::uint64_t last_contact = 0;
+    std::vector<Handling> handlings;
+    DofFlags free{};
+    TrackedObject info;                   // what GetObjects shows
+  };
+
+  ForegroundConfig config;
+  std::vector<Object> objects;  // candidates and foreground objects, in the order first touched
+  Pose T_support = Pose::Identity();
+
+  Registration locate(Object& o, const FrameView& f, const Pose& guess, Crop& c) {
+    c = crop(f, guess.translation(), config.search_radius_m, config.target_voxel_m);
+    return register_model(*o.model, c.target, guess, f.T_world_camera.translation(), config.registration, f.up_world);
+  }
+
+  // The frame's pixels on the registered model.
+  std::vector<int> pixels_on(const Object& o, const Crop& c) const {
+    VoxelSet surface(config.mask_m);
+    for (const auto& p : posed_points(*o.model, o.T)) surface.insert(p);
+    std::vector<int> out;
+    for (std::size_t i = 0; i < c.points.size(); ++i) {
+      if (surface.near(c.points[i])) out.push_back(c.pixels[i]);
+    }
+    return out;
+  }
+
+  // The share of the model, placed where it stood, that the frame still sees filled: of the
+  // points the frame observes (neither hidden behind something nearer nor without depth), those
+  // whose pixel holds a surface at their depth; the others are seen through, hence empty.
+  double still_filled(const Object& o, const FrameView& f) const {
+    const auto home = posed_points(*o.model, o.T_home);
+    if (home.empty()) return 1.0;
+    if (!f.K || f.cloud->height <= 1) {
+      const Crop c = crop(f, o.T_home.translation(), config.search_radius_m, config.target_voxel_m);
+      VoxelSet frame(config.registration.inlier_m * 1.5);
+      for (const auto& p : c.points) frame.insert(p);
+      std::size_t filled = 0;
+      for (const auto& p : home) filled += frame.near(p) ? 1 : 0;
+      return static_cast<double>(filled) / home.size();
+    }
+    const Pose T_cw = f.T_world_camera.inverse();
+    const Cloud& cloud = *f.cloud;
+    // Pixels on the object where it is now say nothing about its old place (a cup lifted by less
+    // than its height still covers most of where it stood).
+    const std::unordered_set<int> itself(o.pixels.begin(), o.pixels.end());
+    std::size_t filled = 0, empty = 0;
+    for (const auto& pw : home) {
+      const Eigen::Vector3d p = T_cw * pw;
+      if (p.z() <= 0) continue;
+      const int u = static_cast<int>(std::lround(f.K->fx * p.x() / p.z() + f.K->cx));
+      const int v = static_cast<int>(std::lround(f.K->fy * p.y() / p.z() + f.K->cy));
+      if (u < 0 || v < 0 || u >= static_cast<int>(cloud.width) || v >= static_cast<int>(cloud.height)) continue;
+      const int i = v * static_cast<int>(cloud.width) + u;
+      const PointT& q = cloud.points[static_cast<std::size_t>(i)];
+      if (!is_valid(q) || (f.hands && f.hands->is_agent(i)) || itself.count(i)) continue;
+      const double depth = q.z;
+      if (depth > p.z() + kSeenThroughM) ++empty;
+      else if (depth > p.z() - kSeenThroughM) ++filled;
+      // nearer: hidden behind something, unknown
+    }
+    const std::size_t observed = filled + empty;
+    if (observed < std::max<std::size_t>(10, home.size() / 10)) return 1.0;  // too little of it seen to tell
+    return static_cast<double>(filled) / observed;
+  }
+
+  void refresh_info(Object& o, double stamp_s) {
+    const auto pts = posed_points(*o.model, o.T);
+    const Aabb box = bounds(pts);
+    ObjectCluster& c = o.info.cluster;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (const auto& p : pts) sum += p;
+    c.centroid = pts.empty() ? o.T.translation() : Eigen::Vector3d(sum / pts.size());
+    c.box.center = box.center();
+    c.box.rotation = Eigen::Quaterniond::Identity();
+    c.box.extents = box.max - box.min;
+    c.point_count = o.pixels.size();
+    if (o.visible) o.info.last_seen_s = stamp_s;
+    if (!o.info.foreground) o.info.foreground = ForegroundState{};
+    ForegroundState& s = *o.info.foreground;
+    s.T_world_object = o.T;
+    s.free = o.free;
+    s.handlings = o.handlings;
+    if (o.handling) s.handlings.push_back(o.handling->handling(0.0, config.dof));
+    s.in_hand = o.in_hand;
+    s.visible = o.visible;
+    s.model_points = o.model->size();
+  }
+
+  Event event_for(const Object& o, EventKind kind, EventLevel level, const FrameView& f) const {
+    Event e;
+    e.kind = kind;
+    e.level = level;
+    e.stamp_s = f.stamp_s;
+    e.object_id = o.id;
+    const auto pts = posed_points(*o.model, o.T);
+    e.box_world = bounds(pts);
+    e.centroid_world = e.box_world.center();
+    e.evidence["frame"] = static_cast<double>(f.frame_index);
+    return e;
+  }
+
+  // The handling of one object in this frame: start, record, raise, end.
+  void handle(Object& o, bool contact, const FrameView& f, ForegroundUpdate& out) {
+    if (contact) {
+      o.last_contact = f.frame_index;
+      if (!o.handling) {
+        o.handling.emplace(T_support, o.T, f.stamp_s);
+        o.handling_raised = false;
+      }
+    }
+    if (!o.handling) return;
+    if (o.visible) {
+      const DofFlags fresh = o.handling->add(o.T, config.dof);
+      const bool learning = o.handlings.empty();
+      if (o.promoted && !learning && !o.handling_raised) raise_frozen(o, fresh, f, out);
+    }
+    if (f.frame_index - o.last_contact > static_cast<std::uint64_t>(config.release_frames)) {
+      const Handling h = o.handling->handling(f.stamp_s, config.dof);
+      if (o.promoted) {
+        for (std::size_t k = 0; k < h.moved.size(); ++k) o.free[k] = o.free[k] || h.moved[k];
+        o.handlings.push_back(h);
+      }
+      o.handling.reset();
+    }
+  }
+
+  void raise_frozen(Object& o, const DofFlags& fresh, const FrameView& f, ForegroundUpdate& out) {
+    const Handling now = o.handling->handling(0.0, config.dof);
+    int worst = -1;
+    double worst_ratio = 0;
+    std::string named;
+    for (int k = 0; k < kDofCount; ++k) {
+      const auto ks = static_cast<std::size_t>(k);
+      if (!fresh[ks] || o.free[ks]) continue;
+      const double ratio = now.range[ks] / (k < 3 ? config.dof.translation_m : config.dof.rotation_deg);
+      named += (named.empty() ? "" : ", ") + std::string(to_string(static_cast<Dof>(k)));
+      if (ratio > worst_ratio) worst_ratio = ratio, worst = k;
+    }
+    if (worst < 0) return;
+    Event e = event_for(o, EventKind::kFrozenDofMotion, EventLevel::kImplausibility, f);
+    const auto ws = static_cast<std::size_t>(worst);
+    e.score = worst_ratio;
+    std::ostringstream detail;
+    detail.precision(3);
+    detail << "motion in frozen DoF " << to_string(static_cast<Dof>(worst)) << ": " << now.range[ws]
+           << (worst < 3 ? " m" : " deg") << " (frozen DoFs that moved: " << named << ")";
+    e.detail = detail.str();
+    e.evidence["dof"] = worst;
+    e.evidence["magnitude"] = now.range[ws];
+    e.evidence["handling"] = static_cast<double>(o.handlings.size());
+    for (int k = 0; k < kDofCount; ++k) e.evidence[std::string("range_") + to_string(static_cast<Dof>(k))] = now.range[static_cast<std::size_t>(k)];
+    out.events.push_back(std::move(e));
+    o.handling_raised = true;
+  }
+
+  void promote(Object& o, const FrameView& f, double moved_m, double turned_deg, double filled, ForegroundUpdate& out) {
+    o.promoted = true;
+    o.info.foreground = ForegroundState{};
+    o.info.foreground->promoted_s = f.stamp_s;
+    Event e = event_for(o, EventKind::kObjectPromoted, EventLevel::kPrediction, f);
+    e.score = std::max(moved_m / config.promote_translation_m, turned_deg / config.promote_rotation_deg);
+    std::ostringstream detail;
+    detail.precision(3);
+    detail << "touched by a hand and moved " << moved_m << " m, turned " << turned_deg << " deg; its old place is "
+           << 100 * (1 - filled) << " % empty";
+    e.detail = detail.str();
+    e.evidence["moved_m"] = moved_m;
+    e.evidence["turned_deg"] = turned_deg;
+    e.evidence["model_points"] = static_cast<double>(o.model->size());
+    e.displacement_world = o.T.translation() - o.T_home.translation();
+    out.events.push_back(std::move(e));
+    out.vacated.push_back(posed_points(*o.model, o.T_home));
+    out.promoted.push_back(o.id);
+  }
+
+  // A lost foreground object among the frame's clusters near its last place.
+  void reacquire(Object& o, const FrameView& f, const std::vector<ObjectCluster>& clusters,
+                 std::vector<bool>& claimed, ForegroundUpdate& out) {
+    const Aabb model_box = bounds(posed_points(*o.model, Pose::Identity()));
+    const double model_size = (model_box.max - model_box.min).norm();
+    Registration best;
+    std::size_t best_cluster = clusters.size();
+    for (std::size_t ci = 0; ci < clusters.size(); ++ci) {
+      const ObjectCluster& c = clusters[ci];
+      if (claimed[ci] || (c.centroid - o.T.translation()).norm() > config.reacquire_radius_m) continue;
+      if (c.box.extents.norm() > 2.5 * model_size) continue;
+      Cloud target;
+      for (int i : c.indices) {
+        PointT q = f.cloud->points[static_cast<std::size_t>(i)];
+        q.getVector3fMap() = world(q, f.T_world_camera).cast<float>();
+        target.push_back(q);
+      }
+      target = *thinned(target, config.target_voxel_m, 20000);
+      for (int turn = 0; turn < 4; ++turn) {
+        Pose guess = o.T;
+        guess.linear() = Eigen::AngleAxisd(turn * M_PI / 2, f.up_world).toRotationMatrix() * o.T.linear();
+        guess.translation() = c.centroid;
+        const Registration r = register_model(*o.model, target, guess, f.T_world_camera.translation(), config.registration, f.up_world);
+        if (r.ok && r.inlier_fraction > best.inlier_fraction) best = r, best_cluster = ci;
+      }
+    }
+    if (best_cluster == clusters.size()) return;
+    o.T = best.T_world_object;
+    o.visible = true;
+    o.velocity.setZero();
+    claimed[best_cluster] = true;
+    out.claimed_clusters.push_back(best_cluster);
+    o.pixels = clusters[best_cluster].indices;
+  }
+};
+
+Status validate(const ForegroundConfig& c) {
+  if (auto st = validate(c.hands); !st) return st;
+  auto positive = [](double v) { return std::isfinite(v) && v > 0; };
+  if (!positive(c.contact_m) || c.contact_m > 0.5) return invalid_argument("foreground.contact_m: must be in (0, 0.5] m");
+  if (!positive(c.promote_translation_m)) return invalid_argument("foreground.promote_translation_m: must be > 0");
+  if (!positive(c.promote_rotation_deg)) return invalid_argument("foreground.promote_rotation_deg: must be > 0");
+  if (!(c.vacated_fraction > 0 && c.vacated_fraction <= 1)) return invalid_argument("foreground.vacated_fraction: must be in (0, 1]");
+  if (!positive(c.dof.translation_m)) return invalid_argument("foreground.dof_translation_m: must be > 0");
+  if (!positive(c.dof.rotation_deg)) return invalid_argument("foreground.dof_rotation_deg: must be > 0");
+  if (c.release_frames < 1 || c.touch_timeout_frames < 1) return invalid_argument("foreground.release_frames and touch_timeout_frames: must be >= 1");
+  if (!positive(c.search_radius_m) || c.search_radius_m > 2) return invalid_argument("foreground.search_radius_m: must be in (0, 2] m");
+  if (!positive(c.mask_m) || !positive(c.model_voxel_m) || !positive(c.target_voxel_m)) return invalid_argument("foreground.mask_m, model_voxel_m, target_voxel_m: must be > 0");
+  if (c.max_model_points < 50) return invalid_argument("foreground.max_model_points: must be >= 50");
+  return {};
+}
+
+ForegroundTracker::ForegroundTracker(ForegroundConfig config) : impl_(std::make_unique<Impl>(std::move(config))) {}
+ForegroundTracker::~ForegroundTracker() = default;
+ForegroundTracker::ForegroundTracker(ForegroundTracker&&) noexcept = default;
+ForegroundTracker& ForegroundTracker::operator=(ForegroundTracker&&) noexcept = default;
+
+std::vector<int> ForegroundTracker::track(const FrameView& f) {
+  Impl& m = *impl_;
+  m.T_support = support_frame(f.up_world);
+  std::vector<int> pixels;
+  for (auto& o : m.objects) {
+    Pose guess = o.T;
+    guess.translation() += o.velocity;
+    Crop c;
+    const Registration r = m.locate(o, f, guess, c);
+    o.pixels.clear();
+    if (!r.ok) {
+      o.visible = false;
+      o.velocity.setZero();
+      continue;
+    }
+    const Eigen::Vector3d step = r.T_world_object.translation() - o.T.translation();
+    o.velocity = step.norm() < m.config.search_radius_m / 2 ? step : Eigen::Vector3d::Zero();
+    o.T = r.T_world_object;
+    o.visible = true;
+    o.pixels = m.pixels_on(o, c);
+    if (o.promoted) pixels.insert(pixels.end(), o.pixels.begin(), o.pixels.end());
+  }
+  return pixels;
+}
+
+ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector<ObjectCluster>& clusters,
+                                           const std::vector<TrackedObject>& known) {
+  Impl& m = *impl_;
+  const ForegroundConfig& cfg = m.config;
+  ForegroundUpdate out;
+  std::vector<bool> claimed(clusters.size(), false);
+
+  // Where the hands are: the hand proper (the forearm touches nothing it carries).
+  VoxelSet hand(cfg.contact_m);
+  bool any_hand = false;
+  if (f.hands) {
+    for (const auto& h : f.hands->hands) {
+      for (int i : h.tip_indices.empty() ? h.indices : h.tip_indices) {
+        const PointT& p = f.cloud->points[static_cast<std::size_t>(i)];
+        if (!is_valid(p)) continue;
+        hand.insert(world(p, f.T_world_camera));
+        any_hand = true;
+      }
+    }
+  }
+  auto touches = [&](const std::vector<Eigen::Vector3d>& pts) {
+    if (!any_hand) return false;
+    for (const auto& p : pts)
+      if (hand.near(p)) return true;
+    return false;
+  };
+
+  // Lost foreground objects first: their clusters are theirs, not new background objects.
+  for (auto& o : m.objects) {
+    if (o.promoted && !o.visible) m.reacquire(o, f, clusters, claimed, out);
+  }
+
+  // New candidates: background objects a hand touches.
+  if (any_hand) {
+    for (std::size_t ci = 0; ci < clusters.size(); ++ci) {
+      const ObjectCluster& c = clusters[ci];
+      if (claimed[ci] || c.box.extents.maxCoeff() > kMaxObjectExtentM) continue;
+      std::vector<Eigen::Vector3d> pts;
+      pts.reserve(c.indices.size());
+      for (int i : c.indices) pts.push_back(world(f.cloud->points[static_cast<std::size_t>(i)], f.T_world_camera));
+      if (!touches(pts)) continue;
+      const TrackedObject* match = nullptr;
+      double best = 0.06;
+      for (const auto& k : known) {
+        const double d = (k.cluster.centroid - c.centroid).norm();
+        if (d < best) best = d, match = &k;
+      }
+      if (!match) continue;
+      const bool already = std::any_of(m.objects.begin(), m.objects.end(), [&](const auto& o) { return o.id == match->id; });
+      if (already) continue;
+      Impl::Object o;
+      o.id = match->id;
+      o.info = *match;
+      o.info.foreground.reset();
+      Cloud local;
+      for (int i : c.indices) {
+        PointT q = f.cloud->points[static_cast<std::size_t>(i)];
+        q.getVector3fMap() = (world(q, f.T_world_camera) - c.centroid).cast<float>();
+        local.push_back(q);
+      }
+      o.model = thinned(local, cfg.model_voxel_m, cfg.max_model_points);
+      o.T.translation() = c.centroid;
+      o.T_home = o.T;
+      o.pixels = c.indices;
+      o.last_contact = f.frame_index;
+      m.objects.push_back(std::move(o));
+    }
+  }
+
+  // Contacts, handlings, promotion, and the candidates that were touched but never moved.
+  for (auto& o : m.objects) {
+    const bool contact = touches(posed_points(*o.model, o.T));
+    o.in_hand = contact;
+    m.handle(o, contact, f, out);
+    if (!o.promoted && o.visible) {
+      const double moved = (o.T.translation() - o.T_home.translation()).norm();
+      const double turned = rotation_deg(o.T, o.T_home);
+      if (moved > cfg.promote_translation_m || turned > cfg.promote_rotation_deg) {
+        const double filled = m.still_filled(o, f);
+        if (filled <= 1.0 - cfg.vacated_fraction) m.promote(o, f, moved, turned, filled, out);
+      }
+    }
+  }
+  m.objects.erase(std::remove_if(m.objects.begin(), m.objects.end(), [&](const Impl::Object& o) {
+                    return !o.promoted && f.frame_index - o.last_contact > static_cast<std::uint64_t>(cfg.touch_timeout_frames);
+                  }), m.objects.end());
+
+  for (auto& o : m.objects) {
+    if (o.promoted) m.refresh_info(o, f.stamp_s);
+    const Aabb now = bounds(posed_points(*o.model, o.T)).grown(kQuietMarginM);
+    out.quiet_boxes.push_back(now);
+    out.quiet_boxes.push_back(bounds(posed_points(*o.model, o.T_home)).grown(kQuietMarginM));
+  }
+  // Clusters that are (mostly) a foreground object's pixels are not background objects.
+  std::unordered_set<int> mine;
+  for (const auto& o : m.objects)
+    if (o.promoted) mine.insert(o.pixels.begin(), o.pixels.end());
+  for (std::size_t ci = 0; ci < clusters.size(); ++ci) {
+    if (claimed[ci] || mine.empty()) continue;
+    std::size_t n = 0;
+    for (int i : clusters[ci].indices) n += mine.count(i);
+    if (2 * n > clusters[ci].indices.size()) out.claimed_clusters.push_back(ci);
+  }
+  return out;
+}
+
+std::vector<TrackedObject> ForegroundTracker::objects() const {
+  std::vector<TrackedObject> out;
+  for (const auto& o : impl_->objects)
+    if (o.promoted) out.push_back(o.info);
+  return out;
+}
+
+std::vector<std::uint64_t> ForegroundTracker::candidates() const {
+  std::vector<std::uint64_t> out;
+  for (const auto& o : impl_->objects)
+    if (!o.promoted) out.push_back(o.id);
+  return out;
+}
+
+CloudConstPtr ForegroundTracker::model(std::uint64_t id) const {
+  for (const auto& o : impl_->objects)
+    if (o.id == id) return o.model;
+  return nullptr;
+}
+
+void ForegroundTracker::restore(const TrackedObject& object, CloudConstPtr model) {
+  Impl::Object o;
+  o.id = object.id;
+  o.promoted = true;
+  o.model = std::make_shared<Cloud>(*model);
+  o.info = object;
+  if (object.foreground) {
+    o.T = object.foreground->T_world_object;
+    o.free = object.foreground->free;
+    for (const auto& h : object.foreground->handlings)
+      if (h.end_s > 0) o.handlings.push_back(h);
+  }
+  o.T_home = o.T;
+  o.visible = false;
+  impl_->objects.push_back(std::move(o));
+}
+
+void ForegroundTracker::reset() { impl_->objects.clear(); }
+
+}  // namespace scenewatch::foreground

@@ -1,0 +1,41 @@
+#pragma once
+// A set of occupied voxels for "is there a point within about one voxel of p" questions: cheaper
+// than a k-d tree for the few thousand points of an object or a hand.
+#include <cmath>
+#include <cstdint>
+#include <unordered_set>
+
+#include <Eigen/Core>
+
+namespace scenewatch::foreground {
+
+class VoxelSet {
+ public:
+  explicit VoxelSet(double voxel_m) : inv_(1.0 / voxel_m) {}
+  /// Inserts the voxel of p; false when it was already there.
+  bool insert(const Eigen::Vector3d& p) { return set_.insert(key(cell(p))).second; }
+  /// True when p's voxel or one of its 26 neighbours holds a point (within 1 to 2.6 voxels).
+  bool near(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3i c = cell(p);
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz)
+          if (set_.count(key(c + Eigen::Vector3i(dx, dy, dz)))) return true;
+    return false;
+  }
+  bool empty() const { return set_.empty(); }
+
+ private:
+  Eigen::Vector3i cell(const Eigen::Vector3d& p) const {
+    return {static_cast<int>(std::floor(p.x() * inv_)), static_cast<int>(std::floor(p.y() * inv_)),
+            static_cast<int>(std::floor(p.z() * inv_))};
+  }
+  static std::uint64_t key(const Eigen::Vector3i& c) {
+    const auto u = [](int v) { return static_cast<std::uint64_t>(static_cast<std::uint32_t>(v + (1 << 20)) & 0x1FFFFF); };
+    return u(c.x()) | (u(c.y()) << 21) | (u(c.z()) << 42);
+  }
+  double inv_;
+  std::unordered_set<std::uint64_t> set_;
+};
+
+}  // namespace scenewatch::foreground

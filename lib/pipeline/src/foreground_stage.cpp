@@ -1,0 +1,116 @@
+#include "foreground_stage.h"
+
+#include <limits>
+
+#include "timing.h"
+
+namespace scenewatch::pipeline {
+
+Eigen::Vector3d up_direction(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
+                             const Eigen::Vector3d& camera_world) {
+  if (configured && configured->norm() > 0) return configured->normalized();
+  const Plane* largest = nullptr;
+  for (const auto& p : planes) {
+    if (!largest || p.area_m2 > largest->area_m2) largest = &p;
+  }
+  if (!largest) return Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d n = largest->normal.normalized();
+  return n.dot(camera_world - largest->centroid) >= 0 ? n : Eigen::Vector3d(-n);
+}
+
+namespace {
+
+HandsSeen summarise(const foreground::HandDetection& d, const Cloud& cloud, const Pose& T, std::uint64_t index, double stamp_s) {
+  HandsSeen s;
+  s.frame_index = index;
+  s.stamp_s = stamp_s;
+  auto box_of = [&](const std::vector<int>& pixels) {
+    Aabb box{Eigen::Vector3d::Constant(1e30), Eigen::Vector3d::Constant(-1e30)};
+    for (int i : pixels) {
+      const PointT& p = cloud.points[static_cast<std::size_t>(i)];
+      if (!is_valid(p)) continue;
+      const Eigen::Vector3d w = T * p.getVector3fMap().cast<double>();
+      box.min = box.min.cwiseMin(w);
+      box.max = box.max.cwiseMax(w);
+    }
+    return box;
+  };
+  for (const auto& h : d.hands) {
+    HandSeen hs;
+    hs.box_world = box_of(h.indices);
+    hs.tip_world = T * h.tip_camera;
+    hs.score = h.score;
+    hs.pixels = h.indices.size();
+    hs.enters_from_border = h.enters_from_border;
+    if (hs.box_world.valid()) s.hands.push_back(hs);
+  }
+  s.person_pixels = d.person_indices.size();
+  if (!d.person_indices.empty()) {
+    const Aabb b = box_of(d.person_indices);
+    if (b.valid()) s.person_box_world = b;
+  }
+  return s;
+}
+
+}  // namespace
+
+Frame ForegroundStage::prepare(const Frame& frame, std::uint64_t frame_index, const std::vector<Plane>& planes,
+                               const std::optional<Eigen::Vector3d>& configured_up, FrameResult& result) {
+  const Pose T = frame.pose_or_identity();
+  cloud_ = frame.cloud;
+  planes_ = planes;
+  view_ = foreground::FrameView{};
+  view_.cloud = cloud_.get();
+  view_.T_world_camera = T;
+  view_.stamp_s = frame.stamp_s;
+  view_.frame_index = frame_index;
+  view_.planes = &planes_;
+  view_.up_world = up_direction(configured_up, planes, T.translation());
+  K_ = frame.intrinsics;
+  view_.K = K_ ? &*K_ : nullptr;
+  detection_ = foreground::HandDetection{};
+  if (!config_.enabled) return frame;
+
+  const auto t_hands = Clock::now();
+  if (config_.hands.enabled && frame.has_color && frame.cloud->height > 1) {
+    detection_ = foreground::detect_hands(*frame.cloud, config_.hands);
+  }
+  view_.hands = &detection_;
+  result.hands_ms = ms_since(t_hands);
+  result.hands = detection_.hands.size();
+  if (!detection_.labels.empty()) hands_ = summarise(detection_, *frame.cloud, T, frame_index, frame.stamp_s);
+
+  const auto t_track = Clock::now();
+  std::vector<int> blank = tracker_.track(view_);
+  result.foreground_ms = ms_since(t_track);
+  for (std::size_t i = 0; i < detection_.labels.size(); ++i) {
+    if (detection_.labels[i] != foreground::AgentLabel::kNone) blank.push_back(static_cast<int>(i));
+  }
+  if (blank.empty()) return frame;
+  auto masked = std::make_shared<Cloud>(*frame.cloud);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int i : blank) {
+    PointT& p = masked->points[static_cast<std::size_t>(i)];
+    p.x = p.y = p.z = nan;
+  }
+  Frame seen = frame;
+  seen.cloud = masked;
+  return seen;
+}
+
+foreground::ForegroundUpdate ForegroundStage::update(const std::vector<ObjectCluster>& clusters,
+                                                     const std::vector<TrackedObject>& known, FrameResult& result) {
+  if (!config_.enabled || !cloud_) return {};
+  const auto t0 = Clock::now();
+  auto out = tracker_.update(view_, clusters, known);
+  result.foreground_ms += ms_since(t0);
+  return out;
+}
+
+void ForegroundStage::reset() {
+  tracker_.reset();
+  hands_ = HandsSeen{};
+  cloud_.reset();
+}
+
+}  // namespace scenewatch::pipeline

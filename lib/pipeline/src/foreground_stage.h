@@ -1,0 +1,50 @@
+#pragma once
+// The foreground's part of a frame (issue 12): before the background stages, the hands, the
+// person and the registered foreground objects are found and blanked out of the frame the
+// background sees (they are neither background changes nor new objects, and never enter the
+// map); after the segmentation, contacts and promotion.
+#include <cstdint>
+#include <vector>
+
+#include "scenewatch/core/frame.h"
+#include "scenewatch/foreground/foreground_tracker.h"
+#include "scenewatch/pipeline/working_memory.h"
+
+namespace scenewatch::pipeline {
+
+class ForegroundStage {
+ public:
+  explicit ForegroundStage(const foreground::ForegroundConfig& config) : config_(config), tracker_(config) {}
+
+  /// Finds hands and registers the foreground objects; returns the frame without their pixels
+  /// (the frame itself when there are none). `planes` are the last frame's, world frame.
+  Frame prepare(const Frame& frame, std::uint64_t frame_index, const std::vector<Plane>& planes,
+                const std::optional<Eigen::Vector3d>& configured_up, FrameResult& result);
+
+  /// Contacts and promotion, after the segmentation (`clusters` world frame, indices into the frame).
+  foreground::ForegroundUpdate update(const std::vector<ObjectCluster>& clusters, const std::vector<TrackedObject>& known,
+                                      FrameResult& result);
+
+  const HandsSeen& hands() const { return hands_; }
+  foreground::ForegroundTracker& tracker() { return tracker_; }
+  const foreground::ForegroundTracker& tracker() const { return tracker_; }
+  void reset();
+
+ private:
+  foreground::ForegroundConfig config_;
+  foreground::ForegroundTracker tracker_;
+  // This frame's, between prepare() and update().
+  foreground::HandDetection detection_;
+  foreground::FrameView view_;
+  std::vector<Plane> planes_;
+  CloudConstPtr cloud_;
+  std::optional<Intrinsics> K_;
+  HandsSeen hands_;
+};
+
+/// The world's up direction: the configured one, else the normal of the largest supporting plane
+/// turned towards the camera, else +z.
+Eigen::Vector3d up_direction(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
+                             const Eigen::Vector3d& camera_world);
+
+}  // namespace scenewatch::pipeline
