@@ -6,7 +6,9 @@
 //  - saturation (max - min) / max >= 0.32 and R the largest channel (Kovac, Peer & Solina 2003,
 //    "Human skin colour clustering for face detection", R > G and R > B): a white table under warm
 //    light falls inside the Cr/Cb box but is unsaturated (hrt1's table measures 0.16-0.31, the
-//    real forearm 0.6-1.0, the simulator's light skin 0.35-0.40).
+//    real forearm 0.6-1.0, the simulator's light skin 0.35-0.40);
+//  - hue above ~6 degrees (G - B at least a tenth of R - B): skin hue lies in about 0-50 degrees
+//    (Sobottka & Pitas 1998), but its red end is where shaded red objects are.
 #include "skin_model.h"
 
 #include <algorithm>
@@ -20,12 +22,16 @@ namespace {
 constexpr int kMinY = 20;
 constexpr int kCrLow = 133, kCrHigh = 173, kCbLow = 77, kCbHigh = 127;
 constexpr double kMinSaturation = 0.32;
+constexpr double kMinHueRatio = 0.1;  // (G - B) / (R - B) = hue / 60 degrees
 
 bool skin_ycrcb(int y, int cr, int cb, int r, int g, int b) {
   if (y < kMinY || cr < kCrLow || cr > kCrHigh || cb < kCbLow || cb > kCbHigh) return false;
   if (r <= g || r <= b) return false;
   const int lo = std::min(g, b);
-  return (r - lo) >= kMinSaturation * r;
+  if ((r - lo) < kMinSaturation * r) return false;
+  // Hue at least ~6 degrees towards yellow: shaded saturated red (a red mug's stripes in shadow)
+  // passes the Cr/Cb box too, but has G barely above B.
+  return g > b && (g - b) >= kMinHueRatio * (r - b);
 }
 
 }  // namespace
