@@ -234,6 +234,14 @@ Eigen::Vector3d centroid_of(const Grid& g, const std::vector<int>& cells) {
   return cells.empty() ? c : Eigen::Vector3d(c / static_cast<double>(cells.size()));
 }
 
+/// Pixels from the mean image position of the cells to the nearest image border.
+double distance_to_border(const Grid& g, const std::vector<int>& cells) {
+  double u = 0, v = 0;
+  for (int i : cells) u += g.u_full(i), v += g.v_full(i);
+  u /= std::max<std::size_t>(1, cells.size()), v /= std::max<std::size_t>(1, cells.size());
+  return std::min({u, v, g.full_w - 1 - u, g.full_h - 1 - v});
+}
+
 }  // namespace
 
 HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
@@ -278,23 +286,45 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
   }
   SupportPlaneConfig plane_config;
   plane_config.tolerance_m = static_cast<float>(config.support_plane_tolerance_m);
-  std::vector<std::uint8_t> on_table, on_wall;
-  const std::vector<SupportPlane> planes = find_support_planes(g.p, g.valid, g.w, g.h, plane_config, &on_table);
+  // Planes are found on a coarser grid (every other cell; they are large, and RANSAC's cost is
+  // in the points), then a cell lies on one when its coarse cell is in a kept patch and the cell
+  // itself is within the tolerance.
+  const int cw = (g.w + 1) / 2, ch = (g.h + 1) / 2;
+  std::vector<Eigen::Vector3f> coarse_p(static_cast<std::size_t>(cw) * ch);
+  std::vector<std::uint8_t> coarse_valid(coarse_p.size(), 0);
+  for (int v = 0; v < ch; ++v) {
+    for (int u = 0; u < cw; ++u) {
+      const std::size_t fine = static_cast<std::size_t>(2 * v) * g.w + 2 * u;
+      coarse_p[static_cast<std::size_t>(v) * cw + u] = g.p[fine];
+      coarse_valid[static_cast<std::size_t>(v) * cw + u] = g.valid[fine];
+    }
+  }
+  std::vector<std::uint8_t> coarse_table, coarse_wall;
+  const std::vector<SupportPlane> planes = find_support_planes(coarse_p, coarse_valid, cw, ch, plane_config, &coarse_table);
   // Then walls: any plane covering a good part of what is left. A person's body is never that
   // large and flat; without this the body grows into a wall it stands close to.
-  std::vector<std::uint8_t> rest(n, 0);
-  for (std::size_t c = 0; c < n; ++c) rest[c] = g.valid[c] && !on_table[c];
+  std::vector<std::uint8_t> rest(coarse_p.size(), 0);
+  for (std::size_t c = 0; c < rest.size(); ++c) rest[c] = coarse_valid[c] && !coarse_table[c];
   SupportPlaneConfig wall_config = plane_config;
   wall_config.min_abs_normal_y = 0.0f;
   wall_config.min_fraction = kMinWallFraction;
-  (void)find_support_planes(g.p, rest, g.w, g.h, wall_config, &on_wall);
+  const std::vector<SupportPlane> walls = find_support_planes(coarse_p, rest, cw, ch, wall_config, &coarse_wall);
   // Distance to the table or floor, for telling an arm held up from an object lying there.
   std::vector<float> plane_distance(n, std::numeric_limits<float>::infinity());
   cv::Mat on_support(g.h, g.w, CV_8U, cv::Scalar(0));
-  for (std::size_t c = 0; c < n; ++c) {
-    if (!g.valid[c]) continue;
-    for (const SupportPlane& plane : planes) plane_distance[c] = std::min(plane_distance[c], std::abs(plane.distance(g.p[c])));
-    on_support.data[c] = on_table[c] || on_wall[c];
+  for (int gv = 0; gv < g.h; ++gv) {
+    for (int gu = 0; gu < g.w; ++gu) {
+      const std::size_t c = static_cast<std::size_t>(gv) * g.w + gu;
+      if (!g.valid[c]) continue;
+      for (const SupportPlane& plane : planes) plane_distance[c] = std::min(plane_distance[c], std::abs(plane.distance(g.p[c])));
+      const std::size_t coarse = static_cast<std::size_t>(gv / 2) * cw + gu / 2;
+      const float tolerance = plane_config.tolerance_at(g.p[c].z());
+      bool on = coarse_table[coarse] && plane_distance[c] < tolerance;
+      if (!on && coarse_wall[coarse]) {
+        for (const SupportPlane& wall : walls) on |= std::abs(wall.distance(g.p[c])) < tolerance;
+      }
+      on_support.data[c] = on;
+    }
   }
   cv::Mat near_support;
   cv::dilate(on_support, near_support, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
@@ -369,7 +399,9 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
         if (t[k] <= t_min + kEndSlabM) ends[0].push_back(cells[k]);
         if (t[k] >= t_max - kEndSlabM) ends[1].push_back(cells[k]);
       }
-      std::size_t best_size = 0;
+      // When both ends reach the border (one through a held object and a table edge), the arm
+      // enters at the end nearer the border: arms come from outside the view.
+      double best_border_distance = std::numeric_limits<double>::infinity();
       for (int e = 0; e < 2; ++e) {
         const Eigen::Vector3d end_point = centroid_of(g, ends[e]);
         const int id = ++scratch_id;
@@ -383,8 +415,9 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
           if (g.on_border(i, margin)) reaches = true;
           return true;
         });
-        if (reaches && body.size() > best_size) {
-          best_size = body.size();
+        const double border_distance = distance_to_border(g, ends[e]);
+        if (reaches && border_distance < best_border_distance) {
+          best_border_distance = border_distance;
           cand.entry = Entry::kBody;
           cand.entry_point = end_point;
         }
@@ -413,15 +446,8 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
         if (near <= kFreeArmMaxOnSupport * cells.size() && contact <= kFreeArmMaxContact * outline) {
           // No body in view: the arm comes from outside the image, so it enters at its end nearer
           // the border.
-          double border_distance[2];
-          for (int e = 0; e < 2; ++e) {
-            double u = 0, v = 0;
-            for (int i : ends[e]) u += g.u_full(i), v += g.v_full(i);
-            u /= ends[e].size(), v /= ends[e].size();
-            border_distance[e] = std::min({u, v, g.full_w - 1 - u, g.full_h - 1 - v});
-          }
           cand.entry = Entry::kFree;
-          cand.entry_point = centroid_of(g, ends[border_distance[0] <= border_distance[1] ? 0 : 1]);
+          cand.entry_point = centroid_of(g, ends[distance_to_border(g, ends[0]) <= distance_to_border(g, ends[1]) ? 0 : 1]);
         }
       }
     }
@@ -501,6 +527,9 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
     // Cells of other skin components may join: a face or bare legs are the person's.
     const std::vector<int> body = grow(g, cand.base_cells, jump, scratch, ++scratch_id, [&](int i) {
       if (grid_label[i] == AgentLabel::kHand || grid_label[i] == AgentLabel::kArm || near_support.data[i]) return false;
+      // Nor onto the table's plane beyond the patches found: where the plane fit missed part of
+      // the table (a missed body pixel is better than the table as a person).
+      if (plane_distance[i] < plane_config.tolerance_at(g.p[i].z())) return false;
       if (g.p[i].z() > config.person_max_range_m) return false;
       // Depth edges are smeared (mixed pixels ramp from the body to the wall behind it): the
       // body stays within this depth of the arm's entry.

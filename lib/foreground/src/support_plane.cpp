@@ -11,7 +11,11 @@
 namespace scenewatch::foreground {
 namespace {
 
-constexpr std::size_t kMaxScoringPoints = 3000;
+constexpr std::size_t kMaxScoringPoints = 1500;
+/// Adaptive stop (Fischler & Bolles 1981; Hartley & Zisserman, alg. 4.5): enough samples for a
+/// 99.9% chance that one of them was all inliers, given the best inlier ratio so far.
+constexpr double kConfidence = 0.999;
+constexpr int kMinIterations = 60;
 
 /// Small deterministic generator: the same frame gives the same planes.
 struct Lcg {
@@ -78,7 +82,8 @@ std::vector<SupportPlane> find_support_planes(const std::vector<Eigen::Vector3f>
     for (std::size_t i = 0; i < remaining.size(); i += stride) sample.push_back(remaining[i]);
     SupportPlane best;
     std::size_t best_count = 0;
-    for (int it = 0; it < config.iterations; ++it) {
+    int needed = config.iterations;
+    for (int it = 0; it < needed; ++it) {
       const int a = remaining[rng.next() % remaining.size()];
       const int b = remaining[rng.next() % remaining.size()];
       const int c = remaining[rng.next() % remaining.size()];
@@ -91,12 +96,18 @@ std::vector<SupportPlane> find_support_planes(const std::vector<Eigen::Vector3f>
       if (count > best_count) {
         best_count = count;
         best = hypothesis;
+        const double w = static_cast<double>(count) / sample.size();
+        const double all_inliers = w * w * w;
+        if (all_inliers > 1e-9 && all_inliers < 1.0) {
+          const double n = std::log(1.0 - kConfidence) / std::log(1.0 - all_inliers);
+          needed = std::min(config.iterations, std::max({it + 1, kMinIterations, static_cast<int>(std::ceil(n))}));
+        }
       }
     }
     if (best_count < 3) break;
     std::vector<int> inliers, outliers;
     for (int i : remaining) (std::abs(best.distance(points[i])) < config.tolerance_at(points[i].z()) ? inliers : outliers).push_back(i);
-    for (int pass = 0; pass < 2; ++pass) {  // least squares on the inliers, while it gains inliers
+    for (int pass = 0; pass < 3; ++pass) {  // least squares on the inliers, while it gains inliers
       SupportPlane refined = best;
       if (!refit(points, inliers, &refined) || std::abs(refined.normal.y()) < config.min_abs_normal_y ||
           std::abs(refined.d) < config.min_camera_distance_m) {
