@@ -11,11 +11,11 @@
 namespace scenewatch::foreground {
 namespace {
 
-constexpr std::size_t kMaxScoringPoints = 1500;
+constexpr std::size_t kMaxScoringPoints = 800;
 /// Adaptive stop (Fischler & Bolles 1981; Hartley & Zisserman, alg. 4.5): enough samples for a
 /// 99.9% chance that one of them was all inliers, given the best inlier ratio so far.
 constexpr double kConfidence = 0.999;
-constexpr int kMinIterations = 60;
+constexpr int kMinIterations = 40;
 
 /// Small deterministic generator: the same frame gives the same planes.
 struct Lcg {
