@@ -49,9 +49,9 @@ std::string describe(const HandDetection& d) {
   std::string s;
   char text[200];
   for (const Hand& h : d.hands) {
-    std::snprintf(text, sizeof text, " [hand %.2f %s %d,%d %dx%d, %zu px, tip %zu px, %.3f m2, elong %.1f, %.2f m]", h.score,
+    std::snprintf(text, sizeof text, " [hand %.2f %s %d,%d %dx%d, %zu px, tip %zu px, %.3f m2, elong %.1f, %.2f x %.3f m]", h.score,
                   h.enters_from_border ? "border" : "free", h.region.x, h.region.y, h.region.width, h.region.height,
-                  h.indices.size(), h.tip_indices.size(), h.area_m2, h.elongation, h.length_m);
+                  h.indices.size(), h.tip_indices.size(), h.area_m2, h.elongation, h.length_m, h.width_m);
     s += text;
   }
   std::snprintf(text, sizeof text, " person %zu px, %.2f ms", d.person_indices.size(), d.ms);
@@ -412,6 +412,8 @@ TEST(HandDetector, ConfigValidation) {
   bad([](HandConfig& c) { c.tip_length_m = 0; }, "tip_length_m");
   bad([](HandConfig& c) { c.tip_clearance_m = -0.1; }, "tip_clearance_m");
   bad([](HandConfig& c) { c.min_arm_length_m = -1; }, "min_arm_length_m");
+  bad([](HandConfig& c) { c.max_arm_length_m = 0.1; }, "min_arm_length_m");
+  bad([](HandConfig& c) { c.min_arm_width_m = -1; }, "min_arm_width_m");
   bad([](HandConfig& c) { c.min_elongation = 0.5; }, "min_elongation");
   bad([](HandConfig& c) { c.free_arm_min_elongation = 1.0; }, "free_arm_min_elongation");
   bad([](HandConfig& c) { c.free_arm_min_length_m = 0; }, "free_arm_min_length_m");

@@ -39,7 +39,8 @@ Status validate(const HandConfig& c) {
   if (!(c.person_max_extent_m > 0)) return invalid_argument("foreground.hands.person_max_extent_m: must be > 0");
   if (!(c.tip_length_m > 0 && c.tip_length_m <= 0.5)) return invalid_argument("foreground.hands.tip_length_m: must be in (0, 0.5]");
   if (!(c.tip_clearance_m >= 0)) return invalid_argument("foreground.hands.tip_clearance_m: must be >= 0");
-  if (!(c.min_arm_length_m >= 0)) return invalid_argument("foreground.hands.min_arm_length_m: must be >= 0");
+  if (!(c.min_arm_length_m >= 0 && c.min_arm_length_m < c.max_arm_length_m)) return invalid_argument("foreground.hands.min_arm_length_m: must be >= 0 and below max_arm_length_m");
+  if (!(c.min_arm_width_m >= 0)) return invalid_argument("foreground.hands.min_arm_width_m: must be >= 0");
   if (!(c.min_elongation >= 1)) return invalid_argument("foreground.hands.min_elongation: must be >= 1");
   if (!(c.free_arm_min_elongation >= c.min_elongation)) return invalid_argument("foreground.hands.free_arm_min_elongation: must be >= min_elongation");
   if (!(c.free_arm_min_length_m > 0)) return invalid_argument("foreground.hands.free_arm_min_length_m: must be > 0");
@@ -65,7 +66,6 @@ constexpr double kFreeArmMaxContact = 0.1;  ///< of its outline continuous with 
 constexpr double kInPersonFraction = 0.3;
 constexpr double kSecondArmMinLengthM = 0.3;
 constexpr double kSecondArmMinElongation = 4.0;
-constexpr double kMinArmWidthSpreadM = 0.012;
 /// At most this fraction of an arm's cells lies within the border margin.
 constexpr double kMaxBorderFraction = 0.5;
 /// Cells this far under the table plane are under the table; an arm has at most this fraction there.
@@ -219,7 +219,7 @@ enum class Entry { kNone, kBorder, kBody, kFree };
 struct Candidate {
   std::vector<int> cells;
   double area_m2 = 0;
-  double elongation = 1, length_m = 0;
+  double elongation = 1, length_m = 0, width_m = 0;
   Entry entry = Entry::kNone;
   Eigen::Vector3d entry_point = Eigen::Vector3d::Zero();
   std::vector<int> base_cells;  ///< where the body is grown from
@@ -361,9 +361,10 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
     const Eigen::Vector3d lambda = solver.eigenvalues();  // ascending
     const Eigen::Vector3d axis = solver.eigenvectors().col(2);
     cand.elongation = std::sqrt(lambda(2) / std::max(lambda(1), 1e-12));
-    // A sliver (a bright edge along the image's top, a rim) is narrower than any forearm, whose
-    // 6-9 cm width spreads by about 2 cm (width / sqrt(12)).
-    if (std::sqrt(std::max(0.0, lambda(1))) < kMinArmWidthSpreadM) continue;
+    cand.width_m = std::sqrt(12.0 * std::max(0.0, lambda(1)));
+    // A sliver (a bright edge along the image's top, a board's edge, a chair's slat) is narrower
+    // than any forearm.
+    if (cand.width_m < config.min_arm_width_m) continue;
     double t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
     std::vector<double> t(cells.size());
     for (std::size_t k = 0; k < cells.size(); ++k) {
@@ -372,7 +373,10 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
       t_max = std::max(t_max, t[k]);
     }
     cand.length_m = t_max - t_min;
-    if (cand.elongation < config.min_elongation || cand.length_m < config.min_arm_length_m) continue;
+    if (cand.elongation < config.min_elongation || cand.length_m < config.min_arm_length_m ||
+        cand.length_m > config.max_arm_length_m) {
+      continue;
+    }
 
     // Legs (bare, or trousers of a skin-like colour) are under the table; a hand working on it
     // is above its plane. planes[0] is the largest horizontal plane; its normal points towards
@@ -602,6 +606,7 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
     hand.area_m2 = cand.area_m2;
     hand.elongation = cand.elongation;
     hand.length_m = cand.length_m;
+    hand.width_m = cand.width_m;
   }
   return finish();
 }

@@ -29,6 +29,8 @@ struct HandConfig {
   double tip_length_m = 0.12;        ///< the hand proper: this much of the arm's far end, in 3D
   double tip_clearance_m = 0.15;     ///< the body is not grown this close to the hand (a held object)
   double min_arm_length_m = 0.15;    ///< a hand with some forearm is at least this long
+  double max_arm_length_m = 0.9;     ///< a whole arm, shoulder to fingertips, is about 0.75 m
+  double min_arm_width_m = 0.05;     ///< a forearm is 6-9 cm wide; a board's edge or a slat is thinner
   double min_elongation = 3.0;       ///< an arm's length over its width (principal axes), at least
   /// An arm that reaches neither the border nor a body that does (a cut-off view, the simulator's
   /// floating forearm) is still a hand when this elongated, this long, and not lying on the table.
@@ -53,6 +55,7 @@ struct Hand {
   double area_m2 = 0.0;              ///< metric area of hand and forearm, from depth
   double elongation = 0.0;           ///< length over width (square root of the principal variances' ratio)
   double length_m = 0.0;             ///< extent along the principal axis
+  double width_m = 0.0;              ///< sqrt(12) times the spread across it (a uniform strip's width)
 };
 
 struct HandDetection {
