@@ -120,10 +120,10 @@ TEST(HandDetector, SimulatedHandPixels) {
   std::printf("sim: hand found in %d of %d frames; pixels precision %.3f recall %.3f; median per %dx%d frame %.2f ms CPU, "
               "%.2f ms wall-clock\n", found, frames, total.precision(), total.recall(), scenario->intrinsics.width,
               scenario->intrinsics.height, median(cpu_ms), median(ms));
-  // Measured: 29 of 31 (the first two frames show only fingers, no forearm), precision 0.92,
+  // Measured: 29 of 31 (the first two frames show only fingers, no forearm), precision 0.93,
   // recall 0.89 (fingers behind the held cup are cut off from the arm and left out).
   EXPECT_GE(found, 28);
-  EXPECT_GE(total.precision(), 0.88);
+  EXPECT_GE(total.precision(), 0.90);
   EXPECT_GE(total.recall(), 0.85);
 }
 
@@ -278,7 +278,7 @@ TEST(HandDetector, Hrt1PickToy1) {
   const SequenceResult r = run_sequence("pick_toy_1", kPickToy1);
   EXPECT_EQ(r.in_view, 40);
   EXPECT_GE(r.found, 39);    // measured 40
-  EXPECT_GE(r.located, 37);  // measured 39
+  EXPECT_GE(r.located, 38);  // measured 40
   EXPECT_EQ(r.false_alarms, 0);
   EXPECT_LT(r.person_on_table, 0.01 * std::max<std::size_t>(1, r.person));
 }
@@ -288,9 +288,9 @@ TEST(HandDetector, Hrt1PickToy2) {
   const SequenceResult r = run_sequence("pick_toy_2", kPickToy2);
   EXPECT_EQ(r.in_view, 42);
   EXPECT_GE(r.found, 41);    // measured 42
-  // Measured 25: from frame 11 to 23 the hand proper takes in the toy's skin-coloured face, which
-  // touches the fingers in colour and depth, and its centre drops below the box.
-  EXPECT_GE(r.located, 24);
+  // Measured 40: in frames 15 and 37 the hand proper still takes in part of the toy's
+  // skin-coloured face, which touches the fingers in depth, and its centre drops below the box.
+  EXPECT_GE(r.located, 38);
   EXPECT_EQ(r.false_alarms, 0);
   EXPECT_LT(r.person_on_table, 0.01 * std::max<std::size_t>(1, r.person));
   // The body stays in view in this recording: some of it must be found.
@@ -330,7 +330,7 @@ TEST(HandDetector, HandsInAnEmptyKitchen) {
     dump(*frame->cloud, d, "redkitchen_" + std::to_string(f));
   }
   std::printf("redkitchen: hands in %d of %zu frames without a person\n", with_hands, seq->frames.size());
-  // Known weakness, measured 48 of 50: wood (a tray's edge, chair slats, a table) is skin-coloured
+  // Known weakness, measured 46 of 50: wood (a tray's edge, chair slats, a table) is skin-coloured
   // and long, and the view is hand-held, so the border cuts everything. Kept as a figure to improve
   // on, not a pass mark.
   EXPECT_LE(with_hands, 50);

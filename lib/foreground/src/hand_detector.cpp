@@ -71,6 +71,8 @@ constexpr double kMaxBorderFraction = 0.5;
 /// Cells this far under the table plane are under the table; an arm has at most this fraction there.
 constexpr float kBelowTableM = 0.03f;
 constexpr double kMaxBelowTableFraction = 0.5;
+/// Skin brighter or darker than the arm's base by more than this factor is not the same skin.
+constexpr float kMaxToneRatio = 2.5f;
 /// An empty band along the image's side at most this wide (pixels) counts as the border.
 constexpr int kMaxEmptyBorderPx = 48;
 /// The person's pixels are at least the entry's distance from the hand, less this.
@@ -278,12 +280,17 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
   // depth lies beside its colour. The components are depth-continuous, so the dilated mask does
   // not join the background.
   std::vector<std::uint8_t> skin = skin_mask(g.rgb, g.w, g.h);
+  const std::vector<std::uint8_t> skin_colour = skin;  // before closing and dilation
+  const int dilation_radius = (config.skin_dilation_px + g.step - 1) / g.step;
   {
     cv::Mat mask(g.h, g.w, CV_8U, skin.data());
     cv::morphologyEx(mask, mask, cv::MORPH_CLOSE, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(3, 3)));
-    const int radius = (config.skin_dilation_px + g.step - 1) / g.step;
-    if (radius > 0) cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * radius + 1, 2 * radius + 1)));
+    if (dilation_radius > 0) {
+      cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * dilation_radius + 1, 2 * dilation_radius + 1)));
+    }
   }
+  std::vector<float> luma(n);
+  for (std::size_t c = 0; c < n; ++c) luma[c] = 0.299f * g.rgb[3 * c] + 0.587f * g.rgb[3 * c + 1] + 0.114f * g.rgb[3 * c + 2] + 1.0f;
   SupportPlaneConfig plane_config;
   plane_config.tolerance_m = static_cast<float>(config.support_plane_tolerance_m);
   // Planes are found on a coarser grid (every other cell; they are large, and RANSAC's cost is
@@ -457,20 +464,60 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
     }
     if (cand.entry == Entry::kNone) continue;
 
-    std::vector<double> reach(cells.size());
+    std::vector<double> reach(cand.cells.size());
     double reach_max = 0;
-    for (std::size_t k = 0; k < cells.size(); ++k) {
-      reach[k] = (g.p[cells[k]].cast<double>() - cand.entry_point).norm();
+    for (std::size_t k = 0; k < cand.cells.size(); ++k) {
+      reach[k] = (g.p[cand.cells[k]].cast<double>() - cand.entry_point).norm();
       reach_max = std::max(reach_max, reach[k]);
     }
-    for (std::size_t k = 0; k < cells.size(); ++k) {
-      if (reach[k] >= reach_max - config.tip_length_m) cand.tip_cells.push_back(cells[k]);
+    // Skin of another tone in the far half is what the hand holds (a plush toy's light face in
+    // dark fingers, touching them in colour and depth): it leaves the arm, with the dilated
+    // rim around it, before the hand proper is measured.
+    {
+      std::vector<float> base;
+      for (std::size_t k = 0; k < cand.cells.size(); ++k) {
+        if (skin_colour[cand.cells[k]] && reach[k] < 0.5 * reach_max) base.push_back(luma[cand.cells[k]]);
+      }
+      if (base.size() >= kMinComponentCells) {
+        std::nth_element(base.begin(), base.begin() + base.size() / 2, base.end());
+        const float tone = base[base.size() / 2];
+        cv::Mat foreign(g.h, g.w, CV_8U, cv::Scalar(0));
+        bool any = false;
+        for (std::size_t k = 0; k < cand.cells.size(); ++k) {
+          const int i = cand.cells[k];
+          const float ratio = luma[i] / tone;
+          if (skin_colour[i] && reach[k] >= 0.5 * reach_max && (ratio > kMaxToneRatio || ratio < 1.0f / kMaxToneRatio)) {
+            foreign.data[i] = 1;
+            any = true;
+          }
+        }
+        if (any) {
+          cv::Mat rim;
+          cv::dilate(foreign, rim, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * dilation_radius + 3, 2 * dilation_radius + 3)));
+          std::vector<int> kept;
+          std::vector<double> kept_reach;
+          reach_max = 0;
+          for (std::size_t k = 0; k < cand.cells.size(); ++k) {
+            const int i = cand.cells[k];
+            if (foreign.data[i] || (rim.data[i] && !skin_colour[i])) continue;
+            kept.push_back(i);
+            kept_reach.push_back(reach[k]);
+            reach_max = std::max(reach_max, reach[k]);
+          }
+          cand.cells.swap(kept);
+          reach.swap(kept_reach);
+        }
+      }
+    }
+    if (cand.cells.size() < kMinComponentCells) continue;
+    for (std::size_t k = 0; k < cand.cells.size(); ++k) {
+      if (reach[k] >= reach_max - config.tip_length_m) cand.tip_cells.push_back(cand.cells[k]);
       // The body is grown from the arm's base only, well away from the hand and what it holds.
-      if (reach[k] < reach_max - config.tip_length_m - config.tip_clearance_m) cand.base_cells.push_back(cells[k]);
+      if (reach[k] < reach_max - config.tip_length_m - config.tip_clearance_m) cand.base_cells.push_back(cand.cells[k]);
     }
     if (cand.base_cells.empty()) {
-      for (std::size_t k = 0; k < cells.size(); ++k) {
-        if (reach[k] < reach_max - config.tip_length_m) cand.base_cells.push_back(cells[k]);
+      for (std::size_t k = 0; k < cand.cells.size(); ++k) {
+        if (reach[k] < reach_max - config.tip_length_m) cand.base_cells.push_back(cand.cells[k]);
       }
     }
     cand.tip = centroid_of(g, cand.tip_cells);
