@@ -1,29 +1,34 @@
 // Hands, arms and the person in an organized RGB-D frame.
 //
-// Steps, on a grid of every grid_step-th pixel (the labels are upsampled at the end):
-//  1. skin mask (skin_model.h) and large near-horizontal planes (support_plane.h): table and floor;
-//  2. connected components of skin pixels off those planes, neighbours joined only when their
+// Steps, on a grid of every grid_step-th pixel (frame_grid.h; labels are upsampled at the end):
+//  1. skin mask (skin_model.h), closed and dilated; large planes (support_plane.h): table and
+//     floor (near-horizontal), then walls;
+//  2. connected components of skin cells off those planes, neighbours joined only when their
 //     depths differ by less than depth_jump_m;
-//  3. per component: metric area from depth, 3D principal axes (elongation, length), and where the
-//     arm enters: at the image border directly, or through a depth-continuous body (not on a
-//     support plane) that reaches the border from one end of the arm, or - for a long, clearly
-//     elongated arm off the table - at its end nearer the border ("free arm");
-//  4. the hand proper is the part farthest from the entry in 3D (tip_length_m);
-//  5. the person: grown from the arm's base (never from the hand, which may hold an object)
-//     through depth-continuous pixels off the support planes, within person_max_extent_m of the
-//     entry and not within tip_clearance_m of the hand.
+//  3. per component: metric area from depth, 3D principal axes (elongation, length, width), and
+//     where the arm enters: at the image border directly, or through a depth-continuous body (off
+//     the planes) that reaches the border from one end of the arm, or - for a long, clearly
+//     elongated arm off the table - at its end nearer the border ("free arm", as the simulator's
+//     forearm that ends in mid-air);
+//  4. skin of another tone at the far end (a held object) leaves the arm; the hand proper is the
+//     part farthest from the entry in 3D (tip_length_m);
+//  5. most confident first: a candidate inside an accepted hand's person is that person (face,
+//     legs), one beside an accepted arm joins it; the person is grown from the arm's base (never
+//     from the hand, which may hold an object) through depth-continuous cells off the planes,
+//     within person_max_extent_m of the entry, person_max_depth_offset_m of its depth, and not
+//     back towards the hand.
 #include "scenewatch/foreground/hand_detector.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <deque>
 #include <limits>
 #include <utility>
 
 #include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
+#include "frame_grid.h"
 #include "skin_model.h"
 #include "support_plane.h"
 
@@ -73,148 +78,10 @@ constexpr float kBelowTableM = 0.03f;
 constexpr double kMaxBelowTableFraction = 0.5;
 /// Skin brighter or darker than the arm's base by more than this factor is not the same skin.
 constexpr float kMaxToneRatio = 2.5f;
-/// An empty band along the image's side at most this wide (pixels) counts as the border.
-constexpr int kMaxEmptyBorderPx = 48;
 /// The person's pixels are at least the entry's distance from the hand, less this.
 constexpr double kBodyBehindEntryM = 0.15;
 /// A wall: a plane with at least this fraction of the points off the table and floor.
 constexpr double kMinWallFraction = 0.12;
-
-/// The frame subsampled: one point per grid_step x grid_step block (the first valid one).
-struct Grid {
-  int w = 0, h = 0, step = 1, full_w = 0, full_h = 0;
-  std::vector<Eigen::Vector3f> p;
-  std::vector<std::uint8_t> valid;
-  std::vector<std::uint8_t> rgb;  ///< w * h * 3
-  std::vector<int> src;           ///< index of the sampled pixel in the full frame
-
-  /// Per row and per column, the first cell with depth from each side (-1: none).
-  std::vector<int> first_left, first_right, first_top, first_bottom;
-
-  int u_full(int cell) const { return src[cell] % full_w; }
-  int v_full(int cell) const { return src[cell] / full_w; }
-  /// Within `margin` pixels of the image border, or of where depth begins when the image's edge
-  /// has none (a depth image registered to the colour camera has an empty band along its sides).
-  bool on_border(int cell, int margin) const {
-    const int u = u_full(cell), v = v_full(cell);
-    if (u <= margin || v <= margin || u >= full_w - 1 - margin || v >= full_h - 1 - margin) return true;
-    const int gu = cell % w, gv = cell / w;
-    const auto near = [&](int first, int here, bool from_start, int extent) {
-      if (first < 0) return false;
-      const int edge_px = from_start ? first * step : (extent - 1 - first) * step;
-      const int here_px = from_start ? here * step : (extent - 1 - here) * step;
-      return edge_px <= kMaxEmptyBorderPx && here_px <= edge_px + margin;
-    };
-    return near(first_left[gv], gu, true, w) || near(first_right[gv], gu, false, w) ||
-           near(first_top[gu], gv, true, h) || near(first_bottom[gu], gv, false, h);
-  }
-};
-
-Grid sample_grid(const Cloud& cloud, int step) {
-  Grid g;
-  g.full_w = static_cast<int>(cloud.width);
-  g.full_h = static_cast<int>(cloud.height);
-  g.step = step;
-  g.w = (g.full_w + step - 1) / step;
-  g.h = (g.full_h + step - 1) / step;
-  const std::size_t n = static_cast<std::size_t>(g.w) * g.h;
-  g.p.assign(n, Eigen::Vector3f::Constant(std::numeric_limits<float>::quiet_NaN()));
-  g.valid.assign(n, 0);
-  g.rgb.assign(n * 3, 0);
-  g.src.assign(n, 0);
-  for (int gv = 0; gv < g.h; ++gv) {
-    for (int gu = 0; gu < g.w; ++gu) {
-      const int cell = gv * g.w + gu;
-      const int u0 = gu * step, v0 = gv * step;
-      int chosen = v0 * g.full_w + u0;
-      for (int dv = 0; dv < step && !g.valid[cell]; ++dv) {
-        for (int du = 0; du < step; ++du) {
-          const int u = u0 + du, v = v0 + dv;
-          if (u >= g.full_w || v >= g.full_h) continue;
-          const int i = v * g.full_w + u;
-          if (is_valid(cloud.points[i]) && cloud.points[i].z > 0) {
-            chosen = i;
-            g.valid[cell] = 1;
-            break;
-          }
-        }
-      }
-      const PointT& pt = cloud.points[chosen];
-      g.src[cell] = chosen;
-      if (g.valid[cell]) g.p[cell] = pt.getVector3fMap();
-      g.rgb[3 * cell] = pt.r;
-      g.rgb[3 * cell + 1] = pt.g;
-      g.rgb[3 * cell + 2] = pt.b;
-    }
-  }
-  g.first_left.assign(g.h, -1), g.first_right.assign(g.h, -1), g.first_top.assign(g.w, -1), g.first_bottom.assign(g.w, -1);
-  for (int gv = 0; gv < g.h; ++gv) {
-    for (int gu = 0; gu < g.w; ++gu) {
-      if (!g.valid[gv * g.w + gu]) continue;
-      if (g.first_left[gv] < 0) g.first_left[gv] = gu;
-      g.first_right[gv] = gu;
-      if (g.first_top[gu] < 0) g.first_top[gu] = gv;
-      g.first_bottom[gu] = gv;
-    }
-  }
-  return g;
-}
-
-/// The focal length in pixels, by least squares on u = f x / z + c over the valid points: the
-/// cloud carries no intrinsics, and metric areas need it.
-double estimate_focal_px(const Grid& g) {
-  double fs[2] = {0, 0};
-  for (int axis = 0; axis < 2; ++axis) {
-    double sa = 0, sb = 0, saa = 0, sab = 0;
-    std::size_t n = 0;
-    for (std::size_t cell = 0; cell < g.p.size(); cell += 7) {
-      if (!g.valid[cell]) continue;
-      const Eigen::Vector3f& q = g.p[cell];
-      const double a = (axis == 0 ? q.x() : q.y()) / q.z();
-      const double b = axis == 0 ? g.u_full(static_cast<int>(cell)) : g.v_full(static_cast<int>(cell));
-      sa += a, sb += b, saa += a * a, sab += a * b;
-      ++n;
-    }
-    const double den = n * saa - sa * sa;
-    if (n >= 10 && den > 1e-12) fs[axis] = (n * sab - sa * sb) / den;
-  }
-  const double f = std::sqrt(std::max(0.0, fs[0] * fs[1]));
-  // Fallback: a VGA Kinect-class camera's focal length, scaled to the image width.
-  return std::isfinite(f) && f > 1 ? f : 525.0 * g.full_w / 640.0;
-}
-
-/// Breadth-first growth over 4-neighbours from seeds: a cell joins when accept(cell) and its depth
-/// is within depth_jump of the neighbour it is reached from. `mark` holds 0 for free cells and gets
-/// `id` for joined ones.
-template <typename Accept>
-std::vector<int> grow(const Grid& g, const std::vector<int>& seeds, float depth_jump, std::vector<int>& mark, int id, Accept accept) {
-  std::vector<int> out;
-  std::deque<int> queue;
-  for (int s : seeds) {
-    if (mark[s] == id) continue;
-    mark[s] = id;
-    out.push_back(s);
-    queue.push_back(s);
-  }
-  static constexpr int kDu[4] = {1, -1, 0, 0}, kDv[4] = {0, 0, 1, -1};
-  while (!queue.empty()) {
-    const int c = queue.front();
-    queue.pop_front();
-    const int cu = c % g.w, cv = c / g.w;
-    for (int k = 0; k < 4; ++k) {
-      const int nu = cu + kDu[k], nv = cv + kDv[k];
-      if (nu < 0 || nv < 0 || nu >= g.w || nv >= g.h) continue;
-      const int n = nv * g.w + nu;
-      if (mark[n] == id || !g.valid[n]) continue;
-      if (std::abs(g.p[n].z() - g.p[c].z()) >= depth_jump) continue;
-      if (!accept(n)) continue;
-      mark[n] = id;
-      out.push_back(n);
-      queue.push_back(n);
-    }
-  }
-  return out;
-}
 
 enum class Entry { kNone, kBorder, kBody, kFree };
 
@@ -229,20 +96,6 @@ struct Candidate {
   Eigen::Vector3d tip = Eigen::Vector3d::Zero();
   double score = 0;
 };
-
-Eigen::Vector3d centroid_of(const Grid& g, const std::vector<int>& cells) {
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (int i : cells) c += g.p[i].cast<double>();
-  return cells.empty() ? c : Eigen::Vector3d(c / static_cast<double>(cells.size()));
-}
-
-/// Pixels from the mean image position of the cells to the nearest image border.
-double distance_to_border(const Grid& g, const std::vector<int>& cells) {
-  double u = 0, v = 0;
-  for (int i : cells) u += g.u_full(i), v += g.v_full(i);
-  u /= std::max<std::size_t>(1, cells.size()), v /= std::max<std::size_t>(1, cells.size());
-  return std::min({u, v, g.full_w - 1 - u, g.full_h - 1 - v});
-}
 
 }  // namespace
 
@@ -272,9 +125,7 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
   const float jump = static_cast<float>(config.depth_jump_m);
   const int margin = config.border_margin_px;
 
-  // 1. Skin and support planes. The person may not enter a band around the planes either: the
-  // table's rounded edge is off the plane but part of the table.
-  // Closing bridges one-cell gaps in the mask: a dark forearm in shadow breaks into pieces
+  // 1. Skin. Closing bridges one-cell gaps in the mask: a dark forearm in shadow breaks into pieces
   // where single pixels fall below the luminance gate. Dilating then tolerates colour and depth
   // that are not quite registered (hrt1's are ~15 px apart at the image's side): the skin's
   // depth lies beside its colour. The components are depth-continuous, so the dilated mask does
@@ -289,8 +140,10 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
       cv::dilate(mask, mask, cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * dilation_radius + 1, 2 * dilation_radius + 1)));
     }
   }
-  std::vector<float> luma(n);
+  std::vector<float> luma(n);  // BT.601 luminance, +1 so that ratios stay finite
   for (std::size_t c = 0; c < n; ++c) luma[c] = 0.299f * g.rgb[3 * c] + 0.587f * g.rgb[3 * c + 1] + 0.114f * g.rgb[3 * c + 2] + 1.0f;
+
+  // Planes.
   SupportPlaneConfig plane_config;
   plane_config.tolerance_m = static_cast<float>(config.support_plane_tolerance_m);
   // Planes are found on a coarser grid (every other cell; they are large, and RANSAC's cost is
@@ -333,6 +186,8 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
       on_support.data[c] = on;
     }
   }
+  // The person may not enter a band around the planes either: the table's rounded edge is off
+  // the plane but part of the table.
   cv::Mat near_support;
   cv::dilate(on_support, near_support, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
 
