@@ -127,6 +127,32 @@ TEST(HandDetector, SimulatedHandPixels) {
   EXPECT_GE(total.recall(), 0.85);
 }
 
+/// The grid step trades speed for detail; the hand is found at every step.
+TEST(HandDetector, SimulatedHandAtOtherGridSteps) {
+  auto scenario = sim::load_scenario(test::source_dir() / "sample_clouds/scenarios/hand_picks_cup_upright.yaml");
+  ASSERT_TRUE(scenario.ok()) << scenario.error().message;
+  auto simulator = sim::Simulator::create(*scenario);
+  ASSERT_TRUE(simulator.ok()) << simulator.error().message;
+  const sim::SimFrame rendered = simulator->render(0, 60);
+  auto cloud = io::rgbd_to_cloud(rendered.color, rendered.depth, simulator->scenario().intrinsics);
+  ASSERT_TRUE(cloud.ok());
+  for (int step : {1, 2, 3, 4}) {
+    HandConfig config;
+    config.grid_step = step;
+    const HandDetection d = detect_hands(**cloud, config);
+    PixelScore score;
+    for (std::size_t i = 0; i < (*cloud)->size(); ++i) {
+      const bool truth = rendered.labels.labels[i] == sim::kLabelHand && is_valid((*cloud)->points[i]);
+      const bool detected = d.labels[i] == AgentLabel::kHand || d.labels[i] == AgentLabel::kArm;
+      score.truth += truth, score.detected += detected, score.true_positive += truth && detected;
+    }
+    std::printf("grid step %d: precision %.3f recall %.3f,%s\n", step, score.precision(), score.recall(), describe(d).c_str());
+    ASSERT_EQ(d.hands.size(), 1u) << "step " << step;
+    EXPECT_GE(score.precision(), 0.8) << "step " << step;
+    EXPECT_GE(score.recall(), 0.75) << "step " << step;
+  }
+}
+
 /// A skin-coloured box and a skin-coloured bar lying on the table, away from the border, and no
 /// hand: neither is a hand.
 TEST(HandDetector, SkinColouredObjectsOnTheTableAreNotHands) {

@@ -73,8 +73,8 @@ Status validate(const HandConfig& config);
 /// Hands, arms and the person in an organized RGB cloud (camera frame). An unorganized cloud, or
 /// one without colour, gives an empty detection (not an error). A hand needs some forearm (it is
 /// told from skin-coloured things by its arm's shape); skin-coloured wood that is as long and
-/// wide as a forearm and cut by the border is a known source of false hands. Not thread safe to
-/// share a config being modified; otherwise stateless and reentrant.
+/// wide as a forearm and cut by the border is a known source of false hands. Stateless: safe to
+/// call from several threads at once.
 HandDetection detect_hands(const Cloud& organized, const HandConfig& config);
 
 }  // namespace scenewatch::foreground
