@@ -1,6 +1,6 @@
 // Skin colour. The chrominance box is Chai & Ngan's (IEEE TCSVT 9(4), 1999, "Face segmentation
 // using skin-color map in videophone applications"): 133 <= Cr <= 173 and 77 <= Cb <= 127, which
-// holds for light and dark skin alike because it ignores luminance. Two gates are ours, set on the
+// holds for light and dark skin alike because it ignores luminance. Three gates are ours, set on the
 // hrt1 recordings and the simulator's skin:
 //  - luminance Y >= 20: below it JPEG chroma is noise (the black shirt, deep shadow);
 //  - saturation (max - min) / max >= 0.32 and R the largest channel (Kovac, Peer & Solina 2003,
@@ -12,7 +12,6 @@
 #include "skin_model.h"
 
 #include <algorithm>
-#include <cmath>
 
 #include <opencv2/imgproc.hpp>
 
@@ -35,14 +34,6 @@ bool skin_ycrcb(int y, int cr, int cb, int r, int g, int b) {
 }
 
 }  // namespace
-
-bool is_skin(std::uint8_t r, std::uint8_t g, std::uint8_t b) {
-  // OpenCV's 8-bit RGB -> YCrCb (ITU-R BT.601, delta 128), rounded as cvtColor rounds.
-  const double y = 0.299 * r + 0.587 * g + 0.114 * b;
-  const int cr = static_cast<int>(std::lround((r - y) * 0.713 + 128.0));
-  const int cb = static_cast<int>(std::lround((b - y) * 0.564 + 128.0));
-  return skin_ycrcb(static_cast<int>(std::lround(y)), cr, cb, r, g, b);
-}
 
 std::vector<std::uint8_t> skin_mask(const std::vector<std::uint8_t>& rgb, int width, int height) {
   std::vector<std::uint8_t> mask(static_cast<std::size_t>(width) * height, 0);
