@@ -23,6 +23,21 @@ struct HandConfig {
   double depth_jump_m = 0.03;        ///< neighbours farther apart in depth are not connected
   int border_margin_px = 12;         ///< an arm "enters from the border" within this margin
   double person_max_range_m = 4.0;   ///< the person's body is grown from the arm up to this range
+  double person_max_extent_m = 1.2;  ///< ... and no farther than this from where the arm enters
+  double person_max_depth_offset_m = 0.5;  ///< ... nor farther than this in depth from that entry
+  int skin_dilation_px = 4;          ///< the skin mask grown by this: colour and depth slightly misregistered
+  double tip_length_m = 0.12;        ///< the hand proper: this much of the arm's far end, in 3D
+  double tip_clearance_m = 0.15;     ///< the body is not grown this close to the hand (a held object)
+  double min_arm_length_m = 0.15;    ///< a hand with some forearm is at least this long
+  double max_arm_length_m = 0.9;     ///< a whole arm, shoulder to fingertips, is about 0.75 m
+  double min_arm_width_m = 0.05;     ///< a forearm is 6-9 cm wide; a board's edge or a slat is thinner
+  double min_elongation = 3.0;       ///< an arm's length over its width (principal axes), at least
+  /// An arm that reaches neither the border nor a body that does (a cut-off view, the simulator's
+  /// floating forearm) is still a hand when this elongated, this long, and not lying on the table.
+  double free_arm_min_elongation = 4.0;
+  double free_arm_min_length_m = 0.25;
+  double support_plane_tolerance_m = 0.015;  ///< points this close to the table or floor plane are on it
+  int grid_step = 2;                 ///< work on every grid_step-th pixel per axis, labels upsampled
 };
 
 /// What a pixel of the frame is.
@@ -35,8 +50,12 @@ struct Hand {
   PixelRegion region;                ///< bounding rectangle of all its pixels
   Aabb box_camera;                   ///< of its 3D points, camera frame
   Eigen::Vector3d tip_camera = Eigen::Vector3d::Zero();  ///< centroid of the hand proper, camera frame
-  bool enters_from_border = false;
+  bool enters_from_border = false;   ///< directly, or through a body that reaches the border
   double score = 0.0;                ///< in [0, 1]: how sure
+  double area_m2 = 0.0;              ///< metric area of hand and forearm, from depth
+  double elongation = 0.0;           ///< length over width (square root of the principal variances' ratio)
+  double length_m = 0.0;             ///< extent along the principal axis
+  double width_m = 0.0;              ///< sqrt(12) times the spread across it (a uniform strip's width)
 };
 
 struct HandDetection {
@@ -52,7 +71,10 @@ struct HandDetection {
 Status validate(const HandConfig& config);
 
 /// Hands, arms and the person in an organized RGB cloud (camera frame). An unorganized cloud, or
-/// one without colour, gives an empty detection (not an error).
+/// one without colour, gives an empty detection (not an error). A hand needs some forearm (it is
+/// told from skin-coloured things by its arm's shape); skin-coloured wood that is as long and
+/// wide as a forearm and cut by the border is a known source of false hands. Stateless: safe to
+/// call from several threads at once.
 HandDetection detect_hands(const Cloud& organized, const HandConfig& config);
 
 }  // namespace scenewatch::foreground

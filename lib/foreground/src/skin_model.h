@@ -1,0 +1,13 @@
+#pragma once
+/// The skin model: which colours are skin, per pixel, in YCrCb with a luminance and a saturation
+/// gate. Private to the foreground module.
+#include <cstdint>
+#include <vector>
+
+namespace scenewatch::foreground {
+
+/// The skin mask of an interleaved RGB image (w * h * 3 bytes): 1 where skin, 0 elsewhere.
+/// Converts through OpenCV's YCrCb (ITU-R BT.601).
+std::vector<std::uint8_t> skin_mask(const std::vector<std::uint8_t>& rgb, int width, int height);
+
+}  // namespace scenewatch::foreground
