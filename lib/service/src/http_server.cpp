@@ -47,6 +47,9 @@ HttpResponse http_error(int status, const std::string& message) {
 
 namespace {
 
+/// Seconds a connection keeps reading (and dropping) after its answer was sent.
+constexpr int kLingerS = 2;
+
 std::string response_head(const HttpResponse& r, bool streaming) {
   std::string head = "HTTP/1.1 " + std::to_string(r.status) + " " + http_reason(r.status) + "\r\n";
   head += "Content-Type: " + r.content_type + "\r\n";
@@ -147,12 +150,13 @@ class Connection : public std::enable_shared_from_this<Connection> {
   void on_read(const boost::system::error_code& ec, std::size_t n) {
     if (closed_) return;
     if (ec) {
-      // A stream's client went away (or a client hung up before finishing its request).
-      if (!answered_ || streaming_) close();
+      // The client went away: before finishing its request, from its stream, or after its answer.
+      if (!answered_ || streaming_ || lingering_) close();
       return;
     }
     if (answered_) {
-      if (streaming_) read();  // a stream's client sends nothing more that matters; keep watching for its close
+      // What a client sends after its request does not matter: it is read only to notice its close.
+      if (streaming_ || lingering_) read();
       return;
     }
     switch (parser_.feed(std::string_view(buffer_.data(), n))) {
@@ -220,9 +224,23 @@ class Connection : public std::enable_shared_from_this<Connection> {
                         if (!self->queue_.empty()) {
                           self->write_next();
                         } else if (!self->streaming_) {
-                          self->close();  // one request per connection
+                          self->linger();  // one request per connection
                         }
                       });
+  }
+
+  /// After the answer: no more sending, and what the client still sends is read and dropped
+  /// until it closes (at most kLingerS), so that closing with unread bytes (the rest of an
+  /// oversized request) does not reset the connection before the client has read the answer.
+  void linger() {
+    lingering_ = true;
+    boost::system::error_code ignored;
+    socket_.shutdown(tcp::socket::shutdown_send, ignored);
+    timer_.expires_after(std::chrono::seconds(kLingerS));
+    timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+      if (!ec) self->close();
+    });
+    read();
   }
 
   void close() {
@@ -263,6 +281,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::size_t queued_bytes_ = 0;
   bool answered_ = false;
   bool streaming_ = false;
+  bool lingering_ = false;
   std::atomic<bool> closed_{false};
 };
 
