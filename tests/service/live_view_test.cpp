@@ -186,6 +186,8 @@ TEST_F(LiveViewTest, BadRequestsGetAnErrorAndTheDaemonKeepsServing) {
   const std::string state = get(http_port_, "/api/state");
   EXPECT_EQ(status_of(state), 200);
   EXPECT_NE(body_of(state).find("\"frames_processed\":0"), std::string::npos) << state;
+  EXPECT_NE(body_of(state).find("\"voxels\":{"), std::string::npos) << state;
+  EXPECT_EQ(body_of(get(http_port_, "/api/state?voxels=0")).find("\"voxels\""), std::string::npos) << "the light poll";
   EXPECT_EQ(status_of(get(http_port_, "/api/frame.png")), 404) << "no frame yet";
   EXPECT_EQ(body_of(get(http_port_, "/api/events?since=0")), "{\"events\":[]}");
   EXPECT_EQ(status_of(silent.get()), 408);

@@ -93,35 +93,38 @@ struct LiveView::Impl {
     return r;
   }
 
-  HttpResponse state() const {
+  /// With `with_voxels` false, the "voxels" key is left out: the page polls that way and asks
+  /// for them only when a frame was processed.
+  HttpResponse state(bool with_voxels) const {
     const auto snapshot = memory.snapshot();
     const pipeline::Stats stats = memory.stats();
-    const pipeline::OccupiedVoxels voxels = memory.occupied_voxels(config.max_voxels);
     json planes = json::array();
     for (const auto& p : snapshot->planes) planes.push_back(to_json(p));
     json objects = json::array();
     for (const auto& o : snapshot->objects) objects.push_back(to_json(o));
-    std::vector<double> centers;
-    centers.reserve(3 * voxels.centers_world.size());
-    for (const auto& c : voxels.centers_world) {
-      centers.push_back(mm(c.x()));
-      centers.push_back(mm(c.y()));
-      centers.push_back(mm(c.z()));
+    json state = {{"frames_processed", snapshot->frames_processed},
+                  {"last_stamp_s", snapshot->last_stamp_s},
+                  {"stats",
+                   {{"frames_processed", stats.frames_processed}, {"points_processed", stats.points_processed},
+                    {"events_emitted", stats.events_emitted}, {"tracked_objects", stats.tracked_objects},
+                    {"map_occupied_leaves", stats.map_occupied_leaves}, {"map_memory_bytes", stats.map_memory_bytes},
+                    {"map_resolution_m", stats.map_resolution_m}, {"last_frame_ms", stats.last_frame_ms},
+                    {"mean_frame_ms", stats.mean_frame_ms}, {"keyframes", stats.keyframes}}},
+                  {"planes", planes},
+                  {"objects", objects}};
+    if (with_voxels) {
+      const pipeline::OccupiedVoxels voxels = memory.occupied_voxels(config.max_voxels);
+      std::vector<double> centers;
+      centers.reserve(3 * voxels.centers_world.size());
+      for (const auto& c : voxels.centers_world) {
+        centers.push_back(mm(c.x()));
+        centers.push_back(mm(c.y()));
+        centers.push_back(mm(c.z()));
+      }
+      state["voxels"] = {{"resolution_m", voxels.resolution_m}, {"total", voxels.total}, {"stride", voxels.stride},
+                         {"count", voxels.centers_world.size()}, {"centers_world", centers}};
     }
-    return json_response(
-        {{"frames_processed", snapshot->frames_processed},
-         {"last_stamp_s", snapshot->last_stamp_s},
-         {"stats",
-          {{"frames_processed", stats.frames_processed}, {"points_processed", stats.points_processed},
-           {"events_emitted", stats.events_emitted}, {"tracked_objects", stats.tracked_objects},
-           {"map_occupied_leaves", stats.map_occupied_leaves}, {"map_memory_bytes", stats.map_memory_bytes},
-           {"map_resolution_m", stats.map_resolution_m}, {"last_frame_ms", stats.last_frame_ms},
-           {"mean_frame_ms", stats.mean_frame_ms}, {"keyframes", stats.keyframes}}},
-         {"planes", planes},
-         {"objects", objects},
-         {"voxels",
-          {{"resolution_m", voxels.resolution_m}, {"total", voxels.total}, {"stride", voxels.stride},
-           {"count", voxels.centers_world.size()}, {"centers_world", centers}}}});
+    return json_response(state);
   }
 
   HttpResponse frame_png() {
@@ -197,7 +200,7 @@ HttpResponse LiveView::handle(const HttpRequest& request) {
   Impl& s = *impl_;
   if (request.path == "/" || request.path == "/index.html") return s.page();
   if (request.path == "/three.min.js") return s.three_js();
-  if (request.path == "/api/state") return s.state();
+  if (request.path == "/api/state") return s.state(request.query_value("voxels") != "0");
   if (request.path == "/api/frame.png") return s.frame_png();
   if (request.path == "/api/events") return s.events(request);
   return http_error(404, "no such page: the live view serves /, /three.min.js, /api/state, /api/frame.png and "

@@ -4,7 +4,8 @@
 ///
 ///   GET /                  the page (embedded in the binary)
 ///   GET /three.min.js      three.js, read from Debian's libjs-three (LiveViewConfig::three_js)
-///   GET /api/state         frames, stats, planes (hulls), objects (boxes), occupied voxels (JSON)
+///   GET /api/state         frames, stats, planes (hulls), objects (boxes), occupied voxels (JSON);
+///                          (?voxels=0: without the voxels)
 ///   GET /api/frame.png     the last colour frame with the surprise heatmap laid over it
 ///   GET /api/events        the events as they are emitted (Server-Sent Events)
 ///   GET /api/events?since=N  the logged events with id > N (JSON)
