@@ -6,6 +6,7 @@
 #include <csignal>
 #include <ctime>
 #include <iostream>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -13,6 +14,8 @@
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/service/access_token.h"
 #include "scenewatch/service/daemon_config.h"
+#include "scenewatch/service/http_server.h"
+#include "scenewatch/service/live_view.h"
 #include "scenewatch/service/log.h"
 #include "scenewatch/service/server.h"
 #include "scenewatch/core/memory.h"
@@ -54,12 +57,15 @@ int main(int argc, char** argv) {
   CLI::App app{"scenewatchd - the scenewatch perception service.\n"
                "Serves the scenewatch protocol (4-byte big-endian length + protobuf) over TCP, keeps the\n"
                "working memory of the scene and saves it to the model directory on SaveModel and on\n"
-               "SIGINT/SIGTERM. Prints 'listening on ADDRESS:PORT' on stdout once ready."};
+               "SIGINT/SIGTERM. Prints 'listening on ADDRESS:PORT' on stdout once ready (and, with --http,\n"
+               "'live view on http://ADDRESS:PORT/' on the next line)."};
   std::string config_path;
   std::optional<int> port;
   std::optional<std::string> address;
   std::optional<std::string> model_dir;
   std::optional<std::string> token_file;
+  std::optional<int> http_port;
+  std::optional<std::string> http_bind;
   std::string log_level = "info";
   app.add_option("--config", config_path, "YAML config file (see config/scenewatchd.yaml); default: built-in defaults");
   app.add_option("--port", port, "TCP port, 0 = pick a free one (overrides server.port)")->check(CLI::Range(0, 65535));
@@ -68,6 +74,11 @@ int main(int argc, char** argv) {
   app.add_option("--token-file", token_file,
                  "access token file, created (mode 0600) when missing (overrides server.token_file; "
                  "default ~/.scenewatch/token)");
+  app.add_option("--http", http_port,
+                 "serve the live view in the browser on this HTTP port, 0 = pick a free one (overrides "
+                 "server.http_port; read-only)")
+      ->check(CLI::Range(0, 65535));
+  app.add_option("--http-bind", http_bind, "the live view's listen address (overrides server.http_bind; default 127.0.0.1)");
   app.add_option("--log-level", log_level, "debug, info, warn or error")
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}));
   try {
@@ -96,6 +107,10 @@ int main(int argc, char** argv) {
   if (address) config.server.address = *address;
   if (model_dir) config.server.model_dir = *model_dir;
   if (token_file) config.server.token_file = *token_file;
+  // The live view is on when --http is given (0: a free port) or server.http_port is set.
+  const bool live_view_on = http_port.has_value() || config.server.http_port != 0;
+  if (http_port) config.server.http_port = static_cast<std::uint16_t>(*http_port);
+  if (http_bind) config.server.http_bind = *http_bind;
   if (config.server.token_file.empty()) config.server.token_file = scenewatch::service::default_token_path();
   if (auto s = scenewatch::service::validate(config.server); !s) {
     log(LogLevel::kError, "config: " + s.error().message);
@@ -141,12 +156,44 @@ int main(int argc, char** argv) {
     log(LogLevel::kError, s.error().message);
     return 1;
   }
+
+  // The live view: its own thread and socket; it sees the frames the server processes.
+  std::unique_ptr<scenewatch::service::LiveView> live_view;
+  std::unique_ptr<scenewatch::service::HttpServer> http;
+  if (live_view_on) {
+    scenewatch::service::LiveViewConfig view_config;
+    view_config.three_js = config.server.http_three_js;
+    live_view = std::make_unique<scenewatch::service::LiveView>(memory, view_config);
+    if (auto s = live_view->check_three_js(); !s) log(LogLevel::kWarning, "live view: " + s.error().message);
+    server.set_frame_observer([view = live_view.get()](const scenewatch::Frame& frame,
+                                                       const scenewatch::pipeline::FrameResult& result) {
+      view->observe(frame, result);
+    });
+    scenewatch::service::HttpServerConfig http_config;
+    http_config.address = config.server.http_bind;
+    http_config.port = config.server.http_port;
+    http = std::make_unique<scenewatch::service::HttpServer>(
+        http_config, [view = live_view.get()](const scenewatch::service::HttpRequest& r) { return view->handle(r); },
+        [&log](LogLevel level, const std::string& message) { log(level, message); });
+    if (auto s = http->listen(); !s) {
+      log(LogLevel::kError, "live view: " + s.error().message);
+      return 1;
+    }
+  }
+
   log(LogLevel::kInfo, "scenewatchd listening on " + server.endpoint() + " (max message " +
                            std::to_string(config.server.max_message_bytes) + " bytes, " +
                            std::to_string(config.server.data_roots.size()) + " data roots)");
   std::cout << "listening on " << server.endpoint() << std::endl;
+  if (http) {
+    http->start();
+    log(LogLevel::kInfo, "live view (read-only) on http://" + http->endpoint() + "/");
+    std::cout << "live view on http://" << http->endpoint() << "/" << std::endl;
+  }
 
   server.run();
+  // No frame is processed any more: the live view's streams can close.
+  if (http) http->stop();
 
   int rc = 0;
   if (!model.empty()) {

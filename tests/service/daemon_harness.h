@@ -26,15 +26,17 @@ inline constexpr double kCallTimeoutS = 60.0;
 class Daemon {
  public:
   /// `server_yaml`: lines of the server section (indented by two spaces), `port: 0` is added, and
-  /// `token_file: WORK_DIR/token` unless it names one.
-  void start(const std::filesystem::path& work_dir, const std::string& server_yaml) {
+  /// `token_file: WORK_DIR/token` unless it names one. `extra_args` go on the command line.
+  void start(const std::filesystem::path& work_dir, const std::string& server_yaml,
+             const std::vector<std::string>& extra_args = {}) {
     work_dir_ = work_dir;
     if (server_yaml.find("token_file:") == std::string::npos) token_file_ = work_dir / "token";
     const auto config = work_dir / ("scenewatchd-" + std::to_string(++starts_) + ".yaml");
     std::ofstream(config) << "server:\n  address: 127.0.0.1\n  port: 0\n"
                           << (token_file_.empty() ? "" : "  token_file: " + token_file_.string() + "\n") << server_yaml;
-    auto child = ChildProcess::start({daemon_binary().string(), "--config", config.string(), "--port", "0"},
-                                     work_dir / ("scenewatchd-" + std::to_string(starts_) + ".log"));
+    std::vector<std::string> argv{daemon_binary().string(), "--config", config.string(), "--port", "0"};
+    argv.insert(argv.end(), extra_args.begin(), extra_args.end());
+    auto child = ChildProcess::start(argv, work_dir / ("scenewatchd-" + std::to_string(starts_) + ".log"));
     ASSERT_TRUE(child.has_value()) << "cannot start " << daemon_binary();
     process_ = std::move(*child);
     const auto line = process_->read_line(kStartTimeoutS);
@@ -55,6 +57,11 @@ class Daemon {
     if (!process_) return std::nullopt;
     process_->signal(SIGTERM);
     return process_->wait(kStartTimeoutS);
+  }
+
+  /// The next line the daemon prints on stdout after "listening on ..." (nothing on timeout).
+  std::optional<std::string> read_line(double timeout_s = kStartTimeoutS) {
+    return process_ ? process_->read_line(timeout_s) : std::nullopt;
   }
 
   /// True while the process runs.

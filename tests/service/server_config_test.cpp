@@ -43,6 +43,10 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
   EXPECT_TRUE(s.data_roots.empty());
   EXPECT_TRUE(s.model_dir.empty());
   EXPECT_TRUE(s.token_file.empty()) << "empty: the daemon and the CLI use ~/.scenewatch/token";
+  EXPECT_EQ(s.http_port, 0) << "no live view unless asked";
+  EXPECT_EQ(s.http_bind, defaults.http_bind);
+  EXPECT_EQ(s.http_bind, "127.0.0.1");
+  EXPECT_EQ(s.http_three_js, defaults.http_three_js);
   const pipeline::Config pipeline_defaults;
   EXPECT_DOUBLE_EQ(loaded->pipeline.background.resolution_m, pipeline_defaults.background.resolution_m);
   EXPECT_DOUBLE_EQ(loaded->pipeline.segmentation.voxel_size_m, pipeline_defaults.segmentation.voxel_size_m);
@@ -74,6 +78,9 @@ TEST_F(ServerConfigTest, ErrorsNameTheKey) {
       {"server:\n  max_message_bytes: 10\n", "server.max_message_bytes"},
       {"server:\n  max_queued_bytes: 100\n", "server.max_queued_bytes"},
       {"server:\n  io_threads: 0\n", "server.io_threads"},
+      {"server:\n  http_port: 70000\n", "server.http_port"},
+      {"server:\n  http_port: 7878\n  port: 7878\n", "server.http_port"},
+      {"server:\n  http_port: 8080\n  http_bind: ''\n", "server.http_bind"},
       {"server:\n  data_roots: [does-not-exist]\n", "server.data_roots[0]"},
       {"server: 5\n", "server"},
       {"segmentation:\n  voxel_size_m: -1\n", "segmentation.voxel_size_m"},

@@ -157,6 +157,21 @@ Status write_color_png(const fs::path& path, const ColorImage& image) {
   return write_mat(path, bgr);
 }
 
+Result<std::string> encode_color_png(const ColorImage& image) {
+  if (auto st = check_buffer("(in memory)", image, image.rgb, 3); !st) return st.error();
+  cv::Mat rgb(image.height, image.width, CV_8UC3, const_cast<std::uint8_t*>(image.rgb.data()));
+  cv::Mat bgr;
+  cv::cvtColor(rgb, bgr, cv::COLOR_RGB2BGR);
+  std::vector<std::uint8_t> bytes;
+  try {
+    if (!cv::imencode(".png", bgr, bytes)) return io_error("cannot encode a " + std::to_string(image.width) + "x" +
+                                                           std::to_string(image.height) + " image as PNG");
+  } catch (const cv::Exception& e) {
+    return io_error(std::string("cannot encode an image as PNG: ") + e.what());
+  }
+  return std::string(bytes.begin(), bytes.end());
+}
+
 Status write_depth_png(const fs::path& path, const DepthImage& image) {
   if (auto st = check_buffer(path, image, image.depth_mm, 1); !st) return st;
   return write_mat(path, cv::Mat(image.height, image.width, CV_16UC1, const_cast<std::uint16_t*>(image.depth_mm.data())));

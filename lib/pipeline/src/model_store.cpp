@@ -14,13 +14,8 @@ namespace fs = std::filesystem;
 using nlohmann::json;
 
 namespace {
-json vec(const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); }
 Eigen::Vector3d vec3(const json& j) { return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()}; }
 
-json box_json(const OrientedBox& b) {
-  const Eigen::Quaterniond& q = b.rotation;
-  return {{"center", vec(b.center)}, {"rotation_xyzw", {q.x(), q.y(), q.z(), q.w()}}, {"extents", vec(b.extents)}};
-}
 OrientedBox box_from(const json& j) {
   OrientedBox b;
   b.center = vec3(j.at("center"));
@@ -30,13 +25,6 @@ OrientedBox box_from(const json& j) {
   return b;
 }
 
-json dofs_json(const DofVector& v) { return json(std::vector<double>(v.begin(), v.end())); }
-json flags_json(const DofFlags& f) {
-  json names = json::array();
-  for (int k = 0; k < kDofCount; ++k)
-    if (f[static_cast<std::size_t>(k)]) names.push_back(to_string(static_cast<Dof>(k)));
-  return names;
-}
 DofFlags flags_from(const json& j) {
   DofFlags f{};
   for (const auto& name : j) {
@@ -47,16 +35,6 @@ DofFlags flags_from(const json& j) {
     if (!known) throw std::invalid_argument("unknown DoF '" + name.get<std::string>() + "'");
   }
   return f;
-}
-
-json foreground_json(const ForegroundState& s) {
-  json handlings = json::array();
-  for (const auto& h : s.handlings) {
-    handlings.push_back({{"start_s", h.start_s}, {"end_s", h.end_s}, {"range", dofs_json(h.range)}, {"moved", flags_json(h.moved)}});
-  }
-  const Eigen::Matrix4d& m = s.T_world_object.matrix();
-  return {{"T_world_object", std::vector<double>(m.data(), m.data() + 16)}, {"free", flags_json(s.free)},
-          {"handlings", handlings}, {"promoted_s", s.promoted_s}, {"model_points", s.model_points}};
 }
 
 ForegroundState foreground_from(const json& j) {
@@ -92,23 +70,6 @@ Result<T> parse(const char* what, F&& f) {
   }
 }
 }  // namespace
-
-json to_json(const Plane& p) {
-  json hull = json::array();
-  for (const auto& h : p.hull) hull.push_back(vec(h));
-  return {{"id", p.id}, {"normal", vec(p.normal)}, {"d", p.d}, {"hull", hull}, {"area_m2", p.area_m2},
-          {"inlier_count", p.inlier_count}, {"centroid", vec(p.centroid)}};
-}
-
-json to_json(const TrackedObject& o) {
-  const ObjectCluster& c = o.cluster;
-  json j = {{"id", o.id}, {"plane_id", c.plane_id}, {"centroid", vec(c.centroid)}, {"box", box_json(c.box)},
-          {"point_count", c.point_count}, {"mean_rgb", {c.mean_rgb.x(), c.mean_rgb.y(), c.mean_rgb.z()}},
-          {"first_seen_s", o.first_seen_s}, {"last_seen_s", o.last_seen_s}, {"observations", o.observations},
-          {"supported_by", o.supported_by}};
-  if (o.foreground) j["foreground"] = foreground_json(*o.foreground);
-  return j;
-}
 
 Result<Plane> plane_from_json(const json& j) {
   return parse<Plane>("plane", [&] {

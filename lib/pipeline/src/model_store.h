@@ -13,11 +13,10 @@
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
+#include "scenewatch/core/scene_json.h"  // to_json of planes and objects
 
 namespace scenewatch::pipeline {
 
-nlohmann::json to_json(const Plane& plane);
-nlohmann::json to_json(const TrackedObject& object);
 Result<Plane> plane_from_json(const nlohmann::json& j);
 Result<TrackedObject> object_from_json(const nlohmann::json& j);
 

@@ -404,6 +404,29 @@ background::Occupancy WorkingMemory::query(const Eigen::Vector3d& p) const {
   return impl_->map.query(p);
 }
 
+OccupiedVoxels WorkingMemory::occupied_voxels(std::size_t max_count) const {
+  OccupiedVoxels out;
+  {
+    std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
+    out.centers_world = impl_->map.occupied_voxel_centers();
+    out.resolution_m = impl_->map.resolution();
+  }
+  out.total = out.centers_world.size();
+  if (max_count == 0) {
+    out.centers_world.clear();
+    out.stride = out.total == 0 ? 1 : out.total;
+    return out;
+  }
+  out.stride = (out.total + max_count - 1) / max_count;
+  if (out.stride > 1) {
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < out.total; i += out.stride) out.centers_world[kept++] = out.centers_world[i];
+    out.centers_world.resize(kept);
+  }
+  out.stride = std::max<std::size_t>(out.stride, 1);
+  return out;
+}
+
 background::BoxOccupancy WorkingMemory::query_box(const Aabb& box) const {
   std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
   return impl_->map.query_box(box);

@@ -98,6 +98,7 @@ struct RequestHandler::Impl {
   HandlerConfig config;
   Executor mutate, query;
   std::function<std::size_t()> connections;
+  FrameObserver frame_observer;
   std::atomic<bool> stopping{false};
   std::atomic<std::uint64_t> frames_skipped{0};  // live frames superseded by newer ones
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
@@ -356,6 +357,7 @@ struct RequestHandler::Impl {
   Status process(const Frame& frame, proto::Response& response) {
     auto result = memory.process(frame);
     if (!result) return result.error();
+    if (frame_observer) frame_observer(frame, *result);
     auto* out = response.mutable_ingest();
     out->set_frame_index(result->frame_index);
     out->set_points(result->points);
@@ -544,6 +546,8 @@ void RequestHandler::unsubscribe(SessionContext& context) {
 std::string RequestHandler::error_payload(ErrorCode code, const std::string& message) const {
   return error_reply(0, convert::to_proto(code), message, "connection").payload;
 }
+
+void RequestHandler::set_frame_observer(FrameObserver observer) { impl_->frame_observer = std::move(observer); }
 
 void RequestHandler::set_connection_counter(std::function<std::size_t()> counter) {
   impl_->connections = std::move(counter);

@@ -180,6 +180,8 @@ std::string Server::endpoint() const {
   return ec ? std::string() : format_endpoint(endpoint);
 }
 
+void Server::set_frame_observer(FrameObserver observer) { impl_->handler.set_frame_observer(std::move(observer)); }
+
 void Server::run() {
   Impl& s = *impl_;
   if (s.stop_requested || !s.acceptor.is_open()) return;

@@ -71,6 +71,12 @@ Status validate(const ServerConfig& config) {
     return invalid_argument("server.io_threads: must be in [1, " + std::to_string(kMaxIoThreads) + "], got " +
                             std::to_string(config.io_threads));
   }
+  if (config.http_port != 0 && config.http_bind.empty()) {
+    return invalid_argument("server.http_bind: must not be empty when server.http_port is set");
+  }
+  if (config.http_port != 0 && config.http_port == config.port) {
+    return invalid_argument("server.http_port: must differ from server.port (" + std::to_string(config.port) + ")");
+  }
   for (std::size_t i = 0; i < config.data_roots.size(); ++i) {
     const fs::path& root = config.data_roots[i];
     std::error_code ec;
@@ -111,6 +117,12 @@ Status read_server_config(const YAML::Node& root, const fs::path& base_dir, Serv
   }
   if (Status s = read_integer(section, "io_threads", 1, kMaxIoThreads, config.io_threads); !s) return s;
   if (Status s = read_integer(section, "keep_snapshots", 1, 1000, config.keep_snapshots); !s) return s;
+
+  if (Status s = read_integer(section, "http_port", 0, 65535, config.http_port); !s) return s;
+  if (Status s = section.read("http_bind", config.http_bind); !s) return s;
+  std::string three_js = config.http_three_js.string();
+  if (Status s = section.read("http_three_js", three_js); !s) return s;
+  config.http_three_js = resolve(base_dir, three_js);
 
   std::vector<std::string> roots;
   for (const auto& r : config.data_roots) roots.push_back(r.string());

@@ -1,6 +1,7 @@
 #pragma once
 /// PNG images: 8-bit colour, 16-bit depth in millimetres, 16-bit labels.
 #include <filesystem>
+#include <string>
 #include <utility>
 
 #include "scenewatch/core/image.h"
@@ -22,5 +23,8 @@ Result<std::pair<int, int>> read_png_size(const std::filesystem::path& path);
 Status write_color_png(const std::filesystem::path& path, const ColorImage& image);
 Status write_depth_png(const std::filesystem::path& path, const DepthImage& image);
 Status write_label_png(const std::filesystem::path& path, const LabelImage& image);
+
+/// The PNG file's bytes of a colour image, in memory (for serving it over HTTP).
+Result<std::string> encode_color_png(const ColorImage& image);
 
 }  // namespace scenewatch::io

@@ -121,6 +121,14 @@ struct Stats {
 
 using EventCallback = std::function<void(const Event&)>;
 
+/// Centres of the map's occupied voxels, for display.
+struct OccupiedVoxels {
+  std::vector<Eigen::Vector3d> centers_world;  ///< at most the asked-for count
+  std::size_t total = 0;                       ///< occupied voxels in the map (finest resolution)
+  std::size_t stride = 1;                      ///< every stride-th voxel was kept (1: all of them)
+  double resolution_m = 0.0;
+};
+
 /// Which snapshot load_newest_good() loaded, and why newer ones were refused.
 struct LoadedSnapshot {
   std::filesystem::path folder;
@@ -141,6 +149,9 @@ class WorkingMemory {
 
   background::Occupancy query(const Eigen::Vector3d& p_world) const;
   background::BoxOccupancy query_box(const Aabb& box_world) const;
+  /// The occupied voxels' centres (finest resolution); when there are more than `max_count`,
+  /// every k-th of them in the map's order, k the smallest stride that fits.
+  OccupiedVoxels occupied_voxels(std::size_t max_count) const;
   std::size_t clear_box(const Aabb& box_world);
   void reset();
 

@@ -12,8 +12,12 @@
 
 #include "scenewatch/core/result.h"
 
+namespace scenewatch {
+struct Frame;
+}  // namespace scenewatch
 namespace scenewatch::pipeline {
 class WorkingMemory;
+struct FrameResult;
 }  // namespace scenewatch::pipeline
 
 namespace scenewatch::service {
@@ -44,6 +48,10 @@ struct SessionContext {
   std::function<void(std::string payload)> event_sink;
   int subscription = -1;  ///< WorkingMemory subscription token, -1 when not subscribed
 };
+
+/// Sees each frame an ingest call processed, with what it produced (the live view keeps the last
+/// one's colour). Called on the processing thread: it must be quick.
+using FrameObserver = std::function<void(const Frame& frame, const pipeline::FrameResult& result)>;
 
 /// Runs a piece of work somewhere (a worker thread, a strand); the default runs it inline.
 using Executor = std::function<void(std::function<void()> task)>;
@@ -83,6 +91,9 @@ class RequestHandler {
 
   /// Counts connected clients for Stats; set before serving.
   void set_connection_counter(std::function<std::size_t()> counter);
+
+  /// Sees each processed frame; set before serving.
+  void set_frame_observer(FrameObserver observer);
 
   /// From now on, requests that change the model (also those already queued) are answered
   /// UNAVAILABLE because the server is stopping. Thread safe.

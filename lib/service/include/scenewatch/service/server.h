@@ -7,6 +7,7 @@
 
 #include "scenewatch/core/result.h"
 #include "scenewatch/service/log.h"
+#include "scenewatch/service/request_handler.h"
 #include "scenewatch/service/server_config.h"
 
 namespace scenewatch::pipeline {
@@ -35,6 +36,9 @@ class Server {
   std::uint16_t port() const;
   /// "address:port" of the listening socket ("[::1]:7878" for IPv6); valid after listen().
   std::string endpoint() const;
+
+  /// Sees each frame an ingest call processed (the live view); set before run().
+  void set_frame_observer(FrameObserver observer);
 
   /// Serves until stop() or a caught signal. Returns once every connection is closed and the
   /// calls in progress have finished.

@@ -32,6 +32,11 @@ struct ServerConfig {
   std::size_t keep_snapshots = 3;               ///< saved models kept in model_dir (the newest is `current`)
   /// The access token's file, created at start when missing (empty: default_token_path()).
   std::filesystem::path token_file;
+  /// The live view's HTTP port (0: no live view); read-only, so it needs no token.
+  std::uint16_t http_port = 0;
+  std::string http_bind = "127.0.0.1";          ///< the live view's listen address
+  /// three.js for the page's 3D view (Debian's libjs-three).
+  std::filesystem::path http_three_js = "/usr/share/javascript/three/three.min.js";
   /// Not read from YAML: the token itself (the contents of token_file), which calls that change
   /// the model must carry. Server::listen() refuses to serve without one.
   std::string access_token;

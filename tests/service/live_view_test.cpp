@@ -1,0 +1,316 @@
+// The live view in the browser: the HTTP request parser on byte splits and bad input, the real
+// scenewatchd's HTTP port against raw sockets (bad requests neither stop it nor its TCP API), and
+// headless Chromium on the page after a simulated cup was put on the table: the event and the
+// object are in the page's DOM, and the object's box is drawn in the 3D view of the screenshot.
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <sys/time.h>
+#include <unistd.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <chrono>
+#include <future>
+#include <thread>
+#include <string>
+
+#include "daemon_harness.h"
+#include "scenewatch.pb.h"
+#include "scenewatch/service/http_request.h"
+#include "scenewatch/sim/scenario_yaml.h"
+#include "scenewatch/sim/simulator.h"
+
+namespace scenewatch::test {
+namespace {
+namespace fs = std::filesystem;
+using service::HttpRequestParser;
+
+// ---- the parser
+
+TEST(HttpRequestParser, ParsesAHeadFedInAnySplit) {
+  const std::string head =
+      "GET /api/events?since=7&x HTTP/1.1\r\nHost: 127.0.0.1:8080\r\nAccept:  text/event-stream \r\n\r\n";
+  for (std::size_t split = 0; split <= head.size(); ++split) {
+    SCOPED_TRACE(split);
+    HttpRequestParser parser;
+    if (split > 0) {
+      EXPECT_EQ(parser.feed(head.substr(0, split)),
+                split == head.size() ? HttpRequestParser::State::kComplete : HttpRequestParser::State::kIncomplete);
+    }
+    ASSERT_EQ(parser.feed(head.substr(split)), HttpRequestParser::State::kComplete);
+    const auto& r = parser.request();
+    EXPECT_EQ(r.method, "GET");
+    EXPECT_EQ(r.path, "/api/events");
+    EXPECT_EQ(r.query_value("since"), "7");
+    EXPECT_TRUE(r.has_query("x"));
+    EXPECT_FALSE(r.has_query("y"));
+    EXPECT_EQ(r.header("accept"), "text/event-stream");
+    EXPECT_EQ(r.header("HOST"), "127.0.0.1:8080");
+  }
+  HttpRequestParser bare;  // "\n" line ends
+  EXPECT_EQ(bare.feed("GET / HTTP/1.0\nHost: x\n\n"), HttpRequestParser::State::kComplete);
+  EXPECT_EQ(bare.request().path, "/");
+}
+
+TEST(HttpRequestParser, RefusesGarbageAndOversizedHeads) {
+  struct Case {
+    std::string bytes;
+    int status;
+  };
+  for (const Case& c : {Case{"garbage\r\n\r\n", 400}, Case{"GET /\r\n\r\n", 400}, Case{"GET  / HTTP/1.1\r\n\r\n", 400},
+                        Case{"GET http://x/ HTTP/1.1\r\n\r\n", 400}, Case{"GET / FTP/1.0\r\n\r\n", 400},
+                        Case{"GET / HTTP/2.0\r\n\r\n", 505}, Case{"GET / HTTP/1.1\r\nno colon\r\n\r\n", 400},
+                        Case{"G(T / HTTP/1.1\r\n\r\n", 400}, Case{std::string("GET /\x01 HTTP/1.1\r\n\r\n"), 400}}) {
+    SCOPED_TRACE(c.bytes);
+    HttpRequestParser parser;
+    ASSERT_EQ(parser.feed(c.bytes), HttpRequestParser::State::kError);
+    EXPECT_EQ(parser.error_status(), c.status) << parser.error();
+    EXPECT_EQ(parser.feed("GET / HTTP/1.1\r\n\r\n"), HttpRequestParser::State::kError) << "stays failed";
+  }
+  HttpRequestParser parser(1024);
+  EXPECT_EQ(parser.feed("GET / HTTP/1.1\r\nX: " + std::string(1000, 'a')), HttpRequestParser::State::kIncomplete);
+  EXPECT_EQ(parser.feed(std::string(100, 'a')), HttpRequestParser::State::kError);
+  EXPECT_EQ(parser.error_status(), 413);
+}
+
+// ---- the daemon's HTTP port
+
+/// Sends raw bytes to 127.0.0.1:port and reads until the server closes (or 20 s pass). With
+/// `hang_up`, the client closes its sending side after the bytes.
+std::string raw_exchange(std::uint16_t port, const std::string& bytes, bool hang_up = false) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return "socket failed";
+  timeval timeout{20, 0};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &timeout, sizeof timeout);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(port);
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string out;
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0) {
+    std::size_t sent = 0;
+    while (sent < bytes.size()) {
+      const ssize_t n = ::send(fd, bytes.data() + sent, bytes.size() - sent, MSG_NOSIGNAL);
+      if (n <= 0) break;  // the server may answer and close before it read everything
+      sent += static_cast<std::size_t>(n);
+    }
+    if (hang_up) ::shutdown(fd, SHUT_WR);
+    char buffer[65536];
+    for (ssize_t n; (n = ::recv(fd, buffer, sizeof buffer, 0)) > 0;) out.append(buffer, static_cast<std::size_t>(n));
+  } else {
+    out = "connect failed";
+  }
+  ::close(fd);
+  return out;
+}
+
+std::string get(std::uint16_t port, const std::string& target) {
+  return raw_exchange(port, "GET " + target + " HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n");
+}
+
+int status_of(const std::string& response) {
+  if (response.rfind("HTTP/1.1 ", 0) != 0 || response.size() < 12) return -1;
+  return std::stoi(response.substr(9, 3));
+}
+
+std::string body_of(const std::string& response) {
+  const std::size_t at = response.find("\r\n\r\n");
+  return at == std::string::npos ? std::string() : response.substr(at + 4);
+}
+
+class LiveViewTest : public ::testing::Test {
+ protected:
+  void SetUp() override { tmp_ = make_temp_dir("live-view"); }
+  void TearDown() override {
+    if (HasFailure()) std::cerr << "---- scenewatchd log ----\n" << daemon_.log() << "-------------------------\n";
+    daemon_ = Daemon();
+    std::error_code ec;
+    fs::remove_all(tmp_, ec);
+  }
+
+  /// Starts scenewatchd with `--http 0` and reads the live view's port from its second line.
+  void start() {
+    ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "segmentation:\n  up_vector: [0, 0, 1]\n", {"--http", "0"}));
+    const auto line = daemon_.read_line();
+    ASSERT_TRUE(line.has_value()) << "no 'live view on' line";
+    const std::string prefix = "live view on http://127.0.0.1:";
+    ASSERT_EQ(line->rfind(prefix, 0), 0u) << *line;
+    http_port_ = static_cast<std::uint16_t>(std::stoi(line->substr(prefix.size())));
+  }
+
+  /// The TCP API still answers.
+  void expect_api_serves() {
+    ASSERT_TRUE(daemon_.running()) << daemon_.log();
+    service::Client client = daemon_.connect();
+    EXPECT_EQ(call(client, request([](proto::Request& r) { r.mutable_health(); })).status().code(), proto::Status::OK);
+  }
+
+  fs::path tmp_;
+  Daemon daemon_;
+  std::uint16_t http_port_ = 0;
+};
+
+TEST_F(LiveViewTest, BadRequestsGetAnErrorAndTheDaemonKeepsServing) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  // A client that connects and says nothing is answered 408 after the head deadline (10 s); it
+  // waits meanwhile, and the others are served.
+  auto silent = std::async(std::launch::async, [port = http_port_] { return raw_exchange(port, ""); });
+  struct Case {
+    const char* what;
+    std::string bytes;
+    int status;
+  };
+  for (const Case& c : {Case{"garbage request line", "garbage\r\n\r\n", 400},
+                        Case{"binary noise", std::string("\x16\x03\x01\x02\x00\x01\x00\x01\xfc\x03\x03\r\n\r\n", 15), 400},
+                        Case{"oversized header", "GET / HTTP/1.1\r\nX-Big: " + std::string(20000, 'x') + "\r\n\r\n", 413},
+                        Case{"unknown path", "GET /etc/passwd HTTP/1.1\r\n\r\n", 404},
+                        Case{"POST", "POST /api/state HTTP/1.1\r\nContent-Length: 2\r\n\r\n{}", 405},
+                        Case{"DELETE", "DELETE / HTTP/1.1\r\n\r\n", 405},
+                        Case{"bad since", "GET /api/events?since=-1 HTTP/1.1\r\n\r\n", 400},
+                        Case{"HTTP/2", "GET / HTTP/2.0\r\n\r\n", 505}}) {
+    SCOPED_TRACE(c.what);
+    EXPECT_EQ(status_of(raw_exchange(http_port_, c.bytes)), c.status);
+    ASSERT_NO_FATAL_FAILURE(expect_api_serves());
+    EXPECT_EQ(status_of(get(http_port_, "/")), 200);
+  }
+  // A client that connects and hangs up without a word, or half-way through its request.
+  EXPECT_EQ(raw_exchange(http_port_, "", true), "") << "no request, no answer";
+  EXPECT_EQ(raw_exchange(http_port_, "GET / HT", true), "") << "no whole request, no answer";
+  const std::string page = get(http_port_, "/");
+  EXPECT_NE(page.find("Content-Type: text/html"), std::string::npos);
+  EXPECT_NE(body_of(page).find("scenewatch live view"), std::string::npos);
+  const std::string state = get(http_port_, "/api/state");
+  EXPECT_EQ(status_of(state), 200);
+  EXPECT_NE(body_of(state).find("\"frames_processed\":0"), std::string::npos) << state;
+  EXPECT_NE(body_of(state).find("\"voxels\":{"), std::string::npos) << state;
+  EXPECT_EQ(body_of(get(http_port_, "/api/state?voxels=0")).find("\"voxels\""), std::string::npos) << "the light poll";
+  EXPECT_EQ(status_of(get(http_port_, "/api/frame.png")), 404) << "no frame yet";
+  EXPECT_EQ(body_of(get(http_port_, "/api/events?since=0")), "{\"events\":[]}");
+  EXPECT_EQ(status_of(silent.get()), 408);
+  ASSERT_NO_FATAL_FAILURE(expect_api_serves());
+  ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
+}
+
+// ---- the page in headless Chromium
+
+const char* const kChromium = "/usr/bin/chromium";
+
+/// Streams the simulator's cup_added (320x240, 12 frames per phase) into the daemon; returns
+/// the ground truth of where the cup was put.
+Eigen::Vector3d ingest_cup_added(const Daemon& daemon) {
+  auto loaded = sim::load_scenario(source_dir() / "sample_clouds/scenarios/cup_added.yaml");
+  EXPECT_TRUE(loaded.ok()) << loaded.error().message;
+  if (!loaded.ok()) return {};
+  const sim::Scenario scenario = sim::with_frames(sim::with_resolution(*loaded, 320, 240), 12);
+  auto simulator = sim::Simulator::create(scenario);
+  EXPECT_TRUE(simulator.ok()) << simulator.error().message;
+  if (!simulator.ok()) return {};
+  service::Client client = daemon.connect();
+  double stamp = 0;
+  for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
+    for (int f = 0; f < simulator->frame_count(phase); ++f) {
+      auto frame = sim::as_frame(simulator->render(phase, f), scenario.intrinsics, stamp += 1.0 / 30);
+      EXPECT_TRUE(frame.ok());
+      if (!frame.ok()) return {};
+      proto::Request r;
+      *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+      EXPECT_EQ(call(client, r).status().code(), proto::Status::OK);
+    }
+  }
+  return simulator->changes().at(0).added.at(0).T_world_object.translation();
+}
+
+/// Reads /api/events (Server-Sent Events) until `wanted` came or timeout_s passed; returns what came.
+std::string read_event_stream(std::uint16_t port, const std::string& wanted, double timeout_s) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return "socket failed";
+  timeval tick{0, 200000};
+  ::setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tick, sizeof tick);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(port);
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  std::string out;
+  const std::string request = "GET /api/events HTTP/1.1\r\nAccept: text/event-stream\r\n\r\n";
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) == 0 &&
+      ::send(fd, request.data(), request.size(), MSG_NOSIGNAL) == static_cast<ssize_t>(request.size())) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    char buffer[65536];
+    while (out.find(wanted) == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+      const ssize_t n = ::recv(fd, buffer, sizeof buffer, 0);
+      if (n == 0) break;
+      if (n > 0) out.append(buffer, static_cast<std::size_t>(n));
+    }
+  }
+  ::close(fd);
+  return out;
+}
+
+/// Headless Chromium on a URL with the given output flag (--dump-dom, --screenshot=FILE).
+CommandResult run_chromium(const fs::path& work_dir, const std::string& url, const std::string& output_flag) {
+  return run_command({kChromium, "--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",
+                      "--use-angle=swiftshader", "--user-data-dir=" + (work_dir / "chromium-profile").string(),
+                      "--window-size=1280,800", "--hide-scrollbars", output_flag, url},
+                     work_dir, 240.0);
+}
+
+TEST_F(LiveViewTest, ChromiumShowsTheObjectAndTheEventAfterACupIsPutOnTheTable) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  // A stream opened before the frames hears the event as it is emitted.
+  auto stream = std::async(std::launch::async, [port = http_port_] {
+    return read_event_stream(port, "\"kind\":\"OBJECT_ADDED\"", 120.0);
+  });
+  // The event comes seconds later (after the second phase's frames): the stream is open by then.
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ingest_cup_added(daemon_);
+  const std::string streamed = stream.get();
+  EXPECT_EQ(streamed.rfind("HTTP/1.1 200 OK\r\nContent-Type: text/event-stream\r\n", 0), 0u) << streamed;
+  EXPECT_NE(streamed.find("\nid: 1\ndata: {"), std::string::npos) << streamed;
+  EXPECT_NE(streamed.find("\"kind\":\"OBJECT_ADDED\""), std::string::npos) << streamed;
+  EXPECT_EQ(streamed.find("indices_after"), std::string::npos) << "point indices are left out";
+  // The event is in the backlog and the object in the state before the browser looks.
+  const std::string events = body_of(get(http_port_, "/api/events?since=0"));
+  ASSERT_NE(events.find("OBJECT_ADDED"), std::string::npos) << events;
+  const std::string state = body_of(get(http_port_, "/api/state"));
+  ASSERT_NE(state.find("\"objects\":[{"), std::string::npos) << state;
+  const std::string frame = get(http_port_, "/api/frame.png");
+  ASSERT_EQ(status_of(frame), 200);
+  EXPECT_EQ(body_of(frame).substr(1, 3), "PNG");
+
+  if (!fs::exists(kChromium)) {
+    GTEST_SKIP() << "headless Chromium is not installed (" << kChromium
+                 << "; Debian package chromium, which scripts/install-deps installs): the browser part is skipped";
+  }
+  const std::string url = "http://127.0.0.1:" + std::to_string(http_port_) + "/";
+  const CommandResult dom = run_chromium(tmp_, url, "--dump-dom");
+  ASSERT_EQ(dom.exit_code, 0) << dom.err;
+  EXPECT_NE(dom.out.find("class=\"event OBJECT_ADDED\""), std::string::npos) << dom.out;
+  EXPECT_NE(dom.out.find("class=\"object\">object "), std::string::npos) << dom.out;
+  EXPECT_NE(dom.out.find("id=\"three-error\" hidden"), std::string::npos) << "three.js or WebGL missing:\n" << dom.out;
+
+  const fs::path shot = tmp_ / "live-view.png";
+  const CommandResult screenshot = run_chromium(tmp_, url, "--screenshot=" + shot.string());
+  ASSERT_EQ(screenshot.exit_code, 0) << screenshot.err;
+  const cv::Mat image = cv::imread(shot.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(image.empty()) << "no screenshot at " << shot;
+  EXPECT_EQ(image.cols, 1280);
+  // The 3D view is right of the 440 px side column; the boxes are drawn in pure magenta, a colour
+  // nothing else on the page has (the heatmap is a jet colour map over grey).
+  const cv::Mat view = image(cv::Rect(450, 40, image.cols - 450, image.rows - 40));
+  int magenta = 0;
+  for (int y = 0; y < view.rows; ++y)
+    for (int x = 0; x < view.cols; ++x) {
+      const cv::Vec3b bgr = view.at<cv::Vec3b>(y, x);
+      magenta += bgr[2] > 230 && bgr[0] > 230 && bgr[1] < 40;
+    }
+  EXPECT_GT(magenta, 1000) << "the object's box is not drawn in the 3D view: " << shot;
+  if (const char* keep = std::getenv("SCENEWATCH_LIVE_VIEW_SCREENSHOT")) fs::copy_file(shot, keep, fs::copy_options::overwrite_existing);
+  ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
+}
+
+}  // namespace
+}  // namespace scenewatch::test
