@@ -94,8 +94,11 @@ struct FitOptions {
   bool json = false;
   std::string config;                   ///< YAML config: its segmentation section is used
   std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
+  std::string classes;                  ///< classes file (empty: the shipped config/ontology.yaml)
+  std::string out_dir;                  ///< when set: each object's completed model as PCD and PLY
 };
-/// Offline: segments one frame and fits primitives (plane, cylinder, sphere, cone) to each object.
+/// Offline: segments one frame, fits primitives (plane, cylinder, sphere, cone) to each object and
+/// classifies it (class, score, grasp points, completed model).
 int run_fit(const FitOptions& options);
 
 struct DiffOptions {

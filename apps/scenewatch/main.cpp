@@ -149,15 +149,20 @@ int main(int argc, char** argv) {
 
   FitOptions fit_options;
   auto* fit = app.add_subcommand(
-      "fit", "offline: segment one frame and fit primitives (plane, cylinder, sphere, cone) to each object (no daemon)");
+      "fit", "offline: segment one frame, fit primitives to each object and classify it (no daemon)");
   fit->footer(
       "FILE: a .pcd/.ply cloud, or one frame of an RGB-D sequence folder (DIR:N, DIR/frame-NNNNNN).\n"
       "Shapes by CGAL's Efficient RANSAC on the object's normals; the largest cylinder is refined by\n"
       "least squares, held upright along the support's normal when it stands within 25 degrees of it.\n"
+      "Each class's primitive is then fitted and checked against the class's bounds: the object gets the\n"
+      "best accepted class (score, grasp points, completed model) or 'unknown' with its best primitive.\n"
       "Example: scenewatch fit ../shared/data/ycb/frame-000003 --depth-scale 0.0001");
   fit->add_option("file", fit_options.file, "cloud file or sequence frame")->required();
-  fit->add_flag("--json", fit_options.json, "print JSON (each object's shapes, refined cylinder and timings)");
+  fit->add_flag("--json", fit_options.json, "print JSON (each object's shapes, refined cylinder, class, candidates, grasps and timings)");
   fit->add_option("--config", fit_options.config, "YAML config (its segmentation section is used)");
+  fit->add_option("--classes", fit_options.classes, "object classes file (default: the shipped config/ontology.yaml)");
+  fit->add_option("--out", fit_options.out_dir,
+                  "write each object's completed model (its class's primitive, whole surface) to DIR as object-N-CLASS.pcd and .ply");
   add_depth_scale_option(fit, fit_options.depth_scale_m);
   fit->callback([&] { action = [&] { return run_fit(fit_options); }; });
 
