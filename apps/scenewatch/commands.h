@@ -47,6 +47,10 @@ int run_clear_box(const RemoteOptions& options, const std::vector<double>& box);
 int run_reset(const RemoteOptions& options);
 int run_save(const RemoteOptions& options);
 int run_load(const RemoteOptions& options);
+/// The daemon's object classes (ListClasses).
+int run_classes(const RemoteOptions& options);
+/// Sends a classes file (config/ontology.yaml's format) to the daemon (DefineClass).
+int run_define_class(const RemoteOptions& options, const std::string& yaml_file);
 int run_events(const RemoteOptions& options, std::uint64_t since, std::uint32_t max_count);
 int run_watch(const RemoteOptions& options);
 

@@ -19,7 +19,7 @@ void add_remote_options(CLI::App* command, RemoteOptions& options) {
       ->capture_default_str();
   command->add_flag("--json", options.json, "print machine-readable JSON");
   command->add_option("--token-file", options.token_file,
-                      "the daemon's access token, needed by ingest, clear, reset, save and load")
+                      "the daemon's access token, needed by ingest, clear, reset, save, load and define-class")
       ->capture_default_str();
 }
 
@@ -111,6 +111,17 @@ int main(int argc, char** argv) {
   clear->add_option("box", clear_box, "MINX MINY MINZ MAXX MAXY MAXZ")->expected(6)->required();
   add_remote_options(clear, remote);
   clear->callback([&] { action = [&] { return run_clear_box(remote, clear_box); }; });
+
+  auto* classes = app.add_subcommand("classes", "list the daemon's object classes (name, primitive, bounds, grasps)");
+  add_remote_options(classes, remote);
+  classes->callback([&] { action = [&] { return run_classes(remote); }; });
+
+  std::string class_file;
+  auto* define_class = app.add_subcommand(
+      "define-class", "add or replace object classes from FILE (config/ontology.yaml's format); kept in the daemon's ontology.sqlite");
+  define_class->add_option("file", class_file, "YAML file: classes: [...]")->required();
+  add_remote_options(define_class, remote);
+  define_class->callback([&] { action = [&] { return run_define_class(remote, class_file); }; });
 
   auto* reset = app.add_subcommand("reset", "forget everything: map, objects, events");
   add_remote_options(reset, remote);

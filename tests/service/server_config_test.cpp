@@ -43,6 +43,7 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
   EXPECT_TRUE(s.data_roots.empty());
   EXPECT_TRUE(s.model_dir.empty());
   EXPECT_TRUE(s.token_file.empty()) << "empty: the daemon and the CLI use ~/.scenewatch/token";
+  EXPECT_TRUE(loaded->ontology.classes_file.empty()) << "empty: the shipped config/ontology.yaml";
   const pipeline::Config pipeline_defaults;
   EXPECT_DOUBLE_EQ(loaded->pipeline.background.resolution_m, pipeline_defaults.background.resolution_m);
   EXPECT_DOUBLE_EQ(loaded->pipeline.segmentation.voxel_size_m, pipeline_defaults.segmentation.voxel_size_m);
@@ -60,6 +61,9 @@ TEST_F(ServerConfigTest, RelativePathsAreRelativeToTheConfigFile) {
   EXPECT_EQ(loaded->server.data_roots[0], tmp_ / "data");
   EXPECT_EQ(loaded->server.model_dir, tmp_ / "state" / "model");
   EXPECT_EQ(loaded->server.port, 0);
+  auto classes = load_daemon_config(write("ontology:\n  classes_file: my/classes.yaml\n"));
+  ASSERT_TRUE(classes.ok()) << classes.error().message;
+  EXPECT_EQ(classes->ontology.classes_file, tmp_ / "my" / "classes.yaml");
 }
 
 TEST_F(ServerConfigTest, ErrorsNameTheKey) {
@@ -78,6 +82,8 @@ TEST_F(ServerConfigTest, ErrorsNameTheKey) {
       {"server: 5\n", "server"},
       {"segmentation:\n  voxel_size_m: -1\n", "segmentation.voxel_size_m"},
       {"bogus_section:\n  a: 1\n", "bogus_section"},
+      {"ontology:\n  classes: x.yaml\n", "ontology.classes"},
+      {"ontology: 5\n", "ontology"},
   };
   for (const auto& [text, key] : cases) {
     auto loaded = load_daemon_config(write(text));
