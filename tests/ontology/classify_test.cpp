@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
+#include <cstdlib>
 #include <sstream>
 #include <string>
 
@@ -308,6 +310,54 @@ TEST(ClassifyMugTest, PclStereoMugIsACup) {
   // A mug of about 41 mm (YCB's; this one is not measured): a sensible mug size.
   EXPECT_GT(d->primitive->radius_m, 0.03);
   EXPECT_LT(d->primitive->radius_m, 0.055);
+}
+
+}  // namespace
+}  // namespace scenewatch::ontology
+
+namespace scenewatch::ontology {
+namespace {
+
+// mOSD (../shared/data/mosd/learn): every labelled object of 500 points or more, described with
+// the table's normal (the segmentation's largest plane) as up. A survey printed for the README:
+// the dataset has no per-object category, only the scenes' (learn0-16 boxes, learn17-24 stacked
+// boxes, learn25-32 occluded objects, learn33-44 cylindric objects). Classes are not tuned to it.
+TEST(ClassifyMosdSurvey, LabelledObjects) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
+  const ClassLibrary library = shipped_classes();
+  std::map<std::string, std::map<std::string, int>> counts;  // scene category -> class -> objects
+  for (int n = 0; n < 45; ++n) {
+    const auto path = test::data_dir() / "mosd/learn" / ("learn" + std::to_string(n) + ".pcd");
+    auto file = io::read_cloud(path);
+    auto labels = io::read_pcd_labels(path);
+    ASSERT_TRUE(file.ok() && labels.ok()) << path;
+    const Cloud& cloud = *file->cloud;
+    const segmentation::Segmentation scene = segmentation::segment(cloud, segmentation::Config{});
+    Eigen::Vector3d up(0, -1, 0);
+    double area = 0;
+    for (const auto& plane : scene.planes)
+      if (plane.area_m2 > area) up = plane.normal, area = plane.area_m2;
+    std::map<std::uint32_t, std::vector<int>> objects;
+    for (std::size_t i = 0; i < labels->size(); ++i)
+      if ((*labels)[i] >= 20 && is_valid(cloud.points[i])) objects[(*labels)[i] / 10].push_back(static_cast<int>(i));
+    const std::string category = n <= 16 ? "boxes" : n <= 24 ? "stacked boxes" : n <= 32 ? "occluded" : "cylindric";
+    std::printf("learn%d:", n);
+    for (const auto& [id, indices] : objects) {
+      if (indices.size() < 500) continue;
+      auto d = describe(cloud, indices, up, library);
+      const std::string name = d.ok() ? d->class_name : "error";
+      ++counts[category][name];
+      std::printf(" %u=%s", id, name.c_str());
+      if (d.ok() && d->primitive && name != kUnknownClass) std::printf("(r %.0f)", d->primitive->radius_m * 1000);
+      if (d.ok() && std::getenv("SCENEWATCH_SURVEY_VERBOSE") != nullptr) print("\n  object " + std::to_string(id), *d);
+    }
+    std::printf("\n");
+  }
+  for (const auto& [category, classes] : counts) {
+    std::printf("%s:", category.c_str());
+    for (const auto& [name, count] : classes) std::printf(" %s %d", name.c_str(), count);
+    std::printf("\n");
+  }
 }
 
 }  // namespace
