@@ -71,6 +71,9 @@ TEST(ClassLibraryTest, ErrorsNameTheField) {
   EXPECT_NE(error_of(std::string(kCup) + "  - {name: cup, shape: sphere, radius_m: [0.02, 0.1]}\n").find("used twice"), std::string::npos);
   EXPECT_NE(error_of(replaced(kCup, "name: cup", "name: Cup")).find("a-z"), std::string::npos);
   EXPECT_NE(error_of("classes: [").find("not valid YAML"), std::string::npos);
+  EXPECT_NE(error_of("classes:\n  - {name: a, shape: sphere, radius_m: [0.02, 0.1], [1, 2]: 3}\n").find("not a plain name"), std::string::npos);
+  EXPECT_NE(error_of("classes:\n  - {name: [a], shape: sphere}\n").find("name: expected a string"), std::string::npos);
+  EXPECT_NE(error_of("- 1\n").find("expected a map"), std::string::npos);
   EXPECT_NE(error_of("things: []").find("things: unknown key"), std::string::npos) << error_of("things: []");
   auto missing = load_classes_file("/nonexistent/ontology.yaml");
   ASSERT_FALSE(missing.ok());

@@ -49,6 +49,7 @@ class Fields {
   }
   Status finish() const {
     for (const auto& kv : node_) {
+      if (!kv.first.IsScalar()) return invalid_argument(path_ + ": a key is not a plain name");
       const std::string key = kv.first.as<std::string>();
       if (!read_.count(key)) return invalid_argument(path(key) + ": unknown key");
     }
