@@ -30,6 +30,20 @@ void disc(std::vector<Eigen::Vector3d>& out, const Eigen::Vector3d& center, cons
 
 std::vector<Eigen::Vector3d> complete_surface(const ShapeFit& fit, double spacing, bool open_top) {
   assert(spacing > 0);
+  // A class may allow objects of up to 2 m: coarser spacing beyond kMaxCompletedPoints.
+  double area = 0;
+  switch (fit.shape) {
+    case ClassShape::kCylinder:
+    case ClassShape::kFrustum:
+      area = M_PI * (fit.bottom_radius_m + fit.top_radius_m) * fit.height_m +
+             M_PI * (fit.bottom_radius_m * fit.bottom_radius_m + fit.top_radius_m * fit.top_radius_m);
+      break;
+    case ClassShape::kSphere: area = 4 * M_PI * fit.radius_m * fit.radius_m; break;
+    case ClassShape::kBox:
+      area = 2 * (fit.size_m.x() * fit.size_m.y() + (fit.size_m.x() + fit.size_m.y()) * fit.height_m);
+      break;
+  }
+  spacing = std::max(spacing, std::sqrt(area / static_cast<double>(kMaxCompletedPoints)));
   std::vector<Eigen::Vector3d> out;
   const Eigen::Vector3d a = fit.axis.normalized();
   const Eigen::Vector3d e1 = a.unitOrthogonal(), e2 = a.cross(e1);
