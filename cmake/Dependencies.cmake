@@ -37,6 +37,8 @@ add_library(scenewatch::opencv ALIAS scenewatch_opencv)
 
 find_package(Protobuf 3 REQUIRED)
 find_package(yaml-cpp REQUIRED)
+# The ontology's store (lib/ontology/src/class_store.cpp); Debian: libsqlite3-dev.
+find_package(SQLite3 REQUIRED)
 find_package(nlohmann_json 3 REQUIRED)
 find_package(CLI11 REQUIRED)
 find_package(tsl-robin-map REQUIRED)

@@ -1,7 +1,9 @@
 // Primitive fitting per object: scenewatch's fit_object (PCL normals, CGAL Efficient RANSAC over
 // four shapes, cylinder refinement) against PCL's cylinder RANSAC (SACSegmentationFromNormals,
 // SACMODEL_CYLINDER, with the same normals estimation) on the same clusters, in the same run: the
-// objects of the segmented YCB frames and of a simulated frame with a can and a cup.
+// objects of the segmented YCB frames and of a simulated frame with a can and a cup. Also the time
+// of the whole description (describe(): fit_object plus each shipped class's fit and checks) and
+// the class it gives.
 #include <pcl/ModelCoefficients.h>
 #include <pcl/console/print.h>
 #include <pcl/features/normal_3d.h>
@@ -10,6 +12,7 @@
 
 #include "bench.h"
 #include "scenewatch/io/sequence.h"
+#include "scenewatch/ontology/describe.h"
 #include "scenewatch/ontology/fit.h"
 #include "scenewatch/segmentation/tabletop.h"
 #include "scenewatch/sim/scenario_yaml.h"
@@ -91,10 +94,15 @@ int run_fit(const Options& o) {
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // "RANSAC found no model" on every box
   std::printf("\n== Primitive fitting per object: scenewatch fit_object vs PCL SACMODEL_CYLINDER (medians of %d runs)\n",
               o.repetitions);
-  std::printf("%-24s %6s %7s %7s %6s %9s %9s %9s\n", "scene/object", "points", "ours ms", "pcl ms", "ratio", "best",
-              "ours r mm", "pcl r mm");
-  std::vector<double> ratios, ours_all, pcl_all;
+  std::printf("%-24s %6s %7s %7s %6s %9s %9s %9s %11s %-8s\n", "scene/object", "points", "ours ms", "pcl ms", "ratio", "best",
+              "ours r mm", "pcl r mm", "describe ms", "class");
+  std::vector<double> ratios, ours_all, pcl_all, describe_all;
   const ontology::FitConfig config;
+  auto classes = ontology::load_classes_file(std::filesystem::path(SCENEWATCH_SOURCE_DIR) / "config/ontology.yaml");
+  if (!classes) {
+    std::fprintf(stderr, "%s\n", classes.error().message.c_str());
+    return 1;
+  }
   for (const Scene& scene : scenes(o)) {
     const Cloud& cloud = *scene.cloud;
     const segmentation::Segmentation seg = segmentation::segment(cloud, scene.segmentation);
@@ -105,26 +113,30 @@ int run_fit(const Options& o) {
       for (const auto& plane : seg.planes)
         if (plane.id == object.plane_id) up = plane.normal;
       const std::vector<int> same = subsample(cloud, object.indices, config.max_points);
-      std::vector<double> ours, theirs;
+      std::vector<double> ours, theirs, described;
       Result<ontology::ObjectFit> fit = invalid_argument("not run");
+      Result<ontology::ObjectDescription> description = invalid_argument("not run");
       double pcl_radius = 0;
       for (int r = 0; r < o.repetitions; ++r) {
         ours.push_back(time_ms([&] { fit = ontology::fit_object(cloud, object.indices, config, up); }));
         theirs.push_back(time_ms([&] { pcl_radius = pcl_cylinder_radius(cloud, same); }));
+        described.push_back(time_ms([&] { description = ontology::describe(cloud, object.indices, up, *classes); }));
       }
       if (!fit) continue;
       const double a = median(ours), b = median(theirs);
       ratios.push_back(a / b);
       ours_all.push_back(a);
       pcl_all.push_back(b);
+      describe_all.push_back(median(described));
       const char* best = fit->best >= 0 ? ontology::to_string(fit->shapes[static_cast<std::size_t>(fit->best)].kind) : "-";
       const std::string name = scene.name + " #" + std::to_string(k);
-      std::printf("%-24s %6zu %7.1f %7.1f %6.2f %9s %9.1f %9.1f\n", name.c_str(), same.size(), a, b, a / b, best,
-                  fit->cylinder ? fit->cylinder->radius_m * 1000 : 0.0, pcl_radius * 1000);
+      std::printf("%-24s %6zu %7.1f %7.1f %6.2f %9s %9.1f %9.1f %11.1f %-8s\n", name.c_str(), same.size(), a, b, a / b, best,
+                  fit->cylinder ? fit->cylinder->radius_m * 1000 : 0.0, pcl_radius * 1000, median(described),
+                  description ? description->class_name.c_str() : "error");
     }
   }
-  std::printf("objects %zu: median ours %.1f ms, PCL cylinder %.1f ms, median ratio ours/PCL %.2f\n", ratios.size(),
-              median(ours_all), median(pcl_all), median(ratios));
+  std::printf("objects %zu: median ours %.1f ms, PCL cylinder %.1f ms, median ratio ours/PCL %.2f; median describe %.1f ms\n",
+              ratios.size(), median(ours_all), median(pcl_all), median(ratios), median(describe_all));
   return 0;
 }
 

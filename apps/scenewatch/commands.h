@@ -48,6 +48,10 @@ int run_clear_box(const RemoteOptions& options, const std::vector<double>& box);
 int run_reset(const RemoteOptions& options);
 int run_save(const RemoteOptions& options);
 int run_load(const RemoteOptions& options);
+/// The daemon's object classes (ListClasses).
+int run_classes(const RemoteOptions& options);
+/// Sends a classes file (config/ontology.yaml's format) to the daemon (DefineClass).
+int run_define_class(const RemoteOptions& options, const std::string& yaml_file);
 int run_events(const RemoteOptions& options, std::uint64_t since, std::uint32_t max_count);
 int run_watch(const RemoteOptions& options);
 
@@ -95,8 +99,11 @@ struct FitOptions {
   bool json = false;
   std::string config;                   ///< YAML config: its segmentation section is used
   std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
+  std::string classes;                  ///< classes file (empty: the shipped config/ontology.yaml)
+  std::string out_dir;                  ///< when set: each object's completed model as PCD and PLY
 };
-/// Offline: segments one frame and fits primitives (plane, cylinder, sphere, cone) to each object.
+/// Offline: segments one frame, fits primitives (plane, cylinder, sphere, cone) to each object and
+/// classifies it (class, score, grasp points, completed model).
 int run_fit(const FitOptions& options);
 
 struct DiffOptions {

@@ -1,8 +1,9 @@
 // scenewatch fit: primitives fitted to each object of a scene (offline, no daemon): the
-// segmentation module finds the objects, the ontology module fits them.
+// segmentation module finds the objects, the ontology module fits and classifies them.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
@@ -10,7 +11,8 @@
 #include "commands.h"
 #include "config_file.h"
 #include "frame_spec.h"
-#include "scenewatch/ontology/fit.h"
+#include "scenewatch/io/cloud_io.h"
+#include "scenewatch/ontology/describe.h"
 #include "scenewatch/segmentation/tabletop.h"
 
 namespace scenewatch::cli {
@@ -66,11 +68,89 @@ json to_json(const ontology::CylinderFit& c, const Eigen::Vector3d& up) {
           {"tilt_from_support_deg", angle_deg(c.axis, up)}};
 }
 
+json to_json(const ontology::ShapeFit& f) {
+  json j = {{"shape", ontology::to_string(f.shape)}, {"center", vec(f.center)}, {"rms_m", f.rms_m}};
+  switch (f.shape) {
+    case ontology::ClassShape::kCylinder:
+    case ontology::ClassShape::kFrustum:
+      j["axis"] = vec(f.axis);
+      j["radius_m"] = f.radius_m;
+      j["height_m"] = f.height_m;
+      j["coverage_deg"] = f.coverage_deg;
+      j["axis_tilt_deg"] = f.axis_tilt_deg;
+      j["inner_fraction"] = f.inner_fraction;
+      if (f.shape == ontology::ClassShape::kFrustum) {
+        j["bottom_radius_m"] = f.bottom_radius_m;
+        j["top_radius_m"] = f.top_radius_m;
+        j["taper_deg"] = f.taper_deg;
+      }
+      break;
+    case ontology::ClassShape::kSphere: j["radius_m"] = f.radius_m; j["coverage_deg"] = f.coverage_deg; break;
+    case ontology::ClassShape::kBox:
+      j["axis"] = vec(f.axis);
+      j["x_axis"] = vec(f.x_axis);
+      j["size_m"] = json::array({f.size_m.x(), f.size_m.y(), f.height_m});
+      break;
+  }
+  return j;
+}
+
+std::string text(const ontology::ShapeFit& f) {
+  std::string s = ontology::to_string(f.shape);
+  switch (f.shape) {
+    case ontology::ClassShape::kCylinder:
+      return s + " r " + fixed(f.radius_m * 1000, 1) + " mm, h " + fixed(f.height_m * 1000, 1) + " mm, tilt " +
+             fixed(f.axis_tilt_deg, 1) + " deg, rms " + fixed(f.rms_m * 1000, 2) + " mm, coverage " + fixed(f.coverage_deg, 0) + " deg";
+    case ontology::ClassShape::kFrustum:
+      return s + " r " + fixed(f.bottom_radius_m * 1000, 1) + ".." + fixed(f.top_radius_m * 1000, 1) + " mm (taper " +
+             fixed(f.taper_deg, 1) + " deg), h " + fixed(f.height_m * 1000, 1) + " mm, rms " + fixed(f.rms_m * 1000, 2) +
+             " mm, inside wall " + fixed(f.inner_fraction, 2);
+    case ontology::ClassShape::kSphere:
+      return s + " r " + fixed(f.radius_m * 1000, 1) + " mm, rms " + fixed(f.rms_m * 1000, 2) + " mm";
+    case ontology::ClassShape::kBox:
+      return s + " " + fixed(f.size_m.x() * 1000, 0) + " x " + fixed(f.size_m.y() * 1000, 0) + " x " + fixed(f.height_m * 1000, 0) +
+             " mm, rms " + fixed(f.rms_m * 1000, 2) + " mm";
+  }
+  return s;
+}
+
+json to_json(const ontology::GraspPose& g) {
+  return {{"name", g.name},         {"kind", ontology::to_string(g.kind)}, {"position", vec(g.position)},
+          {"approach", vec(g.approach)}, {"closing", vec(g.closing)},        {"width_m", g.width_m}};
+}
+
+/// The completed model of object `id` as DIR/object-ID-CLASS.pcd and .ply; the message on failure.
+std::string write_completion(const std::string& dir, std::size_t id, const ontology::ObjectDescription& d) {
+  Cloud cloud;
+  for (const auto& p : d.completed_points) {
+    PointT q;
+    q.getVector3fMap() = p.cast<float>();
+    q.r = 230;
+    q.g = 160;
+    q.b = 40;
+    cloud.points.push_back(q);
+  }
+  cloud.width = static_cast<std::uint32_t>(cloud.points.size());
+  cloud.height = 1;
+  const std::string stem = dir + "/object-" + std::to_string(id) + "-" + d.class_name;
+  if (Status s = io::write_pcd(stem + ".pcd", cloud); !s) return s.error().message;
+  if (Status s = io::write_ply(stem + ".ply", cloud); !s) return s.error().message;
+  return {};
+}
+
 }  // namespace
 
 int run_fit(const FitOptions& options) {
   auto loaded = read_config_file(options.config);
   if (!loaded) return fail(loaded.error().message);
+  const std::string classes_file = options.classes.empty() ? std::string(SCENEWATCH_CLASSES_FILE) : options.classes;
+  auto library = ontology::load_classes_file(classes_file);
+  if (!library) return fail(library.error().message);
+  if (!options.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(options.out_dir, ec);
+    if (ec) return fail(options.out_dir + ": cannot create the folder: " + ec.message());
+  }
   auto frame = load_one_frame(options.file, sequence_options(options.depth_scale_m));
   if (!frame) {
     const std::string& message = frame.error().message;
@@ -97,24 +177,43 @@ int run_fit(const FitOptions& options) {
     for (const Plane& plane : scene.planes)
       if (plane.id == object.plane_id) up = plane.normal;
     const auto t1 = std::chrono::steady_clock::now();
-    auto fit = ontology::fit_object(cloud, object.indices, ontology::FitConfig{}, up);
+    auto described = ontology::describe(cloud, object.indices, up, *library);
     const double fit_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count();
     json j = {{"id", i}, {"plane_id", object.plane_id}, {"points", object.point_count}, {"centroid", vec(object.centroid)},
               {"fit_ms", fit_ms}};
     lines += "  object " + std::to_string(i) + " (" + std::to_string(object.point_count) + " points, at " +
              direction(object.centroid) + "):";
-    if (!fit) {
-      j["error"] = fit.error().message;
-      lines += " no fit: " + fit.error().message + "\n";
+    if (!described) {
+      j["error"] = described.error().message;
+      lines += " no fit: " + described.error().message + "\n";
       objects.push_back(std::move(j));
       continue;
     }
+    const ontology::ObjectDescription& d = *described;
+    const ontology::ObjectFit* fit = &d.fit;
     json shapes = json::array();
     for (const auto& s : fit->shapes) shapes.push_back(to_json(s));
     j["shapes"] = std::move(shapes);
     j["best"] = fit->best >= 0 ? json(ontology::to_string(fit->shapes[static_cast<std::size_t>(fit->best)].kind)) : json(nullptr);
     j["cylinder"] = fit->cylinder ? to_json(*fit->cylinder, up) : json(nullptr);
     j["timing_ms"] = {{"normals", fit->normals_ms}, {"detection", fit->detection_ms}, {"refinement", fit->refinement_ms}};
+    j["class"] = d.class_name;
+    j["score"] = d.score;
+    j["primitive"] = d.primitive ? to_json(*d.primitive) : json(nullptr);
+    json grasps = json::array(), candidates = json::array();
+    for (const auto& g : d.grasps) grasps.push_back(to_json(g));
+    for (const auto& m : d.candidates) {
+      candidates.push_back({{"class", m.class_name}, {"accepted", m.accepted}, {"score", m.score}, {"reason", m.reason}});
+    }
+    j["grasps"] = std::move(grasps);
+    j["candidates"] = std::move(candidates);
+    std::string written;
+    if (!options.out_dir.empty() && !d.completed_points.empty()) {
+      if (std::string error = write_completion(options.out_dir, i, d); !error.empty()) return fail(error);
+      written = options.out_dir + "/object-" + std::to_string(i) + "-" + d.class_name + ".pcd";
+      j["completed_file"] = written;
+    }
+    j["completed_points"] = d.completed_points.size();
     objects.push_back(std::move(j));
 
     lines += fit->best >= 0 ? " best " + text(fit->shapes[static_cast<std::size_t>(fit->best)]) : std::string(" no primitive found");
@@ -125,6 +224,19 @@ int run_fit(const FitOptions& options) {
                " mm, axis " + direction(c->axis) + " (" + fixed(angle_deg(c->axis, up), 1) + " deg from the support's normal" +
                (c->axis_fixed ? ", held upright" : "") + "), rms " + fixed(c->rms_m * 1000, 2) + " mm, coverage " +
                fixed(c->coverage_deg, 0) + " deg, " + std::to_string(c->inliers) + " points\n";
+    }
+    if (d.class_name != ontology::kUnknownClass) {
+      lines += "      class " + d.class_name + " (score " + fixed(d.score, 2) + "): " + text(*d.primitive) + "\n";
+      for (const auto& g : d.grasps) {
+        lines += "        grasp " + g.name + " (" + ontology::to_string(g.kind) + "): at " + direction(g.position) + ", approach " +
+                 direction(g.approach) + ", width " + fixed(g.width_m * 1000, 0) + " mm\n";
+      }
+      if (!written.empty()) lines += "        completed model: " + written + " (" + std::to_string(d.completed_points.size()) + " points)\n";
+    } else {
+      lines += "      class unknown" + (d.best_primitive ? " (best primitive " + std::string(ontology::to_string(d.best_primitive->kind)) + ")" : std::string()) + "\n";
+    }
+    for (const auto& m : d.candidates) {
+      if (!m.accepted) lines += "        not " + m.class_name + ": " + m.reason + "\n";
     }
   }
 

@@ -19,7 +19,7 @@ void add_remote_options(CLI::App* command, RemoteOptions& options) {
       ->capture_default_str();
   command->add_flag("--json", options.json, "print machine-readable JSON");
   command->add_option("--token-file", options.token_file,
-                      "the daemon's access token, needed by ingest, clear, reset, save and load")
+                      "the daemon's access token, needed by ingest, clear, reset, save, load and define-class")
       ->capture_default_str();
 }
 
@@ -116,6 +116,17 @@ int main(int argc, char** argv) {
   add_remote_options(clear, remote);
   clear->callback([&] { action = [&] { return run_clear_box(remote, clear_box); }; });
 
+  auto* classes = app.add_subcommand("classes", "list the daemon's object classes (name, primitive, bounds, grasps)");
+  add_remote_options(classes, remote);
+  classes->callback([&] { action = [&] { return run_classes(remote); }; });
+
+  std::string class_file;
+  auto* define_class = app.add_subcommand(
+      "define-class", "add or replace object classes from FILE (config/ontology.yaml's format); kept in the daemon's ontology.sqlite");
+  define_class->add_option("file", class_file, "YAML file: classes: [...]")->required();
+  add_remote_options(define_class, remote);
+  define_class->callback([&] { action = [&] { return run_define_class(remote, class_file); }; });
+
   auto* reset = app.add_subcommand("reset", "forget everything: map, objects, events");
   add_remote_options(reset, remote);
   reset->callback([&] { action = [&] { return run_reset(remote); }; });
@@ -153,15 +164,20 @@ int main(int argc, char** argv) {
 
   FitOptions fit_options;
   auto* fit = app.add_subcommand(
-      "fit", "offline: segment one frame and fit primitives (plane, cylinder, sphere, cone) to each object (no daemon)");
+      "fit", "offline: segment one frame, fit primitives to each object and classify it (no daemon)");
   fit->footer(
       "FILE: a .pcd/.ply cloud, or one frame of an RGB-D sequence folder (DIR:N, DIR/frame-NNNNNN).\n"
       "Shapes by CGAL's Efficient RANSAC on the object's normals; the largest cylinder is refined by\n"
       "least squares, held upright along the support's normal when it stands within 25 degrees of it.\n"
+      "Each class's primitive is then fitted and checked against the class's bounds: the object gets the\n"
+      "best accepted class (score, grasp points, completed model) or 'unknown' with its best primitive.\n"
       "Example: scenewatch fit ../shared/data/ycb/frame-000003 --depth-scale 0.0001");
   fit->add_option("file", fit_options.file, "cloud file or sequence frame")->required();
-  fit->add_flag("--json", fit_options.json, "print JSON (each object's shapes, refined cylinder and timings)");
+  fit->add_flag("--json", fit_options.json, "print JSON (each object's shapes, refined cylinder, class, candidates, grasps and timings)");
   fit->add_option("--config", fit_options.config, "YAML config (its segmentation section is used)");
+  fit->add_option("--classes", fit_options.classes, "object classes file (default: the shipped config/ontology.yaml)");
+  fit->add_option("--out", fit_options.out_dir,
+                  "write each object's completed model (its class's primitive, whole surface) to DIR as object-N-CLASS.pcd and .ply");
   add_depth_scale_option(fit, fit_options.depth_scale_m);
   fit->callback([&] { action = [&] { return run_fit(fit_options); }; });
 

@@ -5,8 +5,10 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <optional>
 #include <thread>
 
@@ -462,6 +464,66 @@ int run_load(const RemoteOptions& options) {
     if (options.json) return print_json({{"model_dir", r.load_model().model_dir()}, {"objects", r.load_model().objects()}});
     std::cout << "loaded the model from " << r.load_model().model_dir() << " ("
               << plural(r.load_model().objects(), "object") << ")" << std::endl;
+  });
+}
+
+int run_classes(const RemoteOptions& options) {
+  proto::Request request;
+  request.mutable_list_classes();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    const auto& reply = r.list_classes();
+    if (options.json) {
+      json classes = json::array();
+      for (const auto& c : reply.classes()) {
+        json grasps = json::array();
+        for (const auto& g : c.grasps()) grasps.push_back({{"name", g.name()}, {"kind", g.kind()}, {"height_fraction", g.height_fraction()}});
+        json j = {{"name", c.name()}, {"shape", c.shape()}, {"axis", c.axis()}, {"top", c.top()}, {"grasps", grasps},
+                  {"allowed_dofs", std::vector<std::string>(c.allowed_dofs().begin(), c.allowed_dofs().end())}};
+        if (c.has_radius_m()) j["radius_m"] = {c.radius_m().min(), c.radius_m().max()};
+        if (c.has_height_m()) j["height_m"] = {c.height_m().min(), c.height_m().max()};
+        if (c.has_taper_deg()) j["taper_deg"] = {c.taper_deg().min(), c.taper_deg().max()};
+        json sizes = json::array();
+        for (const auto& range : c.size_m()) sizes.push_back({range.min(), range.max()});
+        if (!sizes.empty()) j["size_m"] = sizes;
+        classes.push_back(std::move(j));
+      }
+      return print_json({{"classes", classes}});
+    }
+    std::cout << reply.classes_size() << (reply.classes_size() == 1 ? " class" : " classes") << "\n";
+    auto mm = [](const proto::Range& range) {
+      return std::to_string(static_cast<int>(std::lround(range.min() * 1000))) + ".." +
+             std::to_string(static_cast<int>(std::lround(range.max() * 1000))) + " mm";
+    };
+    for (const auto& c : reply.classes()) {
+      std::cout << "  " << c.name() << ": " << c.shape();
+      if (c.has_radius_m()) std::cout << ", radius " << mm(c.radius_m());
+      if (c.has_height_m()) std::cout << ", height " << mm(c.height_m());
+      for (int i = 0; i < c.size_m_size(); ++i) std::cout << (i == 0 ? ", sides " : " x ") << mm(c.size_m(i));
+      std::cout << ", axis " << c.axis() << ", top " << c.top() << "; grasps";
+      for (const auto& g : c.grasps()) std::cout << " " << g.name() << " (" << g.kind() << ")";
+      std::cout << "; motions";
+      for (const auto& d : c.allowed_dofs()) std::cout << " " << d;
+      std::cout << "\n";
+    }
+    std::cout << std::flush;
+  });
+}
+
+int run_define_class(const RemoteOptions& options, const std::string& yaml_file) {
+  std::ifstream in(yaml_file);
+  if (!in) return fail(yaml_file + ": cannot open the classes file");
+  std::stringstream text;
+  text << in.rdbuf();
+  proto::Request request;
+  request.mutable_define_class()->set_yaml(text.str());
+  return simple_call(options, request, [&](const proto::Response& r) {
+    const auto& reply = r.define_class();
+    const std::vector<std::string> names(reply.defined().begin(), reply.defined().end());
+    if (options.json) return print_json({{"defined", names}, {"persisted", reply.persisted()}});
+    std::cout << "defined";
+    for (const auto& n : names) std::cout << " " << n;
+    std::cout << (reply.persisted() ? " (stored in the daemon's ontology.sqlite)" : " (the daemon has no model directory: until it stops)")
+              << std::endl;
   });
 }
 

@@ -13,6 +13,7 @@
 
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/service/access_token.h"
+#include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/service/daemon_config.h"
 #include "scenewatch/service/http_server.h"
 #include "scenewatch/service/live_view.h"
@@ -149,6 +150,29 @@ int main(int argc, char** argv) {
   } else {
     log(LogLevel::kInfo, "no model directory configured: the model is not persisted");
   }
+
+  // The object classes: the classes file, overlaid by those defined through DefineClass, which
+  // ontology.sqlite in the model directory keeps.
+  const std::filesystem::path classes_file =
+      config.ontology.classes_file.empty() ? std::filesystem::path(SCENEWATCH_CLASSES_FILE) : config.ontology.classes_file;
+  std::filesystem::path class_store;
+  if (!model.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(model, ec);
+    if (ec) {
+      log(LogLevel::kError, "cannot create the model directory " + model.string() + ": " + ec.message());
+      return 1;
+    }
+    class_store = model / scenewatch::ontology::kClassStoreFile;
+  }
+  auto classes = scenewatch::ontology::ClassCatalog::open(classes_file, class_store);
+  if (!classes) {
+    log(LogLevel::kError, "ontology: " + classes.error().message);
+    return 1;
+  }
+  config.server.classes = std::move(*classes);
+  log(LogLevel::kInfo, "object classes: " + std::to_string(config.server.classes->library().classes().size()) + " (" +
+                           classes_file.string() + (class_store.empty() ? std::string(", not persisted)") : ", store " + class_store.string() + ")"));
 
   scenewatch::service::Server server(config.server, memory,
                                      [&log](LogLevel level, const std::string& message) { log(level, message); });

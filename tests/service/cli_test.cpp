@@ -160,6 +160,59 @@ TEST_F(CliTest, FitPrintsThePrimitivesOfEachObject) {
   EXPECT_NE(result.err.find("no valid"), std::string::npos) << result.err;
 }
 
+TEST_F(CliTest, FitClassifiesAndWritesTheCompletedModel) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  const fs::path out = tmp_ / "completed";
+  auto result = cli({"fit", (data_dir() / kMug).string(), "--out", out.string(), "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const json j = parse(result.out);
+  ASSERT_GE(j.at("objects").size(), 1u);
+  const json& mug = j.at("objects")[0];
+  EXPECT_EQ(mug.at("class"), "cup") << mug.dump();
+  EXPECT_GT(mug.at("score").get<double>(), 0.5);
+  EXPECT_EQ(mug.at("primitive").at("shape"), "frustum");
+  ASSERT_EQ(mug.at("grasps").size(), 2u);
+  EXPECT_EQ(mug.at("grasps")[1].at("kind"), "rim");
+  EXPECT_TRUE(fs::exists(out / "object-0-cup.pcd"));
+  EXPECT_TRUE(fs::exists(out / "object-0-cup.ply"));
+  auto completed = io::read_cloud(out / "object-0-cup.pcd");
+  ASSERT_TRUE(completed.ok()) << completed.error().message;
+  EXPECT_EQ(completed->cloud->size(), mug.at("completed_points").get<std::size_t>());
+  result = cli({"fit", (data_dir() / kMug).string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("class cup (score"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("not can: top open"), std::string::npos) << result.out;
+  // A bad classes file is named.
+  std::ofstream(tmp_ / "bad.yaml") << "classes:\n  - {name: x, shape: torus}\n";
+  result = cli({"fit", (data_dir() / kMug).string(), "--classes", (tmp_ / "bad.yaml").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("bad.yaml: classes[0] (x).shape: 'torus'"), std::string::npos) << result.err;
+}
+
+TEST_F(CliTest, ClassesAndDefineClass) {
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "  model_dir: " + (tmp_ / "model").string() + "\n"));
+  auto result = remote({"classes", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(parse(result.out).at("classes").size(), 5u);
+  std::ofstream(tmp_ / "kettle.yaml") << "classes:\n  - {name: kettle, shape: cylinder, radius_m: [0.06, 0.12], height_m: [0.12, 0.3]}\n";
+  result = remote({"define-class", (tmp_ / "kettle.yaml").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("defined kettle (stored in the daemon's ontology.sqlite)"), std::string::npos) << result.out;
+  EXPECT_TRUE(fs::exists(tmp_ / "model" / "ontology.sqlite"));
+  result = remote({"classes"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("6 classes"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("kettle: cylinder, radius 60..120 mm"), std::string::npos) << result.out;
+  // Without the token file: refused.
+  result = cli({"define-class", (tmp_ / "kettle.yaml").string(), "--port", std::to_string(daemon_.port()), "--token-file",
+                (tmp_ / "no-token").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("PERMISSION_DENIED"), std::string::npos) << result.err;
+  result = remote({"define-class", (tmp_ / "absent.yaml").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("absent.yaml"), std::string::npos) << result.err;
+}
+
 TEST_F(CliTest, NoDaemonIsAnErrorNamingTheEndpoint) {
   // A port that was free a moment ago.
   const int fd = ::socket(AF_INET, SOCK_STREAM, 0);

@@ -12,6 +12,7 @@
 
 #include "scenewatch.pb.h"
 #include "scenewatch/io/sequence.h"
+#include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/service/client.h"
 #include "test_data.h"
@@ -587,6 +588,58 @@ TEST_F(RequestHandlerTest, ConnectionErrorPayloadHasNoId) {
   EXPECT_EQ(response.id(), 0u);
   EXPECT_EQ(response.status().code(), proto::Status::INVALID_ARGUMENT);
   EXPECT_EQ(response.status().message(), "broken framing");
+}
+
+// DefineClass changes the model's classes: it needs the token; the classes it defines are listed
+// by ListClasses (no token) and kept in ontology.sqlite across a restart (a new catalog).
+TEST_F(RequestHandlerTest, DefineAndListClasses) {
+  const std::string token = "0123456789abcdef0123456789abcdef";
+  const fs::path store = tmp_ / "ontology.sqlite";
+  auto catalog = ontology::ClassCatalog::open(test::source_dir() / "config/ontology.yaml", store);
+  ASSERT_TRUE(catalog.ok()) << catalog.error().message;
+  HandlerConfig config;
+  config.token = token;
+  config.classes = std::move(*catalog);
+  RequestHandler handler(memory_, config);
+
+  proto::Request list;
+  list.mutable_list_classes();
+  auto listed = call(handler, list);
+  ASSERT_EQ(listed.status().code(), proto::Status::OK) << listed.status().message();
+  ASSERT_EQ(listed.list_classes().classes_size(), 5);
+  EXPECT_EQ(listed.list_classes().classes(1).name(), "cup");
+  EXPECT_EQ(listed.list_classes().classes(1).shape(), "frustum");
+  EXPECT_DOUBLE_EQ(listed.list_classes().classes(1).radius_m().max(), 0.07);
+  EXPECT_NE(listed.list_classes().yaml().find("name: cup"), std::string::npos);
+
+  proto::Request define;
+  define.set_id(9);
+  define.mutable_define_class()->set_yaml(
+      "classes:\n  - {name: kettle, shape: cylinder, radius_m: [0.06, 0.12], height_m: [0.12, 0.3], top: closed}\n");
+  auto refused = call(handler, define);
+  EXPECT_EQ(refused.status().code(), proto::Status::PERMISSION_DENIED);
+  define.set_token(token);
+  auto defined = call(handler, define);
+  ASSERT_EQ(defined.status().code(), proto::Status::OK) << defined.status().message();
+  ASSERT_EQ(defined.define_class().defined_size(), 1);
+  EXPECT_EQ(defined.define_class().defined(0), "kettle");
+  EXPECT_TRUE(defined.define_class().persisted());
+  EXPECT_EQ(call(handler, list).list_classes().classes_size(), 6);
+
+  // A bad class is refused with its field named, and nothing changes.
+  define.mutable_define_class()->set_yaml("classes:\n  - {name: pot, shape: cylinder, radius_m: [0.2, 0.1], height_m: [0.1, 0.2]}\n");
+  auto bad = call(handler, define);
+  EXPECT_EQ(bad.status().code(), proto::Status::INVALID_ARGUMENT);
+  EXPECT_NE(bad.status().message().find("radius_m"), std::string::npos) << bad.status().message();
+  EXPECT_EQ(call(handler, list).list_classes().classes_size(), 6);
+
+  auto reopened = ontology::ClassCatalog::open(test::source_dir() / "config/ontology.yaml", store);
+  ASSERT_TRUE(reopened.ok());
+  EXPECT_NE((*reopened)->library().find("kettle"), nullptr);
+
+  // Without classes the calls say so.
+  RequestHandler bare(memory_, HandlerConfig{});
+  EXPECT_EQ(call(bare, list).status().code(), proto::Status::UNAVAILABLE);
 }
 
 }  // namespace

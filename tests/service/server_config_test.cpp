@@ -47,6 +47,7 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
   EXPECT_EQ(s.http_bind, defaults.http_bind);
   EXPECT_EQ(s.http_bind, "127.0.0.1");
   EXPECT_EQ(s.http_three_js, defaults.http_three_js);
+  EXPECT_TRUE(loaded->ontology.classes_file.empty()) << "empty: the shipped config/ontology.yaml";
   const pipeline::Config pipeline_defaults;
   EXPECT_DOUBLE_EQ(loaded->pipeline.background.resolution_m, pipeline_defaults.background.resolution_m);
   EXPECT_DOUBLE_EQ(loaded->pipeline.segmentation.voxel_size_m, pipeline_defaults.segmentation.voxel_size_m);
@@ -64,6 +65,9 @@ TEST_F(ServerConfigTest, RelativePathsAreRelativeToTheConfigFile) {
   EXPECT_EQ(loaded->server.data_roots[0], tmp_ / "data");
   EXPECT_EQ(loaded->server.model_dir, tmp_ / "state" / "model");
   EXPECT_EQ(loaded->server.port, 0);
+  auto classes = load_daemon_config(write("ontology:\n  classes_file: my/classes.yaml\n"));
+  ASSERT_TRUE(classes.ok()) << classes.error().message;
+  EXPECT_EQ(classes->ontology.classes_file, tmp_ / "my" / "classes.yaml");
 }
 
 TEST_F(ServerConfigTest, ErrorsNameTheKey) {
@@ -85,6 +89,8 @@ TEST_F(ServerConfigTest, ErrorsNameTheKey) {
       {"server: 5\n", "server"},
       {"segmentation:\n  voxel_size_m: -1\n", "segmentation.voxel_size_m"},
       {"bogus_section:\n  a: 1\n", "bogus_section"},
+      {"ontology:\n  classes: x.yaml\n", "ontology.classes"},
+      {"ontology: 5\n", "ontology"},
   };
   for (const auto& [text, key] : cases) {
     auto loaded = load_daemon_config(write(text));

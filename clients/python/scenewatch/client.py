@@ -224,6 +224,16 @@ class Client:
             message.frame.CopyFrom(frame)
         return self._call("get_surprise_map", message, result="surprise_map")
 
+    def list_classes(self):
+        """The daemon's object classes: pb.ListClassesReply (``classes``, each a pb.ObjectClass,
+        and ``yaml``, the same as a classes document)."""
+        return self._call("list_classes", pb.ListClasses())
+
+    def define_class(self, yaml_text):
+        """Adds or replaces classes given as a classes document (config/ontology.yaml's format).
+        Needs the token. pb.DefineClassReply (``defined`` names, ``persisted``)."""
+        return self._call("define_class", pb.DefineClass(yaml=yaml_text))
+
     def subscribe(self, timeout_s=0):
         """From now on the daemon pushes every new event on this connection. Returns a
         ``Subscription`` to iterate; ``timeout_s`` is its default wait per event (0: forever)."""

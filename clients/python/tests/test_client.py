@@ -180,6 +180,18 @@ class ClientTest(unittest.TestCase):
             self.assertEqual(caught.exception.code, pb.Status.PERMISSION_DENIED)
             self.assertIn("token", caught.exception.message)
             self.assertIsInstance(stranger.stats(), pb.StatsReply)
+            with self.assertRaises(scenewatch.StatusError) as caught:
+                stranger.define_class("classes: []")
+            self.assertEqual(caught.exception.code, pb.Status.PERMISSION_DENIED)
+            self.assertIn("cup", [c.name for c in stranger.list_classes().classes])
+
+        # Object classes: a bad one names its field; a good one is listed.
+        with self.assertRaises(scenewatch.StatusError) as caught:
+            self.client.define_class("classes:\n  - {name: pot, shape: cylinder, radius_m: [0.2, 0.1], height_m: [0.1, 0.2]}\n")
+        self.assertIn("radius_m", caught.exception.message)
+        reply = self.client.define_class("classes:\n  - {name: pot, shape: cylinder, radius_m: [0.1, 0.2], height_m: [0.1, 0.2]}\n")
+        self.assertEqual(list(reply.defined), ["pot"])
+        self.assertIn("pot", [c.name for c in self.client.list_classes().classes])
 
         with self.assertRaises(ValueError):
             self.client.ingest_frame(cloud=bad.cloud, pose=[1, 0, 0])

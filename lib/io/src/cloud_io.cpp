@@ -320,6 +320,16 @@ Status write_pcd(const fs::path& path, const Cloud& cloud) {
   });
 }
 
+Status write_ply(const fs::path& path, const Cloud& cloud) {
+  quiet_pcl();
+  if (cloud.empty()) return invalid_argument(quoted(path) + ": refusing to write an empty cloud");
+  return write_atomically(path, [&](const fs::path& tmp) -> Status {
+    pcl::PLYWriter writer;
+    if (writer.write(tmp.string(), cloud, true, false) < 0) return io_error(quoted(path) + ": cannot write");
+    return {};
+  });
+}
+
 Status write_mesh_ply(const fs::path& path, const ColoredMesh& mesh) {
   quiet_pcl();
   if (mesh.empty()) return invalid_argument(quoted(path) + ": refusing to write a mesh without triangles");

@@ -144,6 +144,8 @@ Result<ObjectFit> fit_object(const Cloud& cloud, const std::vector<int>& indices
   for (auto& shape : out.shapes)
     for (int& i : shape.indices) i = kept[static_cast<std::size_t>(i)];
   out.refinement_ms = ms_since(t0);
+  out.sample_points = std::move(points);
+  out.sample_normals = std::move(normals);
   return out;
 }
 

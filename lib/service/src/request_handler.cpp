@@ -8,11 +8,13 @@
 #include <optional>
 
 #include "live_frame.h"
+#include "ontology_convert.h"
 #include "proto_convert.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/core/files.h"
 #include "scenewatch/service/access_token.h"
 #include "scenewatch/io/sequence.h"
+#include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/pipeline/working_memory.h"
 
 #ifndef SCENEWATCH_VERSION
@@ -43,6 +45,7 @@ Route route_of(proto::Request::CallCase call) {
     case proto::Request::kReset:
     case proto::Request::kSaveModel:
     case proto::Request::kLoadModel:
+    case proto::Request::kDefineClass:
       return Route::kMutate;
     default:
       return Route::kInline;
@@ -194,6 +197,8 @@ struct RequestHandler::Impl {
       case proto::Request::kSubscribe: return subscribe(context, response);
       case proto::Request::kGetEvents: return get_events(request.get_events(), response);
       case proto::Request::kGetSurpriseMap: return get_surprise_map(request.get_surprise_map(), response);
+      case proto::Request::kDefineClass: return define_class(request.define_class(), response);
+      case proto::Request::kListClasses: return list_classes(response);
       case proto::Request::CALL_NOT_SET: break;
     }
     // Not reached for a known call: the empty oneof is answered by the caller.
@@ -463,6 +468,35 @@ struct RequestHandler::Impl {
     if (Status s = require_model_dir(); !s) return s;
     if (Status s = memory.save(config.model_dir, config.keep_snapshots); !s) return s;
     response.mutable_save_model()->set_model_dir(config.model_dir.string());
+    return {};
+  }
+
+  Status require_classes() const {
+    if (!config.classes) return unavailable("this server has no object classes loaded");
+    return {};
+  }
+
+  Status define_class(const proto::DefineClass& msg, proto::Response& response) {
+    if (Status s = require_classes(); !s) return s;
+    auto parsed = ontology::parse_classes(msg.yaml(), "define_class.yaml");
+    if (!parsed) return parsed.error();
+    if (parsed->empty()) return invalid_argument("define_class.yaml: classes: the list is empty");
+    const double now_s = std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
+    auto* out = response.mutable_define_class();
+    for (const auto& c : parsed->classes()) {
+      if (Status s = config.classes->define(c, now_s); !s) return s;
+      out->add_defined(c.name);
+    }
+    out->set_persisted(config.classes->persistent());
+    return {};
+  }
+
+  Status list_classes(proto::Response& response) {
+    if (Status s = require_classes(); !s) return s;
+    const ontology::ClassLibrary library = config.classes->library();
+    auto* out = response.mutable_list_classes();
+    for (const auto& c : library.classes()) convert::to_proto(c, out->add_classes());
+    out->set_yaml(ontology::to_yaml(library.classes()));
     return {};
   }
 

@@ -143,6 +143,7 @@ Status read_server_config(const YAML::Node& root, const fs::path& base_dir, Serv
 Result<DaemonConfig> load_daemon_config(const fs::path& path) {
   std::vector<std::string> sections = pipeline::pipeline_sections();
   sections.push_back("server");
+  sections.push_back("ontology");
   auto root = pipeline::load_yaml_file(path, sections);
   if (!root) return root.error();
   DaemonConfig config;
@@ -154,6 +155,14 @@ Result<DaemonConfig> load_daemon_config(const fs::path& path) {
   if (Status s = pipeline::read_pipeline_config(*root, config.pipeline); !s) {
     return Error{s.error().code, path.string() + ": " + s.error().message};
   }
+  const YAML::Node& parsed = *root;
+  pipeline::YamlSection ontology(parsed["ontology"], "ontology");
+  std::string classes_file;
+  Status s = ontology.check_is_map();
+  if (s) s = ontology.read("classes_file", classes_file);
+  if (s) s = ontology.finish();
+  if (!s) return Error{s.error().code, path.string() + ": " + s.error().message};
+  if (!classes_file.empty()) config.ontology.classes_file = resolve(base_dir, classes_file);
   return config;
 }
 

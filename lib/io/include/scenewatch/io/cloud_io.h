@@ -29,6 +29,9 @@ Result<std::vector<std::uint32_t>> read_pcd_labels(const std::filesystem::path& 
 /// Writes a binary PCD (x y z rgb). Written to a temporary file and renamed into place.
 Status write_pcd(const std::filesystem::path& path, const Cloud& cloud);
 
+/// Writes a binary PLY point cloud (vertices x y z and colour, no faces). Atomic like write_pcd.
+Status write_ply(const std::filesystem::path& path, const Cloud& cloud);
+
 /// Writes a binary PLY mesh with per-vertex colour (opens in MeshLab, CloudCompare, Open3D).
 Status write_mesh_ply(const std::filesystem::path& path, const ColoredMesh& mesh);
 /// Reads a PLY triangle mesh (vertex colour when present, else black).

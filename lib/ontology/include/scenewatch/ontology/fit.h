@@ -57,6 +57,8 @@ struct ObjectFit {
   int best = -1;                        ///< index in shapes of the best primitive (most points); -1: none
   std::size_t points = 0;               ///< valid points of the object
   std::size_t points_detected = 0;      ///< points given to the shape detection (after subsampling)
+  /// Those points and their unit normals (oriented to the sensor), in the cloud's frame.
+  std::vector<Eigen::Vector3d> sample_points, sample_normals;
   double normals_ms = 0, detection_ms = 0, refinement_ms = 0;
 };
 

@@ -19,6 +19,9 @@ namespace scenewatch::pipeline {
 class WorkingMemory;
 struct FrameResult;
 }  // namespace scenewatch::pipeline
+namespace scenewatch::ontology {
+class ClassCatalog;
+}  // namespace scenewatch::ontology
 
 namespace scenewatch::service {
 
@@ -31,6 +34,8 @@ struct HandlerConfig {
   /// Calls that change the model (ingest, clear, reset, save, load) must carry this token; empty:
   /// they need none (in-process use only: scenewatchd always sets one).
   std::string token;
+  /// The object classes (DefineClass, ListClasses); null: those calls answer FAILED_PRECONDITION.
+  std::shared_ptr<ontology::ClassCatalog> classes;
 };
 
 /// The answer to one request.
@@ -59,7 +64,7 @@ using Executor = std::function<void(std::function<void()> task)>;
 /// Thread safe. Cheap calls (Health, GetPlanes, GetObjects, GetEvents, Subscribe) are answered
 /// on the calling thread; calls that may wait for a frame being processed run on `query`
 /// (QueryOccupancy, Stats) and calls that change the model on `mutate` (ingest, clear, reset,
-/// save, load), which must run one task at a time. `memory` must outlive the handler, and the
+/// save, load, define class), which must run one task at a time. `memory` must outlive the handler, and the
 /// handler must outlive every task it gave to an executor.
 class RequestHandler {
  public:

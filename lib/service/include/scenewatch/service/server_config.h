@@ -5,10 +5,15 @@
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "scenewatch/core/result.h"
+
+namespace scenewatch::ontology {
+class ClassCatalog;
+}  // namespace scenewatch::ontology
 
 namespace scenewatch::service {
 
@@ -40,6 +45,8 @@ struct ServerConfig {
   /// Not read from YAML: the token itself (the contents of token_file), which calls that change
   /// the model must carry. Server::listen() refuses to serve without one.
   std::string access_token;
+  /// Not read from YAML: the object classes the daemon serves (DefineClass, ListClasses); null: none.
+  std::shared_ptr<ontology::ClassCatalog> classes;
 };
 
 /// Checks ranges; the message names the key ("server.read_timeout_s: must be > 0, got 0").
