@@ -9,6 +9,7 @@
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/service/access_token.h"
+#include "scenewatch/service/client.h"
 #include "scenewatch/service/server_config.h"
 
 namespace scenewatch::cli {
@@ -129,5 +130,9 @@ struct ReplayOptions {
 /// Offline: recordings through the working memory as the daemon would run them; prints the
 /// event stream and a summary (events per 100 frames, time per frame and per stage).
 int run_replay(const ReplayOptions& options);
+/// A scenario script (SCRIPT.yaml) through a running daemon; `check`: exit 1 when an expectation fails.
+int run_scenario(const RemoteOptions& remote, const std::string& script, bool check);
+/// Connects to the daemon with the token of `options.token_file` (when it can be read).
+Result<service::Client> connect_remote(const RemoteOptions& options);
 
 }  // namespace scenewatch::cli

@@ -1,6 +1,8 @@
 // scenewatch: the command-line client of scenewatchd, plus offline tools that work on files.
 #include <CLI/CLI.hpp>
 
+#include <filesystem>
+
 #include <functional>
 #include <optional>
 #include <iostream>
@@ -212,7 +214,12 @@ int main(int argc, char** argv) {
       "  scenewatch replay ../shared/data/redkitchen\n"
       "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json\n"
       "  scenewatch replay rgbd_dataset_freiburg1_xyz          (a TUM RGB-D folder: rgb.txt, depth.txt, groundtruth.txt)\n"
-      "  scenewatch replay ../shared/data/ycb --depth-scale 0.0001   (depth in units of 0.1 mm)");
+      "  scenewatch replay ../shared/data/ycb --depth-scale 0.0001   (depth in units of 0.1 mm)\n"
+      "Scenario scripts: `scenewatch replay SCRIPT.yaml [--check] [--port P] [--token-file F]` streams what the\n"
+      "script names (a simulator scenario or a sequence folder) through a RUNNING daemon over TCP, prints the\n"
+      "events and the foreground objects, and compares them with the script's expectations (README, 'Scenario\n"
+      "scripts'); with --check it exits 1 when one is not met.\n"
+      "  scenewatch replay tests/scenarios/hand_tilts_cup.yaml --check --port 7501");
   replay->add_option("inputs", replay_options.inputs, "sequence folders, frame ranges or cloud files")->required();
   replay->add_option("--config", replay_options.config, "YAML config, as the daemon's (its pipeline sections are used)");
   replay->add_option("--stride", replay_options.stride, "process every N-th frame of each input")
@@ -222,7 +229,20 @@ int main(int argc, char** argv) {
                      "write each frame's image surprise over its colour image as DIR/surprise-NNNNNN.png");
   replay->add_flag("--json", replay_options.json, "one JSON object per event (with its frame), then a summary object");
   add_depth_scale_option(replay, replay_options.depth_scale_m);
-  replay->callback([&] { action = [&] { return run_replay(replay_options); }; });
+  bool scenario_check = false;
+  RemoteOptions scenario_remote;
+  replay->add_flag("--check", scenario_check, "scenario scripts: exit 1 when an expectation is not met");
+  replay->add_option("--host", scenario_remote.host, "scenario scripts: the daemon's host")->capture_default_str();
+  replay->add_option("--port", scenario_remote.port, "scenario scripts: the daemon's TCP port")->check(CLI::Range(1, 65535))->capture_default_str();
+  replay->add_option("--token-file", scenario_remote.token_file, "scenario scripts: the daemon's access token")->capture_default_str();
+  replay->callback([&] {
+    const bool script = replay_options.inputs.size() == 1 && std::filesystem::path(replay_options.inputs[0]).extension() == ".yaml";
+    if (script) {
+      action = [&] { return run_scenario(scenario_remote, replay_options.inputs[0], scenario_check); };
+    } else {
+      action = [&] { return run_replay(replay_options); };
+    }
+  });
 
   SurpriseOptions surprise_options;
   auto* surprise = app.add_subcommand(

@@ -140,6 +140,8 @@ int fail(const std::string& message) {
   return kExitError;
 }
 
+Result<service::Client> connect_remote(const RemoteOptions& options) { return connect(options); }
+
 int run_health(const RemoteOptions& options) {
   proto::Request request;
   request.mutable_health();

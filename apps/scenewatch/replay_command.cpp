@@ -49,7 +49,7 @@ int run_replay(const ReplayOptions& options) {
     if (ec) return fail("--heatmaps '" + options.heatmap_dir + "': " + ec.message());
   }
   pipeline::WorkingMemory memory(*config);
-  std::size_t frames = 0, total_events = 0;
+  std::size_t frames = 0, total_events = 0, frames_with_hands = 0;
   std::map<std::string, std::size_t> by_kind;
   std::map<std::string, std::vector<double>> stage_ms;
   std::vector<double> frame_ms;
@@ -69,6 +69,9 @@ int run_replay(const ReplayOptions& options) {
       stage_ms["change"].push_back(result->change_ms);
       stage_ms["surprise"].push_back(result->surprise_ms);
       stage_ms["map insertion"].push_back(result->insert_ms);
+      stage_ms["hands"].push_back(result->hands_ms);
+      frames_with_hands += result->hands > 0 ? 1 : 0;
+      stage_ms["foreground"].push_back(result->foreground_ms);
       if (!options.heatmap_dir.empty() && result->surprise) {
         char name[64];
         std::snprintf(name, sizeof name, "surprise-%06zu.png", frames);
@@ -111,6 +114,7 @@ int run_replay(const ReplayOptions& options) {
                               {"median_frame_ms", percentile(frame_ms, 0.5)},
                               {"p90_frame_ms", percentile(frame_ms, 0.9)},
                               {"tracked_objects", stats.tracked_objects},
+                              {"frames_with_hands", frames_with_hands},
                               {"keyframes", stats.keyframes}};
     for (const auto& [stage, v] : stage_ms) summary["median_stage_ms"][stage] = percentile(v, 0.5);
     std::cout << summary.dump() << "\n";
@@ -122,8 +126,8 @@ int run_replay(const ReplayOptions& options) {
               percentile(frame_ms, 0.9), wall_s);
   std::printf("stage medians:");
   for (const auto& [stage, v] : stage_ms) std::printf("  %s %.1f ms", stage.c_str(), percentile(v, 0.5));
-  std::printf("\nmodel: %zu tracked objects, %zu keyframes, %zu occupied voxels\n", stats.tracked_objects, stats.keyframes,
-              stats.map_occupied_leaves);
+  std::printf("\nmodel: %zu tracked objects, %zu keyframes, %zu occupied voxels; hands seen in %zu frames\n",
+              stats.tracked_objects, stats.keyframes, stats.map_occupied_leaves, frames_with_hands);
   return kExitOk;
 }
 

@@ -31,9 +31,11 @@ constexpr int kHostile = 64;
 /// Room for all of them plus the ingester: at max_connections the quietest connection would be
 /// closed to make room, and a well-behaved client between two requests can be the quietest.
 constexpr int kMaxConnections = kClients + kHostile + 16;
-/// The daemon's VmRSS at its peak during the run, bound: 155 to 163 MiB measured in four runs on
-/// the development machine (69 MiB at start; the mug frames being processed are most of the rise).
-constexpr double kMaxRssMiB = 200;
+/// The daemon's VmRSS at its peak during the run, bound: 204 to 214 MiB measured in three runs on
+/// the development machine (104 MiB at start, most of it the pages of the shared libraries the
+/// foreground's registration and the ontology link in, PCL features and registration, GDAL through
+/// OpenCV; the mug frames being processed are most of the rise).
+constexpr double kMaxRssMiB = 230;
 
 
 TEST(DaemonLoadTest, NoRequestLostUnderLoadWithHostileConnectionsHeld) {

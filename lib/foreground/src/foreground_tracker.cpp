@@ -3,9 +3,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 #include <unordered_set>
 
+#include "skin_model.h"
 #include "voxel_set.h"
 
 namespace scenewatch::foreground {
@@ -15,7 +17,11 @@ constexpr double kDegPerRad = 180.0 / M_PI;
 constexpr double kQuietMarginM = 0.05;    // background changes this close to a foreground object are its doing
 constexpr double kSupportBandM = 0.012;   // frame points this close to a supporting plane are the plane's
 constexpr double kMaxObjectExtentM = 0.6;  // a touched cluster larger than this is furniture, not an object
-constexpr double kSeenThroughM = 0.02;     // a pixel this much deeper than a point sees through it
+constexpr double kSeenThroughM = 0.02;
+constexpr int kMinObservations = 3;
+constexpr double kStillM = 0.03;           // a candidate moved at most this far since it was first seen
+constexpr double kSearchMarginM = 0.08;    // registration targets reach this far beyond the model
+constexpr std::size_t kRegistrationPoints = 500;  // model points registration uses        // frames a background object was seen before it can be a candidate     // a pixel this much deeper than a point sees through it
 
 Eigen::Vector3d world(const PointT& p, const Pose& T) { return T * p.getVector3fMap().cast<double>(); }
 
@@ -48,10 +54,13 @@ Aabb bounds(const std::vector<Eigen::Vector3d>& pts) {
 // Keeps one point per voxel (the first), at most `max_points`.
 CloudPtr thinned(const Cloud& in, double voxel, std::size_t max_points) {
   auto out = std::make_shared<Cloud>();
-  VoxelSet seen(voxel);
-  for (const auto& p : in.points) {
-    if (!seen.insert(p.getVector3fMap().cast<double>())) continue;
-    out->push_back(p);
+  if (voxel > 0) {
+    VoxelSet seen(voxel);
+    for (const auto& p : in.points) {
+      if (seen.insert(p.getVector3fMap().cast<double>())) out->push_back(p);
+    }
+  } else {
+    *out = in;
   }
   if (out->size() > max_points) {
     auto every = std::make_shared<Cloud>();
@@ -112,6 +121,46 @@ Crop crop(const FrameView& f, const Eigen::Vector3d& centre_world, double radius
   return c;
 }
 
+// True when more than a few of the cluster's pixels lie beside an arm or a person's body in the
+// image (a sleeve, a shoulder): an object is touched by the hand proper, a piece of the person is
+// attached to its arm.
+bool beside_person(const HandDetection& d, const std::vector<int>& indices, int width, int height) {
+  if (d.labels.empty()) return false;
+  constexpr int kRadiusPx = 3;
+  std::size_t beside = 0, tested = 0;
+  const std::size_t step = std::max<std::size_t>(1, indices.size() / 400);
+  for (std::size_t k = 0; k < indices.size(); k += step) {
+    const int u = indices[k] % width, v = indices[k] / width;
+    ++tested;
+    bool near = false;
+    for (int dv = -kRadiusPx; dv <= kRadiusPx && !near; ++dv) {
+      for (int du = -kRadiusPx; du <= kRadiusPx && !near; ++du) {
+        const int uu = u + du, vv = v + dv;
+        if (uu < 0 || vv < 0 || uu >= width || vv >= height) continue;
+        const AgentLabel l = d.labels[static_cast<std::size_t>(vv * width + uu)];
+        near = l == AgentLabel::kArm || l == AgentLabel::kPerson;
+      }
+    }
+    beside += near ? 1 : 0;
+  }
+  return tested > 0 && 20 * beside > tested;  // more than 5 %
+}
+
+// True when most of the cluster's pixels have skin colour.
+bool mostly_skin(const Cloud& cloud, const std::vector<int>& indices) {
+  if (indices.empty()) return false;
+  std::vector<std::uint8_t> rgb;
+  rgb.reserve(indices.size() * 3);
+  for (int i : indices) {
+    const PointT& p = cloud.points[static_cast<std::size_t>(i)];
+    rgb.insert(rgb.end(), {p.r, p.g, p.b});
+  }
+  const auto skin = skin_mask(rgb, static_cast<int>(indices.size()), 1);
+  std::size_t n = 0;
+  for (auto v : skin) n += v ? 1 : 0;
+  return 2 * n > indices.size();
+}
+
 }  // namespace
 
 struct ForegroundTracker::Impl {
@@ -126,6 +175,9 @@ struct ForegroundTracker::Impl {
     Eigen::Vector3d velocity = Eigen::Vector3d::Zero();  // per frame
     bool visible = true;
     bool in_hand = false;
+    bool lost_in_hand = false;            // its track was lost while a hand held it
+    CloudPtr sparse;                      // the model thinned for registration
+    const Cloud* sparse_of = nullptr;     // the model it was thinned from
     std::vector<int> pixels;              // this frame
     std::optional<HandlingRecorder> handling;
     bool handling_raised = false;
@@ -137,11 +189,21 @@ struct ForegroundTracker::Impl {
 
   ForegroundConfig config;
   std::vector<Object> objects;  // candidates and foreground objects, in the order first touched
+  std::map<std::uint64_t, Eigen::Vector3d> first_seen_at;  // background objects: where they were first seen
   Pose T_support = Pose::Identity();
 
+  // The object in this frame: registration targets within its own size (plus a margin for a
+  // fast motion) of where it is predicted, the model thinned to what registration needs.
   Registration locate(Object& o, const FrameView& f, const Pose& guess, Crop& c) {
-    c = crop(f, guess.translation(), config.search_radius_m, config.target_voxel_m);
-    return register_model(*o.model, c.target, guess, f.T_world_camera.translation(), config.registration, f.up_world);
+    double radius = 0;
+    for (const auto& p : o.model->points) radius = std::max(radius, static_cast<double>(p.getVector3fMap().norm()));
+    radius = std::min(config.search_radius_m, radius + kSearchMarginM + o.velocity.norm());
+    c = crop(f, guess.translation(), radius, config.target_voxel_m);
+    if (!o.sparse || o.sparse_of != o.model.get()) {
+      o.sparse = thinned(*o.model, 0.0, kRegistrationPoints);
+      o.sparse_of = o.model.get();
+    }
+    return register_model(*o.sparse, c.target, guess, f.T_world_camera.translation(), config.registration, f.up_world);
   }
 
   // The frame's pixels on the registered model.
@@ -372,6 +434,7 @@ std::vector<int> ForegroundTracker::track(const FrameView& f) {
     const Registration r = m.locate(o, f, guess, c);
     o.pixels.clear();
     if (!r.ok) {
+      if (o.visible) o.lost_in_hand = o.in_hand;
       o.visible = false;
       o.velocity.setZero();
       continue;
@@ -380,6 +443,7 @@ std::vector<int> ForegroundTracker::track(const FrameView& f) {
     o.velocity = step.norm() < m.config.search_radius_m / 2 ? step : Eigen::Vector3d::Zero();
     o.T = r.T_world_object;
     o.visible = true;
+    o.lost_in_hand = false;
     o.pixels = m.pixels_on(o, c);
     if (o.promoted) pixels.insert(pixels.end(), o.pixels.begin(), o.pixels.end());
   }
@@ -413,9 +477,36 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
     return false;
   };
 
-  // Lost foreground objects first: their clusters are theirs, not new background objects.
+  // Lost foreground objects first: their clusters are theirs, not new background objects. What a
+  // hand holds when the track of the object it held was lost is that object (a plush toy deforms
+  // and turns faster than registration follows at 10 frames per second): its model is re-seeded.
   for (auto& o : m.objects) {
-    if (o.promoted && !o.visible) m.reacquire(o, f, clusters, claimed, out);
+    if (!o.promoted || o.visible) continue;
+    if (o.lost_in_hand && any_hand) {
+      for (std::size_t ci = 0; ci < clusters.size() && !o.visible; ++ci) {
+        const ObjectCluster& c = clusters[ci];
+        if (claimed[ci] || c.box.extents.maxCoeff() > kMaxObjectExtentM || mostly_skin(*f.cloud, c.indices)) continue;
+        std::vector<Eigen::Vector3d> pts;
+        for (int i : c.indices) pts.push_back(world(f.cloud->points[static_cast<std::size_t>(i)], f.T_world_camera));
+        if (!touches(pts)) continue;
+        Cloud local;
+        const Eigen::Matrix3d R = o.T.linear();
+        for (std::size_t k = 0; k < pts.size(); ++k) {
+          PointT q = f.cloud->points[static_cast<std::size_t>(c.indices[k])];
+          q.getVector3fMap() = (R.transpose() * (pts[k] - c.centroid)).cast<float>();
+          local.push_back(q);
+        }
+        o.model = thinned(local, cfg.model_voxel_m, cfg.max_model_points);
+        o.T.translation() = c.centroid;
+        o.visible = true;
+        o.lost_in_hand = false;
+        o.velocity.setZero();
+        o.pixels = c.indices;
+        claimed[ci] = true;
+        out.claimed_clusters.push_back(ci);
+      }
+    }
+    if (!o.visible) m.reacquire(o, f, clusters, claimed, out);
   }
 
   // New candidates: background objects a hand touches.
@@ -427,13 +518,27 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
       pts.reserve(c.indices.size());
       for (int i : c.indices) pts.push_back(world(f.cloud->points[static_cast<std::size_t>(i)], f.T_world_camera));
       if (!touches(pts)) continue;
+      // A piece of an object already touched (a cup the hand splits in two) is that object.
+      const bool piece = std::any_of(m.objects.begin(), m.objects.end(), [&](const Impl::Object& o) {
+        VoxelSet surface(cfg.mask_m * 2);
+        for (const auto& p : posed_points(*o.model, o.T)) surface.insert(p);
+        std::size_t near = 0;
+        for (const auto& p : pts) near += surface.near(p) ? 1 : 0;
+        return 2 * near > pts.size();
+      });
+      if (piece || mostly_skin(*f.cloud, c.indices)) continue;  // a piece of the hand the detector left out
       const TrackedObject* match = nullptr;
       double best = 0.06;
       for (const auto& k : known) {
         const double d = (k.cluster.centroid - c.centroid).norm();
         if (d < best) best = d, match = &k;
       }
-      if (!match) continue;
+      // Only what stood still in the background for a few frames is a candidate: a cluster that
+      // appears in a hand is the hand's, or a foreground object whose track was lost.
+      if (!match || match->observations < kMinObservations) continue;
+      const auto first = m.first_seen_at.find(match->id);
+      if (first == m.first_seen_at.end() || (first->second - match->cluster.centroid).norm() > kStillM) continue;
+      if (beside_person(*f.hands, c.indices, static_cast<int>(f.cloud->width), static_cast<int>(f.cloud->height))) continue;
       const bool already = std::any_of(m.objects.begin(), m.objects.end(), [&](const auto& o) { return o.id == match->id; });
       if (already) continue;
       Impl::Object o;
@@ -454,6 +559,14 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
       m.objects.push_back(std::move(o));
     }
   }
+
+  // Where each background object was first seen: a candidate must have stood still.
+  std::map<std::uint64_t, Eigen::Vector3d> seen;
+  for (const auto& k : known) {
+    const auto it = m.first_seen_at.find(k.id);
+    seen[k.id] = it == m.first_seen_at.end() ? k.cluster.centroid : it->second;
+  }
+  m.first_seen_at.swap(seen);
 
   // Contacts, handlings, promotion, and the candidates that were touched but never moved.
   for (auto& o : m.objects) {
@@ -529,6 +642,9 @@ void ForegroundTracker::restore(const TrackedObject& object, CloudConstPtr model
   impl_->objects.push_back(std::move(o));
 }
 
-void ForegroundTracker::reset() { impl_->objects.clear(); }
+void ForegroundTracker::reset() {
+  impl_->objects.clear();
+  impl_->first_seen_at.clear();
+}
 
 }  // namespace scenewatch::foreground

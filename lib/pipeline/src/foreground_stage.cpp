@@ -54,8 +54,35 @@ HandsSeen summarise(const foreground::HandDetection& d, const Cloud& cloud, cons
 
 }  // namespace
 
+// A skin-coloured region where the map has remembered a surface for a while is furniture (a wooden
+// worktop), not a hand: hands come and go, the background stays. Drops such hands, and the person
+// grown from them when none is left.
+void ForegroundStage::drop_static_hands(const Cloud& cloud, const Pose& T, const OccupiedFraction& occupied) {
+  if (!occupied || detection_.hands.empty()) return;
+  std::vector<foreground::Hand> kept;
+  for (auto& h : detection_.hands) {
+    std::vector<Eigen::Vector3d> pts;
+    const std::size_t step = std::max<std::size_t>(1, h.indices.size() / 200);
+    for (std::size_t k = 0; k < h.indices.size(); k += step) {
+      const PointT& p = cloud.points[static_cast<std::size_t>(h.indices[k])];
+      if (is_valid(p)) pts.push_back(T * p.getVector3fMap().cast<double>());
+    }
+    if (!pts.empty() && occupied(pts) > kStaticHandFraction) {
+      for (int i : h.indices) detection_.labels[static_cast<std::size_t>(i)] = foreground::AgentLabel::kNone;
+      continue;
+    }
+    kept.push_back(std::move(h));
+  }
+  detection_.hands = std::move(kept);
+  if (detection_.hands.empty()) {
+    for (int i : detection_.person_indices) detection_.labels[static_cast<std::size_t>(i)] = foreground::AgentLabel::kNone;
+    detection_.person_indices.clear();
+  }
+}
+
 Frame ForegroundStage::prepare(const Frame& frame, std::uint64_t frame_index, const std::vector<Plane>& planes,
-                               const std::optional<Eigen::Vector3d>& configured_up, FrameResult& result) {
+                               const std::optional<Eigen::Vector3d>& configured_up, const OccupiedFraction& occupied,
+                               FrameResult& result) {
   const Pose T = frame.pose_or_identity();
   cloud_ = frame.cloud;
   planes_ = planes;
@@ -74,6 +101,7 @@ Frame ForegroundStage::prepare(const Frame& frame, std::uint64_t frame_index, co
   const auto t_hands = Clock::now();
   if (config_.hands.enabled && frame.has_color && frame.cloud->height > 1) {
     detection_ = foreground::detect_hands(*frame.cloud, config_.hands);
+    drop_static_hands(*frame.cloud, T, occupied);
   }
   view_.hands = &detection_;
   result.hands_ms = ms_since(t_hands);
@@ -103,12 +131,21 @@ foreground::ForegroundUpdate ForegroundStage::update(const std::vector<ObjectClu
   if (!config_.enabled || !cloud_) return {};
   const auto t0 = Clock::now();
   auto out = tracker_.update(view_, clusters, known);
+  // Where a hand is or just was, what changed is the person's doing (a hand the detector missed
+  // for a frame or two went into the map, and leaves it as it moves on).
+  if (hands_.frame_index == view_.frame_index) {
+    for (const auto& h : hands_.hands) recent_hands_.push_back({view_.frame_index, h.box_world.grown(kHandQuietM)});
+    if (hands_.person_box_world) recent_hands_.push_back({view_.frame_index, hands_.person_box_world->grown(kHandQuietM)});
+  }
+  while (!recent_hands_.empty() && recent_hands_.front().first + kHandQuietFrames < view_.frame_index) recent_hands_.pop_front();
+  for (const auto& [frame, box] : recent_hands_) out.quiet_boxes.push_back(box);
   result.foreground_ms += ms_since(t0);
   return out;
 }
 
 void ForegroundStage::reset() {
   tracker_.reset();
+  recent_hands_.clear();
   hands_ = HandsSeen{};
   cloud_.reset();
 }

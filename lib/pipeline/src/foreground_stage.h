@@ -4,6 +4,8 @@
 // background sees (they are neither background changes nor new objects, and never enter the
 // map); after the segmentation, contacts and promotion.
 #include <cstdint>
+#include <deque>
+#include <functional>
 #include <vector>
 
 #include "scenewatch/core/frame.h"
@@ -18,8 +20,10 @@ class ForegroundStage {
 
   /// Finds hands and registers the foreground objects; returns the frame without their pixels
   /// (the frame itself when there are none). `planes` are the last frame's, world frame.
+  /// The share of world points the background map holds occupied.
+  using OccupiedFraction = std::function<double(const std::vector<Eigen::Vector3d>&)>;
   Frame prepare(const Frame& frame, std::uint64_t frame_index, const std::vector<Plane>& planes,
-                const std::optional<Eigen::Vector3d>& configured_up, FrameResult& result);
+                const std::optional<Eigen::Vector3d>& configured_up, const OccupiedFraction& occupied, FrameResult& result);
 
   /// Contacts and promotion, after the segmentation (`clusters` world frame, indices into the frame).
   foreground::ForegroundUpdate update(const std::vector<ObjectCluster>& clusters, const std::vector<TrackedObject>& known,
@@ -40,6 +44,11 @@ class ForegroundStage {
   CloudConstPtr cloud_;
   std::optional<Intrinsics> K_;
   HandsSeen hands_;
+  std::deque<std::pair<std::uint64_t, Aabb>> recent_hands_;  ///< frame, box grown by kHandQuietM
+  static constexpr double kHandQuietM = 0.05;
+  static constexpr double kStaticHandFraction = 0.5;  ///< of a hand's points on remembered surfaces: furniture
+  void drop_static_hands(const Cloud& cloud, const Pose& T, const OccupiedFraction& occupied);
+  static constexpr std::uint64_t kHandQuietFrames = 15;
 };
 
 /// The world's up direction: the configured one, else the normal of the largest supporting plane

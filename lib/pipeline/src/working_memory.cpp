@@ -234,6 +234,16 @@ struct WorkingMemory::Impl {
     return changed;
   }
 
+  // The share of world points on surfaces the map remembers (occupied), for the foreground.
+  ForegroundStage::OccupiedFraction occupied_fraction() {
+    return [this](const std::vector<Eigen::Vector3d>& pts) {
+      std::shared_lock<std::shared_mutex> read(map_mutex);
+      std::size_t n = 0;
+      for (const auto& p : pts) n += map.query(p) == background::Occupancy::kOccupied ? 1 : 0;
+      return pts.empty() ? 0.0 : static_cast<double>(n) / pts.size();
+    };
+  }
+
   // One fact, one event: appearance regions where geometry changes are its evidence; others must
   // persist. What the foreground explains (a carried object's old and new place) is not a change.
   std::vector<Event> fuse(const FrameResult& result, const ChangeOutcome& changed, const std::vector<Aabb>& quiet,
@@ -312,7 +322,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   result.frame_index = m.frames;
   result.points = *valid_points;
   // Hands, the person and the foreground objects are blanked out of what the background sees.
-  const Frame seen = m.foreground.prepare(frame, m.frames, m.planes, config_.segmentation.up, result);
+  const Frame seen = m.foreground.prepare(frame, m.frames, m.planes, config_.segmentation.up, m.occupied_fraction(), result);
 
   // Three independent parts on the two cores, each against the memory as it stands before this
   // frame: the image surprise (keyframes and mesh), the geometric change detection with the map

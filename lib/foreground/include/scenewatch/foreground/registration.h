@@ -14,14 +14,14 @@ struct RegistrationConfig {
   double max_distance_m = 0.02;    ///< first correspondence distance; halved twice while it converges
   double inlier_m = 0.01;          ///< a model point within this of the frame counts as seen
   double colour_weight_m = 0.1;    ///< metres one full colour difference (0..1 per channel) is worth
-  int iterations = 25;
+  int iterations = 12;               ///< per correspondence gate
   double min_inlier_fraction = 0.35;  ///< of the model points that face the camera
   std::size_t min_inliers = 40;
   /// After ICP, turns about the vertical through the model's centre are searched in steps of
   /// `spin_step_deg` up to this far either way, scored by colour: ICP's pull on a turn about a
   /// symmetry axis (a cup's) is geometric and hence nil. 0: no search.
   double spin_search_deg = 8.0;
-  double spin_step_deg = 1.0;
+  double spin_step_deg = 2.0;
 };
 
 struct Registration {
