@@ -41,7 +41,8 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
 int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,
                     const std::optional<double>& depth_scale_m);
 int run_planes(const RemoteOptions& options);
-int run_objects(const RemoteOptions& options);
+/// `describe`: with each object's class, primitive and grasps (the ontology).
+int run_objects(const RemoteOptions& options, bool describe);
 int run_hands(const RemoteOptions& options);
 /// `points`: x y z triples; `box`: empty or min x y z, max x y z.
 int run_occupancy(const RemoteOptions& options, const std::vector<double>& points, const std::vector<double>& box);

@@ -57,6 +57,22 @@ nlohmann::json to_json(const proto::Object& object) {
           {"last_seen_s", object.last_seen_s()},
           {"observations", object.observations()},
           {"supported_by", object.supported_by()}};
+  if (object.has_ontology()) {
+    const auto& c = object.ontology();
+    nlohmann::json grasps = nlohmann::json::array();
+    for (const auto& g : c.grasps()) {
+      grasps.push_back({{"name", g.name()}, {"kind", g.kind()}, {"position", to_json(g.position())},
+                        {"approach", to_json(g.approach())}, {"closing", to_json(g.closing())}, {"width_m", g.width_m()}});
+    }
+    j["ontology"] = {{"class", c.class_name()}, {"score", c.score()}, {"grasps", grasps}};
+    if (c.has_primitive()) {
+      const auto& p = c.primitive();
+      j["ontology"]["primitive"] = {{"shape", p.shape()}, {"center", to_json(p.center())}, {"axis", to_json(p.axis())},
+                                    {"radius_m", p.radius_m()}, {"bottom_radius_m", p.bottom_radius_m()},
+                                    {"top_radius_m", p.top_radius_m()}, {"height_m", p.height_m()},
+                                    {"size_x_m", p.size_x_m()}, {"size_y_m", p.size_y_m()}, {"rms_m", p.rms_m()}};
+    }
+  }
   if (!object.foreground()) return j;
   nlohmann::json handlings = nlohmann::json::array();
   for (const auto& h : object.handlings()) {
@@ -175,6 +191,16 @@ std::string text(const proto::Object& object) {
      << fixed(object.mean_rgb().x(), 0) << ", " << fixed(object.mean_rgb().y(), 0) << ", "
      << fixed(object.mean_rgb().z(), 0) << "), seen " << object.observations() << "x (first "
      << fixed(object.first_seen_s(), 2) << " s, last " << fixed(object.last_seen_s(), 2) << " s)";
+  if (object.has_ontology()) {
+    const auto& c = object.ontology();
+    os << "\n    class " << c.class_name();
+    if (c.class_name() != "unknown") os << " (score " << fixed(c.score(), 2) << ")";
+    if (c.has_primitive()) {
+      const auto& p = c.primitive();
+      os << ": " << p.shape() << " r " << fixed(1000 * p.radius_m(), 1) << " mm, h " << fixed(1000 * p.height_m(), 1) << " mm";
+    }
+    for (const auto& g : c.grasps()) os << "\n      grasp " << g.name() << " (" << g.kind() << ") at " << text(g.position());
+  }
   if (object.foreground()) {
     auto names = [](const auto& list) {
       std::string s;

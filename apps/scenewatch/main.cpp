@@ -87,7 +87,10 @@ int main(int argc, char** argv) {
 
   auto* objects = app.add_subcommand("objects", "the tracked objects");
   add_remote_options(objects, remote);
-  objects->callback([&] { action = [&] { return run_objects(remote); }; });
+  bool describe_objects = false;
+  objects->add_flag("--describe", describe_objects,
+                    "also each object's class, fitted primitive and grasps (the ontology; about 20 ms per object)");
+  objects->callback([&] { action = [&] { return run_objects(remote, describe_objects); }; });
 
   auto* hands = app.add_subcommand("hands", "the hands and the person seen in the last frame (where not to reach)");
   add_remote_options(hands, remote);

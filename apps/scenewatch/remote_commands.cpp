@@ -342,9 +342,9 @@ int run_planes(const RemoteOptions& options) {
   });
 }
 
-int run_objects(const RemoteOptions& options) {
+int run_objects(const RemoteOptions& options, bool describe) {
   proto::Request request;
-  request.mutable_get_objects();
+  request.mutable_get_objects()->set_describe(describe);
   return simple_call(options, request, [&](const proto::Response& r) {
     const auto& objects = r.objects();
     if (options.json) {

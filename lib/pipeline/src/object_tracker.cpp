@@ -68,6 +68,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
       t.object.first_seen_s = t.object.last_seen_s = stamp_s;
       t.object.observations = 1;
       t.samples = std::move(observations[c].samples);
+      t.points = std::move(observations[c].points);
       t.support_centroid = support[c];
       tentative_.push_back(std::move(t));
       continue;
@@ -78,6 +79,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     t.object.last_seen_s = stamp_s;
     ++t.object.observations;
     t.samples = std::move(observations[c].samples);
+    t.points = std::move(observations[c].points);
     t.support_centroid = support[c];
     t.misses = t.seen_free = 0;
   }
@@ -128,6 +130,12 @@ void ObjectTracker::resolve_supports() {
 const std::vector<Eigen::Vector3d>* ObjectTracker::samples(std::uint64_t id) const {
   for (const auto& t : tracks_)
     if (t.object.id == id) return &t.samples;
+  return nullptr;
+}
+
+std::shared_ptr<const std::vector<Eigen::Vector3d>> ObjectTracker::points(std::uint64_t id) const {
+  for (const auto& t : tracks_)
+    if (t.object.id == id) return t.points;
   return nullptr;
 }
 

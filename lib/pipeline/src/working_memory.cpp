@@ -84,6 +84,7 @@ ObjectCluster to_world(ObjectCluster c, const Pose& T) {
 }
 
 constexpr std::size_t kSamplesPerObject = 200;
+constexpr std::size_t kPointsPerObject = 4000;  // kept per object for the ontology's describe()
 
 // World sample points of each cluster, for the tracker's free-space evidence; clusters the
 // foreground claimed are left out.
@@ -97,6 +98,11 @@ std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectClu
     const std::size_t step = std::max<std::size_t>(1, idx.size() / kSamplesPerObject);
     for (std::size_t k = 0; k < idx.size(); k += step)
       o.samples.push_back(T * cloud.points[static_cast<std::size_t>(idx[k])].getVector3fMap().cast<double>());
+    auto points = std::make_shared<std::vector<Eigen::Vector3d>>();
+    const std::size_t every = std::max<std::size_t>(1, idx.size() / kPointsPerObject);
+    for (std::size_t k = 0; k < idx.size(); k += every)
+      points->push_back(T * cloud.points[static_cast<std::size_t>(idx[k])].getVector3fMap().cast<double>());
+    o.points = std::move(points);
     o.cluster = objects[i];
     o.range_m = (objects[i].centroid - T.translation()).norm();
     observations.push_back(std::move(o));
@@ -146,7 +152,7 @@ struct ChangeOutcome {
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
       : map(c.background), appearance(c.appearance, c.surprise), changes(c.change), tracker(c.tracking), fusion(c.fusion),
-        foreground(c.foreground), snapshot(std::make_shared<SceneSnapshot>()) {}
+        foreground(c.foreground), up(c.segmentation.up), snapshot(std::make_shared<SceneSnapshot>()) {}
 
   // process() and the other writers hold this for their whole duration.
   mutable std::mutex writer;
@@ -161,6 +167,7 @@ struct WorkingMemory::Impl {
   EventFusion fusion;
   ForegroundStage foreground;
   std::vector<Plane> planes;
+  Eigen::Vector3d last_camera = Eigen::Vector3d::Zero();
   std::uint64_t frames = 0, points = 0;
   double total_ms = 0, last_ms = 0;
   double last_stamp_s = 0.0;
@@ -174,6 +181,8 @@ struct WorkingMemory::Impl {
   std::map<int, EventCallback> subscribers;
   int next_token = 1;
 
+  std::optional<Eigen::Vector3d> up;  // the configured up direction (segmentation.up_vector)
+
   void publish() {
     auto s = std::make_shared<SceneSnapshot>();
     s->frames_processed = frames;
@@ -181,6 +190,18 @@ struct WorkingMemory::Impl {
     s->objects = tracker.objects();
     for (auto& o : foreground.tracker().objects()) s->objects.push_back(std::move(o));
     s->hands = foreground.hands();
+    for (const auto& o : tracker.objects()) {
+      if (auto p = tracker.points(o.id)) s->points[o.id] = std::move(p);
+    }
+    for (const auto& o : foreground.tracker().objects()) {
+      if (auto model = foreground.tracker().model(o.id)) {
+        auto p = std::make_shared<std::vector<Eigen::Vector3d>>();
+        for (const auto& q : model->points) p->push_back(o.foreground->T_world_object * q.getVector3fMap().cast<double>());
+        s->points[o.id] = std::move(p);
+      }
+    }
+    s->up_world = up_direction(up, planes, last_camera);
+    s->camera_world = last_camera;
     s->last_stamp_s = last_stamp_s;
     std::atomic_store(&snapshot, std::shared_ptr<const SceneSnapshot>(std::move(s)));
   }
@@ -373,6 +394,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
 
   m.planes = result.planes;
   for (auto& p : m.planes) p.indices.clear();
+  m.last_camera = T.translation();
   ++m.frames;
   m.last_stamp_s = frame.stamp_s;
   m.points += result.points;

@@ -5,10 +5,13 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
+#include <map>
+#include <mutex>
 #include <optional>
 
 #include "live_frame.h"
 #include "ontology_convert.h"
+#include "scenewatch/ontology/describe.h"
 #include "proto_convert.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/core/files.h"
@@ -184,7 +187,7 @@ struct RequestHandler::Impl {
       case proto::Request::kIngestFrame: return ingest_frame(request.ingest_frame(), response);
       case proto::Request::kIngestFile: return ingest_file(request.ingest_file(), response);
       case proto::Request::kGetPlanes: return get_planes(response);
-      case proto::Request::kGetObjects: return get_objects(response);
+      case proto::Request::kGetObjects: return get_objects(request.get_objects(), response);
       case proto::Request::kGetHands: return get_hands(response);
       case proto::Request::kQueryOccupancy: return query_occupancy(request.query_occupancy(), response);
       case proto::Request::kClearBox: return clear_box(request.clear_box(), response);
@@ -385,12 +388,45 @@ struct RequestHandler::Impl {
     return {};
   }
 
-  Status get_objects(proto::Response& response) {
+  Status get_objects(const proto::GetObjects& msg, proto::Response& response) {
     const auto snapshot = memory.snapshot();
     auto* out = response.mutable_objects();
     out->set_frames_processed(snapshot->frames_processed);
-    for (const auto& object : snapshot->objects) convert::to_proto(object, out->add_objects());
+    for (const auto& object : snapshot->objects) {
+      auto* o = out->add_objects();
+      convert::to_proto(object, o);
+      if (msg.describe() && config.classes) describe(*snapshot, object, o->mutable_ontology());
+    }
     return {};
+  }
+
+  // The ontology's description of one object, cached per object: described again only when it was
+  // seen again (new points) and its description is older than kDescribeAgainS.
+  void describe(const pipeline::SceneSnapshot& snapshot, const TrackedObject& object, proto::ObjectClassInfo* out) {
+    const std::uint64_t id = object.id;
+    const auto points = snapshot.points.find(id);
+    if (points == snapshot.points.end() || !points->second) return;
+    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+    std::lock_guard<std::mutex> lock(described_mutex);
+    auto& cached = described[id];
+    const bool fresh = cached.points == points->second.get() || now - cached.at_s < kDescribeAgainS;
+    if (!fresh || !cached.info) {
+      ontology::DescribeConfig dc;
+      dc.completion_spacing_m = 0;  // no completed surface on the wire
+      // Up is the normal of the plane the object stands on, turned towards the camera.
+      Eigen::Vector3d up = snapshot.up_world;
+      for (const auto& plane : snapshot.planes) {
+        if (plane.id != object.cluster.plane_id || object.foreground) continue;
+        up = plane.normal.dot(snapshot.camera_world - plane.centroid) >= 0 ? plane.normal : Eigen::Vector3d(-plane.normal);
+      }
+      auto d = ontology::describe(*points->second, up, config.classes->library(), snapshot.camera_world, dc);
+      cached.info = std::make_shared<proto::ObjectClassInfo>();
+      if (d) convert::to_proto(*d, cached.info.get());
+      else cached.info->set_class_name(ontology::kUnknownClass);
+      cached.points = points->second.get();
+      cached.at_s = now;
+    }
+    *out = *cached.info;
   }
 
   Status get_hands(proto::Response& response) {
@@ -470,6 +506,15 @@ struct RequestHandler::Impl {
     response.mutable_save_model()->set_model_dir(config.model_dir.string());
     return {};
   }
+
+  struct Described {
+    const void* points = nullptr;  // the snapshot's points it was made from
+    double at_s = 0;
+    std::shared_ptr<proto::ObjectClassInfo> info;
+  };
+  static constexpr double kDescribeAgainS = 2.0;
+  std::mutex described_mutex;
+  std::map<std::uint64_t, Described> described;
 
   Status require_classes() const {
     if (!config.classes) return unavailable("this server has no object classes loaded");

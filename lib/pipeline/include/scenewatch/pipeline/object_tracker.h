@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -32,6 +33,8 @@ struct TrackingConfig {
 struct TrackerObservation {
   ObjectCluster cluster;
   std::vector<Eigen::Vector3d> samples;
+  /// Its points (world, thinned), kept with the object for what describes it (the ontology).
+  std::shared_ptr<const std::vector<Eigen::Vector3d>> points;
   double range_m = 0.0;  ///< distance of its centroid from the camera
 };
 
@@ -51,6 +54,8 @@ class ObjectTracker {
   std::size_t tentative() const { return tentative_.size(); }
   /// Sample points of a confirmed object's last observation (world).
   const std::vector<Eigen::Vector3d>* samples(std::uint64_t id) const;
+  /// The points of a confirmed object's last observation (world), null when none are kept.
+  std::shared_ptr<const std::vector<Eigen::Vector3d>> points(std::uint64_t id) const;
 
   /// Restores a saved list (objects are confirmed).
   void restore(std::vector<TrackedObject> objects, std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples,
@@ -64,6 +69,7 @@ class ObjectTracker {
   struct Track {
     TrackedObject object;
     std::vector<Eigen::Vector3d> samples;
+    std::shared_ptr<const std::vector<Eigen::Vector3d>> points;
     int misses = 0;       ///< consecutive frames unmatched
     int seen_free = 0;    ///< consecutive frames unmatched with its space seen free
     /// Centroid of the observation it stood on in its last frame (a box on a box), if any.

@@ -105,6 +105,11 @@ struct SceneSnapshot {
   std::vector<Plane> planes;            ///< from the last frame, world frame
   std::vector<TrackedObject> objects;   ///< background objects, then foreground ones (foreground set), world frame
   HandsSeen hands;
+  /// Each object's points (world, thinned) by id: the last observation of a background object, the
+  /// posed model of a foreground one. For what describes objects (the ontology's describe()).
+  std::map<std::uint64_t, std::shared_ptr<const std::vector<Eigen::Vector3d>>> points;
+  Eigen::Vector3d up_world = Eigen::Vector3d::UnitZ();      ///< the support's up (config or largest plane)
+  Eigen::Vector3d camera_world = Eigen::Vector3d::Zero();   ///< where the last frame was taken
   double last_stamp_s = 0.0;
 };
 
