@@ -82,6 +82,8 @@ void offline(const Sequence& s) {
     ms["2 image surprise + keyframes"].push_back(r->surprise_ms);
     ms["3 change detection"].push_back(r->change_ms);
     ms["4 map insertion"].push_back(r->insert_ms);
+    ms["0 hands (before the others)"].push_back(r->hands_ms);
+    ms["5 foreground (registration, promotion)"].push_back(r->foreground_ms);
     ms["9 frame (process)"].push_back(r->total_ms);
     events += r->events.size();
   }
@@ -141,7 +143,8 @@ void over_tcp(const Sequence&) { std::printf("   over TCP: built without the ser
 
 int run_pipeline(const Options& o) {
   std::printf("\n== The whole frame: posed VGA RGB-D through WorkingMemory::process, then over TCP\n");
-  for (auto s : {real_sequence(o, "7-Scenes redkitchen (50 frames, hand-held)", "redkitchen"), simulated_sequence("cup_added")}) {
+  for (auto s : {real_sequence(o, "7-Scenes redkitchen (50 frames, hand-held)", "redkitchen"), simulated_sequence("cup_added"),
+                 real_sequence(o, "hrt1 pick_toy_1 (40 frames, a person picks a toy)", "hrt1/pick_toy_1")}) {
     if (!s) {
       std::printf("  (a sequence could not be loaded; skipped)\n");
       continue;

@@ -17,11 +17,11 @@ constexpr double kDegPerRad = 180.0 / M_PI;
 constexpr double kQuietMarginM = 0.05;    // background changes this close to a foreground object are its doing
 constexpr double kSupportBandM = 0.012;   // frame points this close to a supporting plane are the plane's
 constexpr double kMaxObjectExtentM = 0.6;  // a touched cluster larger than this is furniture, not an object
-constexpr double kSeenThroughM = 0.02;
-constexpr int kMinObservations = 3;
+constexpr double kSeenThroughM = 0.02;     // a pixel this much deeper than a point sees through it
+constexpr int kMinObservations = 3;        // frames a background object was seen before it can be a candidate
 constexpr double kStillM = 0.03;           // a candidate moved at most this far since it was first seen
 constexpr double kSearchMarginM = 0.08;    // registration targets reach this far beyond the model
-constexpr std::size_t kRegistrationPoints = 500;  // model points registration uses        // frames a background object was seen before it can be a candidate     // a pixel this much deeper than a point sees through it
+constexpr std::size_t kRegistrationPoints = 300;  // model points registration uses
 
 Eigen::Vector3d world(const PointT& p, const Pose& T) { return T * p.getVector3fMap().cast<double>(); }
 
@@ -208,11 +208,12 @@ struct ForegroundTracker::Impl {
 
   // The frame's pixels on the registered model.
   std::vector<int> pixels_on(const Object& o, const Crop& c) const {
-    VoxelSet surface(config.mask_m);
-    for (const auto& p : posed_points(*o.model, o.T)) surface.insert(p);
+    VoxelSet model(config.mask_m);
+    for (const auto& p : posed_points(*o.model, o.T)) model.insert(p);
+    const VoxelSet surface = model.dilated();
     std::vector<int> out;
     for (std::size_t i = 0; i < c.points.size(); ++i) {
-      if (surface.near(c.points[i])) out.push_back(c.pixels[i]);
+      if (surface.contains(c.points[i])) out.push_back(c.pixels[i]);
     }
     return out;
   }
@@ -458,22 +459,23 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
   std::vector<bool> claimed(clusters.size(), false);
 
   // Where the hands are: the hand proper (the forearm touches nothing it carries).
-  VoxelSet hand(cfg.contact_m);
+  VoxelSet hand_points(cfg.contact_m);
   bool any_hand = false;
   if (f.hands) {
     for (const auto& h : f.hands->hands) {
       for (int i : h.tip_indices.empty() ? h.indices : h.tip_indices) {
         const PointT& p = f.cloud->points[static_cast<std::size_t>(i)];
         if (!is_valid(p)) continue;
-        hand.insert(world(p, f.T_world_camera));
+        hand_points.insert(world(p, f.T_world_camera));
         any_hand = true;
       }
     }
   }
+  const VoxelSet hand = hand_points.dilated();
   auto touches = [&](const std::vector<Eigen::Vector3d>& pts) {
     if (!any_hand) return false;
     for (const auto& p : pts)
-      if (hand.near(p)) return true;
+      if (hand.contains(p)) return true;
     return false;
   };
 

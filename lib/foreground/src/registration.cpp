@@ -2,6 +2,7 @@
 // transform is still estimated from x y z alone). The only PCL registration TU of the module.
 #include "scenewatch/foreground/registration.h"
 
+#include <pcl/console/print.h>
 #include <pcl/kdtree/kdtree_flann.h>
 #include <pcl/registration/correspondence_estimation.h>
 #include <pcl/registration/icp.h>
@@ -98,6 +99,13 @@ Registration register_model(const Cloud& model, const Cloud& target, const Pose&
   pcl::transformPointCloud(model, *source, T_guess.matrix().cast<float>());
   auto target_ptr = std::make_shared<Cloud>(target);
 
+  // A gate that finds too few correspondences is an answer here (the object is not there), not
+  // an error for the console: PCL would print one per such frame.
+  static const bool quiet = [] {
+    pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);
+    return true;
+  }();
+  (void)quiet;
   pcl::IterativeClosestPoint<PointT, PointT> icp;
   icp.setInputTarget(target_ptr);
   // The representation must reach the correspondence search itself: ICP's own setter only

@@ -14,7 +14,7 @@ struct RegistrationConfig {
   double max_distance_m = 0.02;    ///< first correspondence distance; halved twice while it converges
   double inlier_m = 0.01;          ///< a model point within this of the frame counts as seen
   double colour_weight_m = 0.1;    ///< metres one full colour difference (0..1 per channel) is worth
-  int iterations = 12;               ///< per correspondence gate
+  int iterations = 8;                ///< per correspondence gate
   double min_inlier_fraction = 0.35;  ///< of the model points that face the camera
   std::size_t min_inliers = 40;
   /// After ICP, turns about the vertical through the model's centre are searched in steps of
