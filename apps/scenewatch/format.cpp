@@ -197,7 +197,12 @@ std::string text(const proto::Object& object) {
     if (c.class_name() != "unknown") os << " (score " << fixed(c.score(), 2) << ")";
     if (c.has_primitive()) {
       const auto& p = c.primitive();
-      os << ": " << p.shape() << " r " << fixed(1000 * p.radius_m(), 1) << " mm, h " << fixed(1000 * p.height_m(), 1) << " mm";
+      if (p.shape() == "box") {
+        os << ": box " << fixed(1000 * p.size_x_m(), 1) << " x " << fixed(1000 * p.size_y_m(), 1) << " x "
+           << fixed(1000 * p.height_m(), 1) << " mm";
+      } else {
+        os << ": " << p.shape() << " r " << fixed(1000 * p.radius_m(), 1) << " mm, h " << fixed(1000 * p.height_m(), 1) << " mm";
+      }
     }
     for (const auto& g : c.grasps()) os << "\n      grasp " << g.name() << " (" << g.kind() << ") at " << text(g.position());
   }

@@ -184,9 +184,16 @@ class Client:
         """Supporting planes of the last frame: pb.PlanesReply."""
         return self._call("get_planes", pb.GetPlanes(), result="planes")
 
-    def get_objects(self):
-        """The tracked objects: pb.ObjectsReply (``.objects``, each with id, box, plane_id, ...)."""
-        return self._call("get_objects", pb.GetObjects(), result="objects")
+    def get_objects(self, describe=False):
+        """The tracked objects: pb.ObjectsReply (``.objects``, each with id, box, plane_id, ...; a
+        foreground object with ``foreground``, ``pose``, ``free_dofs``, ``frozen_dofs``, ``handlings``).
+        ``describe``: also each object's ``ontology`` (class, score, fitted primitive, grasps)."""
+        return self._call("get_objects", pb.GetObjects(describe=describe), result="objects")
+
+    def get_hands(self):
+        """The hands and the person seen in the last frame: pb.HandsReply (``.hands``, each with
+        ``box_world``, ``tip_world``, ``score``; ``person_pixels``, ``person_box_world``)."""
+        return self._call("get_hands", pb.GetHands(), result="hands")
 
     def query_occupancy(self, points=(), box=None):
         """Occupancy of world points (sequences of 3 numbers) and/or a box ((min xyz), (max xyz)).

@@ -77,6 +77,23 @@ class ClientTest(unittest.TestCase):
         self.assertEqual(len({o.plane_id for o in objects}), 1, "all four stand on one plane")
         table = next(p for p in planes.planes if p.id == objects[0].plane_id)
         self.assertAlmostEqual(table.centroid.z, 0.75, delta=0.01, msg="the table top, 75 cm high")
+        self.assertFalse(objects[0].HasField("ontology"), "described only on request")
+
+        # Described by the ontology: the scene's mug (r 42 mm), can (r 33 mm) and box have their
+        # classes; the 26 cm bottle is taller than any class allows.
+        described = self.client.get_objects(describe=True).objects
+        classes = sorted(o.ontology.class_name for o in described)
+        self.assertEqual(classes, ["box", "can", "cup", "unknown"])
+        can = next(o for o in described if o.ontology.class_name == "can")
+        self.assertAlmostEqual(can.ontology.primitive.radius_m, 0.033, delta=0.002)
+        cup = next(o for o in described if o.ontology.class_name == "cup")
+        self.assertGreaterEqual(len(cup.ontology.grasps), 1)
+
+        # No hand in this frame; no object was handled.
+        hands = self.client.get_hands()
+        self.assertIsInstance(hands, pb.HandsReply)
+        self.assertEqual(len(hands.hands), 0)
+        self.assertFalse(any(o.foreground for o in described))
 
         # Occupancy: on the table top, in the air above it, under the table (never seen).
         top = objects[0]
