@@ -22,6 +22,7 @@ constexpr int kMinObservations = 3;        // frames a background object was see
 constexpr double kStillM = 0.03;           // a candidate moved at most this far since it was first seen
 constexpr double kSearchMarginM = 0.08;    // registration targets reach this far beyond the model
 constexpr std::size_t kRegistrationPoints = 300;  // model points registration uses
+constexpr double kLiftedVacatedFraction = 0.1;     // of its old place a lifted object must have emptied
 
 Eigen::Vector3d world(const PointT& p, const Pose& T) { return T * p.getVector3fMap().cast<double>(); }
 
@@ -234,9 +235,6 @@ struct ForegroundTracker::Impl {
     }
     const Pose T_cw = f.T_world_camera.inverse();
     const Cloud& cloud = *f.cloud;
-    // Pixels on the object where it is now say nothing about its old place (a cup lifted by less
-    // than its height still covers most of where it stood).
-    const std::unordered_set<int> itself(o.pixels.begin(), o.pixels.end());
     std::size_t filled = 0, empty = 0;
     for (const auto& pw : home) {
       const Eigen::Vector3d p = T_cw * pw;
@@ -246,7 +244,7 @@ struct ForegroundTracker::Impl {
       if (u < 0 || v < 0 || u >= static_cast<int>(cloud.width) || v >= static_cast<int>(cloud.height)) continue;
       const int i = v * static_cast<int>(cloud.width) + u;
       const PointT& q = cloud.points[static_cast<std::size_t>(i)];
-      if (!is_valid(q) || (f.hands && f.hands->is_agent(i)) || itself.count(i)) continue;
+      if (!is_valid(q) || (f.hands && f.hands->is_agent(i))) continue;
       const double depth = q.z;
       if (depth > p.z() + kSeenThroughM) ++empty;
       else if (depth > p.z() - kSeenThroughM) ++filled;
@@ -579,8 +577,11 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
       const double moved = (o.T.translation() - o.T_home.translation()).norm();
       const double turned = rotation_deg(o.T, o.T_home);
       if (moved > cfg.promote_translation_m || turned > cfg.promote_rotation_deg) {
+        // Lifted off its support, the object empties only the band under it (a cylinder's side
+        // wall stays where it was): then that band is evidence enough.
+        const bool lifted = (o.T.translation() - o.T_home.translation()).dot(f.up_world) > cfg.promote_translation_m;
         const double filled = m.still_filled(o, f);
-        if (filled <= 1.0 - cfg.vacated_fraction) m.promote(o, f, moved, turned, filled, out);
+        if (filled <= 1.0 - (lifted ? kLiftedVacatedFraction : cfg.vacated_fraction)) m.promote(o, f, moved, turned, filled, out);
       }
     }
   }

@@ -135,7 +135,7 @@ foreground::ForegroundUpdate ForegroundStage::update(const std::vector<ObjectClu
   // for a frame or two went into the map, and leaves it as it moves on).
   if (hands_.frame_index == view_.frame_index) {
     for (const auto& h : hands_.hands) recent_hands_.push_back({view_.frame_index, h.box_world.grown(kHandQuietM)});
-    if (hands_.person_box_world) recent_hands_.push_back({view_.frame_index, hands_.person_box_world->grown(kHandQuietM)});
+    if (hands_.person_box_world) recent_hands_.push_back({view_.frame_index, hands_.person_box_world->grown(kPersonQuietM)});
   }
   while (!recent_hands_.empty() && recent_hands_.front().first + kHandQuietFrames < view_.frame_index) recent_hands_.pop_front();
   for (const auto& [frame, box] : recent_hands_) out.quiet_boxes.push_back(box);

@@ -46,6 +46,9 @@ class ForegroundStage {
   HandsSeen hands_;
   std::deque<std::pair<std::uint64_t, Aabb>> recent_hands_;  ///< frame, box grown by kHandQuietM
   static constexpr double kHandQuietM = 0.05;
+  /// The person's box is grown more: the detection keeps to the body near the arm, and a shoulder
+  /// or a head beside it is just as much the person's (hrt1: 15 cm in front of the body's box).
+  static constexpr double kPersonQuietM = 0.15;
   static constexpr double kStaticHandFraction = 0.5;  ///< of a hand's points on remembered surfaces: furniture
   void drop_static_hands(const Cloud& cloud, const Pose& T, const OccupiedFraction& occupied);
   static constexpr std::uint64_t kHandQuietFrames = 15;

@@ -38,7 +38,7 @@ struct ForegroundConfig {
   double contact_m = 0.03;              ///< a hand this close to an object's points touches it
   double promote_translation_m = 0.02;  ///< a touched object that moved this far (or turned
   double promote_rotation_deg = 20.0;   ///< this much) from where it stood is promoted...
-  double vacated_fraction = 0.5;        ///< ...when at most this share of its old place is still seen filled
+  double vacated_fraction = 0.3;        ///< ...when at least this share of its old place is seen empty
   int touch_timeout_frames = 20;        ///< a touched object that did not move is forgotten after this many frames without contact
   int release_frames = 4;               ///< frames without contact that end a handling
   double search_radius_m = 0.3;         ///< frame points this close to the predicted centre are registration targets
