@@ -118,10 +118,14 @@ std::vector<std::string> names(const DofFlags& f, bool value) {
   return out;
 }
 
+struct TrackingError {
+  double mean_cm = 0, worst_cm = 0, worst_deg = 0;
+};
+
 // Tracking error: the tracked motion since promotion against the true one (the model's frame is
 // not the cup's, so poses are compared as motions from the same frame).
-void report_tracking(const Outcome& o) {
-  if (o.tracked_cup.empty()) return;
+TrackingError report_tracking(const Outcome& o) {
+  if (o.tracked_cup.empty()) return {1e9, 1e9, 1e9};
   const int first = o.tracked_cup.begin()->first;
   double worst_cm = 0, worst_deg = 0, sum_cm = 0;
   for (const auto& [k, T] : o.tracked_cup) {
@@ -139,6 +143,7 @@ void report_tracking(const Outcome& o) {
   }
   std::printf("tracking over %zu frames: mean %.2f cm, worst %.2f cm, worst %.1f deg\n", o.tracked_cup.size(),
               sum_cm / o.tracked_cup.size(), worst_cm, worst_deg);
+  return {sum_cm / o.tracked_cup.size(), worst_cm, worst_deg};
 }
 
 TEST(ForegroundTrackerTest, AnUprightCarryPromotesTheCupAndFreesXYZAndYawOnly) {
@@ -150,7 +155,11 @@ TEST(ForegroundTrackerTest, AnUprightCarryPromotesTheCupAndFreesXYZAndYawOnly) {
     if (e.kind == EventKind::kObjectPromoted) ++promoted, promoted_at = k;
     if (e.kind == EventKind::kFrozenDofMotion) ++frozen;
   }
-  report_tracking(o);
+  // Measured: mean 0.57 cm, worst 0.80 cm and 14.0 degrees over the 81 frames after promotion.
+  const TrackingError error = report_tracking(o);
+  EXPECT_LT(error.mean_cm, 0.7);
+  EXPECT_LT(error.worst_cm, 1.0);
+  EXPECT_LT(error.worst_deg, 18.0);
   EXPECT_EQ(promoted, 1u);
   EXPECT_EQ(frozen, 0u);
   // The cup is grasped at frame 35 and lifted from there to frame 50 (the scenario's keys):
@@ -165,12 +174,8 @@ TEST(ForegroundTrackerTest, AnUprightCarryPromotesTheCupAndFreesXYZAndYawOnly) {
   std::printf("free DoFs after the carry:");
   for (const auto& n : free) std::printf(" %s", n.c_str());
   std::printf("\n");
-  // x, y and z free, roll and pitch frozen. The 40 degree turn about the cup's axis is lost by
-  // the registration after about 25 degrees (see the tracking figures), so yaw is not asserted:
-  // a known weakness, reported rather than hidden.
-  EXPECT_TRUE(f.free[0] && f.free[1] && f.free[2]);
-  EXPECT_FALSE(f.free[static_cast<std::size_t>(Dof::kRoll)]);
-  EXPECT_FALSE(f.free[static_cast<std::size_t>(Dof::kPitch)]);
+  // x, y, z and yaw (the 40 degree turn, seen from the cup's print) free; roll and pitch frozen.
+  EXPECT_EQ(free, (std::vector<std::string>{"x", "y", "z", "yaw"}));
 }
 
 TEST(ForegroundTrackerTest, TiltingAnUprightCupRaisesOneFrozenDofMotion) {
@@ -182,7 +187,11 @@ TEST(ForegroundTrackerTest, TiltingAnUprightCupRaisesOneFrozenDofMotion) {
     if (e.kind == EventKind::kObjectPromoted) ++promoted;
     if (e.kind == EventKind::kFrozenDofMotion) frozen.push_back(e);
   }
-  report_tracking(o);
+  // Measured: mean 1.42 cm, worst 1.82 cm over the 169 frames after promotion; the rotation is
+  // lost during the 60 degree tilt (worst 58.7 degrees), but the tilt is seen.
+  const TrackingError error = report_tracking(o);
+  EXPECT_LT(error.mean_cm, 1.6);
+  EXPECT_LT(error.worst_cm, 2.2);
   EXPECT_EQ(promoted, 1u);
   ASSERT_EQ(frozen.size(), 1u);
   const auto dof = static_cast<Dof>(static_cast<int>(frozen[0].evidence.at("dof")));

@@ -108,11 +108,13 @@ Registration register_model(const Cloud& model, const Cloud& target, const Pose&
   (void)quiet;
   pcl::IterativeClosestPoint<PointT, PointT> icp;
   icp.setInputTarget(target_ptr);
-  // The representation must reach the correspondence search itself: ICP's own setter only
-  // reaches a tree that PCL 1.13's ICP does not search with.
-  auto estimation = std::make_shared<pcl::registration::CorrespondenceEstimation<PointT, PointT>>();
-  estimation->setPointRepresentation(std::make_shared<const XyzRgbRepresentation>(static_cast<float>(config.colour_weight_m)));
-  icp.setCorrespondenceEstimation(estimation);
+  // Colour in the correspondences, when asked: the representation must reach the correspondence
+  // search itself (ICP's own setter reaches a tree that PCL 1.13's ICP does not search with).
+  if (config.colour_weight_m > 0) {
+    auto estimation = std::make_shared<pcl::registration::CorrespondenceEstimation<PointT, PointT>>();
+    estimation->setPointRepresentation(std::make_shared<const XyzRgbRepresentation>(static_cast<float>(config.colour_weight_m)));
+    icp.setCorrespondenceEstimation(estimation);
+  }
   icp.setMaximumIterations(config.iterations);
   icp.setTransformationEpsilon(1e-8);
   icp.setEuclideanFitnessEpsilon(1e-8);
