@@ -1,5 +1,6 @@
-// Colour-aware ICP (PCL's IterativeClosestPoint with a six-dimensional point representation: the
-// transform is still estimated from x y z alone). The only PCL registration TU of the module.
+// PCL's IterativeClosestPoint (by position; optionally with colour in a six-dimensional point
+// representation), then the turn about the vertical searched by colour. The only PCL
+// registration TU of the module.
 #include "scenewatch/foreground/registration.h"
 
 #include <pcl/console/print.h>
