@@ -74,6 +74,37 @@ CloudPtr thinned(const Cloud& in, double voxel, std::size_t max_points) {
   return out;
 }
 
+// A cluster's points (world frame).
+std::vector<Eigen::Vector3d> world_points(const FrameView& f, const ObjectCluster& c) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(c.indices.size());
+  for (int i : c.indices) out.push_back(world(f.cloud->points[static_cast<std::size_t>(i)], f.T_world_camera));
+  return out;
+}
+
+// A cluster's points with their colour, in the frame T_frame_world maps the world into (the world
+// itself for a registration target, an object's frame for its model).
+Cloud cluster_cloud(const FrameView& f, const ObjectCluster& c, const Pose& T_frame_world) {
+  const Pose T = T_frame_world * f.T_world_camera;
+  Cloud out;
+  for (int i : c.indices) {
+    PointT q = f.cloud->points[static_cast<std::size_t>(i)];
+    q.getVector3fMap() = (T * q.getVector3fMap().cast<double>()).cast<float>();
+    out.push_back(q);
+  }
+  out.width = static_cast<std::uint32_t>(out.size());
+  out.height = 1;
+  return out;
+}
+
+// The frame of an object seen as cluster c, turned as R: origin at the cluster's centroid.
+Pose object_frame(const ObjectCluster& c, const Eigen::Matrix3d& R) {
+  Pose T = Pose::Identity();
+  T.linear() = R;
+  T.translation() = c.centroid;
+  return T;
+}
+
 std::vector<Eigen::Vector3d> posed_points(const Cloud& model, const Pose& T) {
   std::vector<Eigen::Vector3d> out;
   out.reserve(model.size());
@@ -376,13 +407,7 @@ struct ForegroundTracker::Impl {
       const ObjectCluster& c = clusters[ci];
       if (claimed[ci] || (c.centroid - o.T.translation()).norm() > config.reacquire_radius_m) continue;
       if (c.box.extents.norm() > 2.5 * model_size) continue;
-      Cloud target;
-      for (int i : c.indices) {
-        PointT q = f.cloud->points[static_cast<std::size_t>(i)];
-        q.getVector3fMap() = world(q, f.T_world_camera).cast<float>();
-        target.push_back(q);
-      }
-      target = *thinned(target, config.target_voxel_m, 20000);
+      const Cloud target = *thinned(cluster_cloud(f, c, Pose::Identity()), config.target_voxel_m, 20000);
       for (int turn = 0; turn < 4; ++turn) {
         Pose guess = o.T;
         guess.linear() = Eigen::AngleAxisd(turn * M_PI / 2, f.up_world).toRotationMatrix() * o.T.linear();
@@ -486,18 +511,9 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
       for (std::size_t ci = 0; ci < clusters.size() && !o.visible; ++ci) {
         const ObjectCluster& c = clusters[ci];
         if (claimed[ci] || c.box.extents.maxCoeff() > kMaxObjectExtentM || mostly_skin(*f.cloud, c.indices)) continue;
-        std::vector<Eigen::Vector3d> pts;
-        for (int i : c.indices) pts.push_back(world(f.cloud->points[static_cast<std::size_t>(i)], f.T_world_camera));
-        if (!touches(pts)) continue;
-        Cloud local;
-        const Eigen::Matrix3d R = o.T.linear();
-        for (std::size_t k = 0; k < pts.size(); ++k) {
-          PointT q = f.cloud->points[static_cast<std::size_t>(c.indices[k])];
-          q.getVector3fMap() = (R.transpose() * (pts[k] - c.centroid)).cast<float>();
-          local.push_back(q);
-        }
-        o.model = thinned(local, cfg.model_voxel_m, cfg.max_model_points);
-        o.T.translation() = c.centroid;
+        if (!touches(world_points(f, c))) continue;
+        o.T = object_frame(c, o.T.linear());
+        o.model = thinned(cluster_cloud(f, c, o.T.inverse()), cfg.model_voxel_m, cfg.max_model_points);
         o.visible = true;
         o.lost_in_hand = false;
         o.velocity.setZero();
@@ -509,23 +525,32 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
     if (!o.visible) m.reacquire(o, f, clusters, claimed, out);
   }
 
-  // New candidates: background objects a hand touches.
+  // New candidates: background objects a hand touches. Each touched object's surface (grown by
+  // one voxel, for one lookup per point) is made once, when a cluster is first tested against it.
+  std::vector<std::optional<VoxelSet>> surfaces;
+  auto surface_of = [&](std::size_t k) -> const VoxelSet& {
+    if (surfaces.size() <= k) surfaces.resize(m.objects.size());
+    if (!surfaces[k]) {
+      VoxelSet points(cfg.mask_m * 2);
+      for (const auto& p : posed_points(*m.objects[k].model, m.objects[k].T)) points.insert(p);
+      surfaces[k] = points.dilated();
+    }
+    return *surfaces[k];
+  };
   if (any_hand) {
     for (std::size_t ci = 0; ci < clusters.size(); ++ci) {
       const ObjectCluster& c = clusters[ci];
       if (claimed[ci] || c.box.extents.maxCoeff() > kMaxObjectExtentM) continue;
-      std::vector<Eigen::Vector3d> pts;
-      pts.reserve(c.indices.size());
-      for (int i : c.indices) pts.push_back(world(f.cloud->points[static_cast<std::size_t>(i)], f.T_world_camera));
+      const std::vector<Eigen::Vector3d> pts = world_points(f, c);
       if (!touches(pts)) continue;
       // A piece of an object already touched (a cup the hand splits in two) is that object.
-      const bool piece = std::any_of(m.objects.begin(), m.objects.end(), [&](const Impl::Object& o) {
-        VoxelSet surface(cfg.mask_m * 2);
-        for (const auto& p : posed_points(*o.model, o.T)) surface.insert(p);
+      bool piece = false;
+      for (std::size_t k = 0; k < m.objects.size() && !piece; ++k) {
+        const VoxelSet& surface = surface_of(k);
         std::size_t near = 0;
-        for (const auto& p : pts) near += surface.near(p) ? 1 : 0;
-        return 2 * near > pts.size();
-      });
+        for (const auto& p : pts) near += surface.contains(p) ? 1 : 0;
+        piece = 2 * near > pts.size();
+      }
       if (piece || mostly_skin(*f.cloud, c.indices)) continue;  // a piece of the hand the detector left out
       const TrackedObject* match = nullptr;
       double best = 0.06;
@@ -545,15 +570,8 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
       o.id = match->id;
       o.info = *match;
       o.info.foreground.reset();
-      Cloud local;
-      for (int i : c.indices) {
-        PointT q = f.cloud->points[static_cast<std::size_t>(i)];
-        q.getVector3fMap() = (world(q, f.T_world_camera) - c.centroid).cast<float>();
-        local.push_back(q);
-      }
-      o.model = thinned(local, cfg.model_voxel_m, cfg.max_model_points);
-      o.T.translation() = c.centroid;
-      o.T_home = o.T;
+      o.T = o.T_home = object_frame(c, Eigen::Matrix3d::Identity());
+      o.model = thinned(cluster_cloud(f, c, o.T.inverse()), cfg.model_voxel_m, cfg.max_model_points);
       o.pixels = c.indices;
       o.last_contact = f.frame_index;
       m.objects.push_back(std::move(o));

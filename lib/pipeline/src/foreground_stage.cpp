@@ -13,9 +13,7 @@ Eigen::Vector3d up_direction(const std::optional<Eigen::Vector3d>& configured, c
   for (const auto& p : planes) {
     if (!largest || p.area_m2 > largest->area_m2) largest = &p;
   }
-  if (!largest) return Eigen::Vector3d::UnitZ();
-  const Eigen::Vector3d n = largest->normal.normalized();
-  return n.dot(camera_world - largest->centroid) >= 0 ? n : Eigen::Vector3d(-n);
+  return largest ? largest->normal_towards(camera_world) : Eigen::Vector3d::UnitZ();
 }
 
 namespace {

@@ -417,7 +417,7 @@ struct RequestHandler::Impl {
       Eigen::Vector3d up = snapshot.up_world;
       for (const auto& plane : snapshot.planes) {
         if (plane.id != object.cluster.plane_id || object.foreground) continue;
-        up = plane.normal.dot(snapshot.camera_world - plane.centroid) >= 0 ? plane.normal : Eigen::Vector3d(-plane.normal);
+        up = plane.normal_towards(snapshot.camera_world);
       }
       auto d = ontology::describe(*points->second, up, config.classes->library(), snapshot.camera_world, dc);
       cached.info = std::make_shared<proto::ObjectClassInfo>();

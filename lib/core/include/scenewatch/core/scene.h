@@ -22,6 +22,11 @@ struct Plane {
   std::vector<int> indices;           ///< indices of the inliers in the input cloud
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   double signed_distance(const Eigen::Vector3d& p) const { return normal.dot(p) + d; }
+  /// Its unit normal turned towards the side `p` is on (a table's up, seen from a camera above it).
+  Eigen::Vector3d normal_towards(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d n = normal.normalized();
+    return n.dot(p - centroid) >= 0 ? n : Eigen::Vector3d(-n);
+  }
 };
 
 /// A cluster of points standing on a plane.
