@@ -346,17 +346,9 @@ Status HttpServer::listen() {
   return {};
 }
 
-std::uint16_t HttpServer::port() const {
-  boost::system::error_code ec;
-  const auto endpoint = impl_->acceptor.local_endpoint(ec);
-  return ec ? 0 : endpoint.port();
-}
+std::uint16_t HttpServer::port() const { return bound_port(impl_->acceptor); }
 
-std::string HttpServer::endpoint() const {
-  boost::system::error_code ec;
-  const auto endpoint = impl_->acceptor.local_endpoint(ec);
-  return ec ? std::string() : format_endpoint(endpoint);
-}
+std::string HttpServer::endpoint() const { return bound_endpoint(impl_->acceptor); }
 
 void HttpServer::start() {
   Impl& s = *impl_;

@@ -168,17 +168,9 @@ Status Server::listen() {
   return {};
 }
 
-std::uint16_t Server::port() const {
-  boost::system::error_code ec;
-  const auto endpoint = impl_->acceptor.local_endpoint(ec);
-  return ec ? 0 : endpoint.port();
-}
+std::uint16_t Server::port() const { return bound_port(impl_->acceptor); }
 
-std::string Server::endpoint() const {
-  boost::system::error_code ec;
-  const auto endpoint = impl_->acceptor.local_endpoint(ec);
-  return ec ? std::string() : format_endpoint(endpoint);
-}
+std::string Server::endpoint() const { return bound_endpoint(impl_->acceptor); }
 
 void Server::set_frame_observer(FrameObserver observer) { impl_->handler.set_frame_observer(std::move(observer)); }
 
