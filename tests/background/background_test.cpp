@@ -284,6 +284,59 @@ TEST(OccupancyMap, AgreesWithPlainOctomapOnRealFrames) {
   EXPECT_GE(g.jaccard(), 0.95);
 }
 
+// The dense copy of the map (the change detector's per-frame view of it) says, voxel by voxel,
+// what query() says, on a real room after 10 frames (pruned free space and finest leaves mixed);
+// a grid filled again for a smaller box reuses its buffers and is just as right.
+TEST(OccupancyMap, DenseGridAgreesWithQueries) {
+  SCENEWATCH_REQUIRE_DATA("redkitchen/frame-000150.color.png");
+  auto seq = io::open_sequence(test::data_dir() / "redkitchen");
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  OccupancyMap map(at(0.02));
+  for (std::size_t i = 0; i < seq->frames.size(); i += 5) {
+    auto frame = io::load_sequence_frame(*seq, i);
+    ASSERT_TRUE(frame.ok());
+    map.insert(*frame->cloud, *frame->T_world_camera);
+  }
+  DenseGrid grid;
+  std::vector<Aabb> boxes{Aabb{{-1.5, -1.5, -0.5}, {1.5, 1.5, 2.5}}};
+  for (std::size_t b = 0; b < 2; ++b) {
+    ASSERT_TRUE(map.fill_dense_grid(boxes[b], grid).ok());
+    std::size_t counts[3] = {0, 0, 0}, disagree = 0;
+    for (std::size_t n = 0; n < grid.size(); ++n) {
+      const Occupancy expected = map.query(grid.center(static_cast<long>(n)));
+      counts[static_cast<int>(expected)]++;
+      disagree += grid.at(static_cast<long>(n)) != expected;
+    }
+    std::printf("dense grid %dx%dx%d: unknown %zu free %zu occupied %zu, disagreeing %zu\n", grid.nx, grid.ny, grid.nz,
+                counts[static_cast<int>(Occupancy::kUnknown)], counts[static_cast<int>(Occupancy::kFree)],
+                counts[static_cast<int>(Occupancy::kOccupied)], disagree);
+    EXPECT_EQ(disagree, 0u);
+    EXPECT_EQ(grid.occupied.size(), counts[static_cast<int>(Occupancy::kOccupied)]) << "every occupied voxel listed";
+    EXPECT_GT(counts[static_cast<int>(Occupancy::kOccupied)], 100u);
+    EXPECT_GT(counts[static_cast<int>(Occupancy::kFree)], 1000u);
+    if (b == 0) {  // the second box: 30 cm around an occupied voxel of the first, not aligned with its voxels
+      const auto hit = std::find(grid.state.begin(), grid.state.end(), static_cast<std::uint8_t>(Occupancy::kOccupied));
+      ASSERT_NE(hit, grid.state.end());
+      const Eigen::Vector3d c = grid.center(static_cast<long>(hit - grid.state.begin()));
+      boxes.push_back(Aabb{c - Eigen::Vector3d(0.3, 0.27, 0.31), c + Eigen::Vector3d(0.29, 0.3, 0.33)});
+    }
+  }
+  auto copy = map.dense_grid(boxes[1]);
+  ASSERT_TRUE(copy.ok());
+  EXPECT_EQ(copy->state, grid.state);
+  ASSERT_EQ(copy->occupied.size(), grid.occupied.size());
+  std::size_t previous = 0;
+  for (std::size_t i = 0; i < grid.occupied.size(); ++i) {
+    const DenseGrid::Surface& s = grid.occupied[i];
+    EXPECT_EQ(grid.at(static_cast<long>(s.index)), Occupancy::kOccupied);
+    EXPECT_TRUE(i == 0 || s.index > previous) << "listed by index, once each";
+    EXPECT_GT(s.probability, 127) << "an occupied voxel's belief is above one half";
+    EXPECT_EQ(copy->occupied[i].index, s.index);
+    EXPECT_EQ(copy->occupied[i].rgb, s.rgb);
+    previous = s.index;
+  }
+}
+
 // On a real frame: a pixel's surface point is occupied, the point halfway to the sensor is free
 // and a point 20 cm behind the surface along the same ray is unknown (for most pixels: other
 // rays can see behind a thin edge, and depth noise blurs the surface).

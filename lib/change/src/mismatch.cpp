@@ -101,7 +101,7 @@ DepthView depth_view(const Cloud& cloud, const Intrinsics& K) {
 }
 
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& cloud, const Pose& T,
-                                      const Intrinsics& K, const Config& config) {
+                                      const Intrinsics& K, const Config& config, background::DenseGrid* grid_scratch) {
   if (!K.valid()) return invalid_argument("mismatch: intrinsics are invalid");
   Mismatch out;
   out.voxel_m = map.resolution();
@@ -122,9 +122,9 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   const double res = map.resolution();
   box.min.array() -= 2 * res;
   box.max.array() += 2 * res;
-  auto grid_or = map.dense_grid(box, config.max_grid_voxels);
-  if (!grid_or) return grid_or.error();
-  const background::DenseGrid& grid = *grid_or;
+  background::DenseGrid local;
+  background::DenseGrid& grid = grid_scratch != nullptr ? *grid_scratch : local;
+  if (auto filled = map.fill_dense_grid(box, grid, config.max_grid_voxels); !filled) return filled.error();
   out.grid_ms = ms_since(t0);
 
   // 2. Added: points whose voxel the model holds free and whose distance to every occupied voxel
@@ -179,9 +179,9 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   const DepthView depth = depth_view(cloud, K);
   const Eigen::Isometry3d T_camera_world = T.inverse();
   const auto min_probability = static_cast<std::uint8_t>(std::floor(255.0 * config.min_surface_probability));
-  for (std::size_t n = 0; n < grid.size(); ++n) {
-    if (grid.state[n] != static_cast<std::uint8_t>(Occupancy::kOccupied) || grid.probability[n] < min_probability) continue;
-    const Eigen::Vector3d c = grid.center(static_cast<long>(n));
+  for (const background::DenseGrid::Surface& surface : grid.occupied) {
+    if (surface.probability < min_probability) continue;
+    const Eigen::Vector3d c = grid.center(static_cast<long>(surface.index));
     const Eigen::Vector3d q = T_camera_world * c;
     if (q.z() <= res || q.z() > config.max_range_m) continue;
     const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
@@ -209,7 +209,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
     if (veto || with_depth < total) continue;
     MissingVoxel m;
     m.center_world = c;
-    m.rgb = grid.rgb[n];
+    m.rgb = surface.rgb;
     m.u = static_cast<int>(std::lround(uc));
     m.v = static_cast<int>(std::lround(vc));
     m.depth_gap_m = static_cast<float>(nearest - q.z());

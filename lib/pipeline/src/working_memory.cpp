@@ -159,6 +159,7 @@ struct WorkingMemory::Impl {
   // Guards `map` between writers and concurrent occupancy readers.
   mutable std::shared_mutex map_mutex;
   background::OccupancyMap map;
+  background::DenseGrid map_grid;  // the change detector's dense copy of the map, its buffers kept between frames
   AppearanceStage appearance;  // keyframes, mesh and image surprise; locks itself for readers
 
   // Owned by the writer.
@@ -217,7 +218,7 @@ struct WorkingMemory::Impl {
     if (!K) return out;
     out.K = *K;
     std::shared_lock<std::shared_mutex> read(map_mutex);
-    auto mismatch = change::mismatch_against_map(map, *frame.cloud, T, *K, config);
+    auto mismatch = change::mismatch_against_map(map, *frame.cloud, T, *K, config, &map_grid);
     if (!mismatch) return out;
     change::ClusterInput input;
     input.after_camera = frame.cloud.get();

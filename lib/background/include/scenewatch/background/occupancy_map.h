@@ -47,8 +47,14 @@ struct DenseGrid {
   double resolution = 0.0;
   int nx = 0, ny = 0, nz = 0;
   std::vector<std::uint8_t> state;  ///< Occupancy per voxel, x fastest
-  std::vector<std::uint32_t> rgb;   ///< 0xRRGGBB per voxel (meaningful where occupied)
-  std::vector<std::uint8_t> probability;  ///< occupancy probability per voxel, times 255
+  /// An occupied voxel's colour and belief. Occupied voxels are few in a frame's box (surfaces),
+  /// so they are listed rather than stored per voxel.
+  struct Surface {
+    std::size_t index = 0;       ///< into state
+    std::uint32_t rgb = 0;       ///< 0xRRGGBB
+    std::uint8_t probability = 0;  ///< occupancy probability times 255
+  };
+  std::vector<Surface> occupied;  ///< every occupied voxel of the grid, by index
   std::size_t size() const { return state.size(); }
   /// Index of the voxel holding p, or -1 outside the grid.
   long index_of(const Eigen::Vector3d& p_world) const {
@@ -96,6 +102,9 @@ class OccupancyMap {
   /// The voxels overlapping a box as a dense grid. Error when the box is invalid, outside the
   /// map's extent, or holds more than max_voxels voxels.
   Result<DenseGrid> dense_grid(const Aabb& box_world, std::size_t max_voxels = std::size_t{1} << 26) const;
+  /// The same into `grid`, whose buffers are kept (a caller that fills one grid per frame
+  /// allocates once). On error `grid` is unspecified.
+  Status fill_dense_grid(const Aabb& box_world, DenseGrid& grid, std::size_t max_voxels = std::size_t{1} << 26) const;
   /// Sets the voxels holding the given points to the clamped free or occupied belief (a confirmed
   /// change written into the model at once instead of over several frames). kUnknown deletes
   /// them. Returns the number of distinct voxels set.

@@ -109,9 +109,12 @@ struct Mismatch {
 };
 
 /// Compares an observation (points in the camera frame, placed with T_world_camera) with the
-/// map. Error when the region is too large for a dense grid or the camera is invalid.
+/// map. Error when the region is too large for a dense grid or the camera is invalid. A caller
+/// that compares every frame passes `grid_scratch`, the dense copy of the map, kept between calls
+/// so that its buffers are allocated once.
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& points_camera,
-                                      const Pose& T_world_camera, const Intrinsics& K, const Config& config);
+                                      const Pose& T_world_camera, const Intrinsics& K, const Config& config,
+                                      background::DenseGrid* grid_scratch = nullptr);
 
 /// Same-camera pair of organized clouds of equal size (the camera did not move): exact per-pixel
 /// reasoning. A pixel whose AFTER depth is in front of BEFORE by more than the tolerance is added
