@@ -68,17 +68,19 @@ TEST(Mosd, TableFoundAndObjectsRecalled) {
     std::printf("  %-18s recall %zu/%zu, precision %zu/%zu\n", names[g], by_group_matched[g], by_group_objects[g],
                 by_group_correct[g], by_group_clusters[g]);
   EXPECT_EQ(tables, scenes) << "the table plane must be found in every scene";
-  // Floors at what the run they were set on measured (README, "Segmentation"): recall 110/112 =
-  // 0.982 and precision 110/115 = 0.957; stacked boxes 18/20, occluded objects 16/16, cylindric
-  // objects 38/38 both ways (Euclidean clusters alone: 0.821 / 0.773, stacked 9/20, occluded
-  // 13/16, cylindric 32/38 at precision 32/48). What is left: a box on a box with flush fronts
-  // (learn19), a stack of three (learn21), two leftover pieces.
-  EXPECT_GE(recall, 0.98);
-  EXPECT_GE(precision, 0.95);
+  // Floors at what the run they were set on measured (README, "Segmentation"): recall and
+  // precision 111/112 = 0.991; boxes 38/38, stacked boxes 19/20, occluded objects 16/16 and
+  // cylindric objects 38/38, each both ways (before the occlusion join fitted one profile to both
+  // pieces: 110/112 and 110/115; Euclidean clusters alone: 0.821 / 0.773). What is left: a stack
+  // of three (learn21) and one leftover piece (learn24).
+  EXPECT_GE(recall, 0.99);
+  EXPECT_GE(precision, 0.99);
   EXPECT_EQ(by_group_matched[3], by_group_objects[3]) << "cylinders, mugs, bowls and pots are found whole";
   EXPECT_EQ(by_group_correct[3], by_group_clusters[3]) << "containers are not cut into inside and outside";
   EXPECT_EQ(by_group_matched[2], by_group_objects[2]) << "occluded objects are found whole";
-  EXPECT_GE(by_group_matched[1], 18u) << "stacked boxes come apart";
+  EXPECT_EQ(by_group_correct[2], by_group_clusters[2]) << "an occluded object seen on both sides is one object";
+  EXPECT_GE(by_group_matched[1], 19u) << "stacked boxes come apart";
+  EXPECT_GE(by_group_correct[1] * 10, by_group_clusters[1] * 9) << "stacked: precision at least 0.90";
   EXPECT_EQ(by_group_matched[0], by_group_objects[0]) << "every isolated box must be recovered";
 }
 

@@ -10,8 +10,8 @@ namespace scenewatch::segmentation {
 namespace {
 
 constexpr int kNone = -1, kSupport = -2;
-// Depth slope of a piece along the walk: from its last pixels before the gap.
-constexpr int kSlopePixels = 8;
+// Pixels of each piece's run next to the gap that the depth profile is fitted to.
+constexpr int kRunPixels = 40;
 // Valid pixels of neither a piece nor the support tolerated on the walk (mixed pixels at edges).
 constexpr int kMaxStrayPixels = 3;
 
@@ -38,8 +38,8 @@ PieceStats stats_of(const Cloud& cloud, const Piece& piece, const Plane& plane) 
   return s;
 }
 
-// Whether the walk from piece a to piece b crosses only nearer things (or no data) and the
-// surface of a, carried on, meets b.
+// Whether the walk from piece a to piece b crosses only nearer things (or no data) and one
+// surface runs through both behind them.
 bool hidden_continuation(const Cloud& cloud, const std::vector<int>& owner, int a, int b, const PieceStats& sa,
                          const PieceStats& sb, const OcclusionParams& params) {
   const int steps = static_cast<int>(std::ceil(std::max(std::abs(sb.u - sa.u), std::abs(sb.v - sa.v))));
@@ -68,24 +68,55 @@ bool hidden_continuation(const Cloud& cloud, const std::vector<int>& owner, int 
     if (o != kNone) ++occluder;
   }
   if (occluder == 0) return false;
-  // Depth of a along the walk (a least-squares line over its last pixels), carried to b.
+  // One straight depth profile through both pieces along the walk: a least-squares line over
+  // each piece's run of pixels next to the gap (up to kRunPixels a side). Fitted over both runs,
+  // its slope rests on a baseline as long as the gap it spans; a slope from a few pixels of one
+  // side, carried across a gap ten times as wide, would carry ten times its depth noise.
   double sk = 0, sz = 0, skk = 0, skz = 0, m = 0;
-  for (int k = std::max(0, last_a - kSlopePixels); k <= last_a; ++k) {
-    if (owner[line[k]] != a || !is_valid(cloud[line[k]])) continue;
+  auto take = [&](int k, int piece) {
+    if (owner[line[k]] != piece || !is_valid(cloud[line[k]])) return;
     const double z = cloud[line[k]].z;
-    sk += k, sz += z, skk += k * k, skz += k * z, m += 1;
-  }
-  const PointT& pb = cloud[line[first_b]];
-  if (m < 2 || !is_valid(pb)) return false;
+    sk += k, sz += z, skk += static_cast<double>(k) * k, skz += k * z, m += 1;
+  };
+  const int a_from = std::max(0, last_a - kRunPixels + 1), b_to = std::min(steps, first_b + kRunPixels - 1);
+  for (int k = a_from; k <= last_a; ++k) take(k, a);
+  const double ma = m;
+  for (int k = first_b; k <= b_to; ++k) take(k, b);
+  const double mb = m - ma;
+  if (ma < 2 || mb < 2) return false;
   const double den = m * skk - sk * sk;
   const double slope = std::abs(den) < 1e-9 ? 0.0 : (m * skz - sk * sz) / den;
-  const double predicted = (sz - slope * sk) / m + slope * first_b;
-  // Everything crossed is in front of the carried surface.
+  const double offset = (sz - slope * sk) / m;
+  const auto depth_at = [&](int k) { return offset + slope * k; };
+  // Each run lies on that line: two surfaces at different angles (two objects side by side) give
+  // a line that fits neither.
+  const auto rms_about_line = [&](int from, int to, int piece) {
+    double sum = 0;
+    int n = 0;
+    for (int k = from; k <= to; ++k) {
+      if (owner[line[k]] != piece || !is_valid(cloud[line[k]])) continue;
+      const double r = cloud[line[k]].z - depth_at(k);
+      sum += r * r;
+      ++n;
+    }
+    return std::sqrt(sum / std::max(n, 1));
+  };
+  if (rms_about_line(a_from, last_a, a) > params.max_profile_rms_m ||
+      rms_about_line(first_b, b_to, b) > params.max_profile_rms_m) {
+    return false;
+  }
+  // Everything crossed is in front of that surface.
   for (int k = last_a + 1; k < first_b; ++k) {
     const PointT& q = cloud[line[k]];
-    if (is_valid(q) && q.z > (sz - slope * sk) / m + slope * k) return false;
+    if (is_valid(q) && q.z > depth_at(k)) return false;
   }
-  return std::abs(predicted - pb.z) <= params.max_depth_gap_m + params.max_depth_gap_rel * pb.z;
+  // Both pieces lie on it where they meet the gap.
+  const PointT &pa = cloud[line[last_a]], &pb = cloud[line[first_b]];
+  if (!is_valid(pa) || !is_valid(pb)) return false;
+  const auto meets = [&](const PointT& p, int k) {
+    return std::abs(depth_at(k) - p.z) <= params.max_depth_gap_m + params.max_depth_gap_rel * p.z;
+  };
+  return meets(pa, last_a) && meets(pb, first_b);
 }
 
 }  // namespace

@@ -2,8 +2,9 @@
 // One object seen in pieces: an object standing behind a narrower one shows on both sides of it
 // (mOSD's occluded scenes; clutter). Two pieces are one object when the image between them is
 // covered by something nearer, with no glimpse of the support or the background in between, and
-// the surface continues across the gap: the depth of one piece, carried on along the line to the
-// other, meets the other's depth, and both reach the same height above the support.
+// the surface continues across the gap: one straight depth profile, fitted along the line to both
+// pieces' pixels next to the gap, fits both, passes behind everything in between and meets both
+// pieces, and both reach the same height above the support.
 #include <vector>
 
 #include "piece.h"
@@ -14,10 +15,14 @@ namespace scenewatch::segmentation {
 
 struct OcclusionParams {
   double max_height_difference_m = 0.02;  ///< the two pieces' tops (95th percentile heights)
-  /// The surface carried across the occluder meets the other piece within this, plus a share
-  /// of the range (depth noise grows with range).
+  /// The profile fitted across the occluder meets each piece within this, plus a share of the
+  /// range (depth noise grows with range).
   double max_depth_gap_m = 0.02;
   double max_depth_gap_rel = 0.03;
+  /// Each piece's pixels next to the gap lie on the fitted profile within this rms. A flat face
+  /// seen by a Kinect-class camera at about 1 m scatters by a few mm; two faces at different
+  /// angles (two objects, not one) leave cm.
+  double max_profile_rms_m = 0.008;
 };
 
 /// Joins pieces of one object seen on both sides of an occluder. Organized clouds only (the test
