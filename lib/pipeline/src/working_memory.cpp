@@ -350,6 +350,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   // frame: the image surprise (keyframes and mesh), the geometric change detection with the map
   // update (the octree), and the segmentation of the frame (this thread). None reads what another
   // writes; the tracker and the event fusion below need all three.
+  const auto t_parallel = Clock::now();
   auto surprise = std::async(std::launch::async, [&] {
     const auto t_surprise = Clock::now();
     result.surprise = m.appearance.process(seen);  // then its keyframe update
@@ -368,6 +369,8 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
 
   surprise.get();  // each rethrows what its part threw
   const ChangeOutcome changed = map_update.get();
+  result.parallel_ms = ms_since(t_parallel);
+  const auto t_after = Clock::now();
   foreground::ForegroundUpdate fg = m.foreground.update(result.objects, m.tracker.objects(), result);
   result.events = m.fuse(result, changed, fg.quiet_boxes, frame.stamp_s);
 
@@ -404,6 +407,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   m.total_ms += result.total_ms;
   m.emit(result.events, config_.max_event_log);
   m.publish();
+  result.after_ms = ms_since(t_after);
   return result;
 }
 

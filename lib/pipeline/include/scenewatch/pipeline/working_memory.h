@@ -76,6 +76,9 @@ struct FrameResult {
   std::shared_ptr<const SurpriseResult> surprise;  ///< null: the frame had no pose or no keyframes existed yet
   double segment_ms = 0, insert_ms = 0, surprise_ms = 0, change_ms = 0, total_ms = 0;
   double hands_ms = 0, foreground_ms = 0;  ///< hand detection; foreground registration and promotion
+  /// Wall time of the three parts side by side (segmentation, surprise, change + insertion), and
+  /// of what follows them on one core (foreground, fusion, tracker, snapshot publication).
+  double parallel_ms = 0, after_ms = 0;
   std::size_t hands = 0;                   ///< hands found in the frame
   std::size_t change_candidates = 0;  ///< changes seen but not yet confirmed
 };
