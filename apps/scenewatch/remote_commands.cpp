@@ -521,6 +521,7 @@ int run_classes(const RemoteOptions& options) {
         for (const auto& d : c.learnt_free_dofs()) std::cout << " " << d;
         std::cout << ", frozen";
         for (const auto& d : c.learnt_frozen_dofs()) std::cout << " " << d;
+        if (c.learnt_frozen_dofs_size() == 0) std::cout << " none";
       }
       std::cout << "\n";
     }
