@@ -413,8 +413,7 @@ struct RequestHandler::Impl {
     auto& cached = described[id];
     const bool fresh = cached.points == points->second.get() || now - cached.at_s < kDescribeAgainS;
     if (!fresh || !cached.info) {
-      ontology::DescribeConfig dc;
-      dc.completion_spacing_m = 0;  // no completed surface on the wire
+      ontology::DescribeConfig dc;  // the completed surface goes to the expected view, not on the wire
       // Up is the normal of the plane the object stands on, turned towards the camera.
       Eigen::Vector3d up = snapshot.up_world;
       for (const auto& plane : snapshot.planes) {
@@ -428,6 +427,13 @@ struct RequestHandler::Impl {
       cached.points = points->second.get();
       cached.at_s = now;
       record(object, *cached.info);
+      // The completed primitive predicts the object's unseen side in later frames' expected view
+      // (none for unknown objects: that removes an earlier one).
+      surprise::KnownSurface surface;
+      if (d) surface.points_world = std::move(d->completed_points);
+      surface.spacing_m = dc.completion_spacing_m;
+      surface.rgb = object.cluster.mean_rgb;
+      memory.set_known_surface(id, object.cluster.centroid, std::move(surface));
     }
     *out = *cached.info;
   }
