@@ -123,12 +123,15 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
         }
     for (std::uint32_t s = range.first; s < range.second; ++s) {
       const std::size_t i = order[s];
-      // Only the block's points within one cell's width can be among the k nearest found here:
+      // The block holds every point within `reach` of p[i]: one cell's width plus p[i]'s distance
+      // to the nearest face of its own cell. Only those can be among the k nearest found here:
       // when there are k of them, the k nearest of those are exact; else the rings decide.
+      const Eigen::Vector3d offset = p[i] / cell - cell_of[i].cast<double>();  // in [0, 1) per axis
+      const double reach = cell * (1.0 + std::min(offset.minCoeff(), 1.0 - offset.maxCoeff()));
       candidates.clear();
       for (const std::uint32_t j : block) {
         const double d2 = (p[j] - p[i]).squaredNorm();
-        if (d2 <= cell * cell) candidates.emplace_back(d2, j);
+        if (d2 <= reach * reach) candidates.emplace_back(d2, j);
       }
       if (candidates.size() >= want) {
         std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(want - 1), candidates.end());
