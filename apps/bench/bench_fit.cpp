@@ -1,6 +1,7 @@
-// Primitive fitting per object: scenewatch's fit_object (PCL normals, CGAL Efficient RANSAC over
-// four shapes, cylinder refinement) against PCL's cylinder RANSAC (SACSegmentationFromNormals,
-// SACMODEL_CYLINDER, with the same normals estimation) on the same clusters, in the same run: the
+// Primitive fitting per object: scenewatch's fit_object (grid k-NN normals, CGAL Efficient RANSAC
+// over four shapes, cylinder refinement), the same with its former kd-tree normals (PCL's
+// NormalEstimation), and PCL's cylinder RANSAC (SACSegmentationFromNormals, SACMODEL_CYLINDER, with
+// kd-tree normals) on the same clusters, in the same run: the
 // objects of the segmented YCB frames and of a simulated frame with a can and a cup. Also the time
 // of the whole description (describe(): fit_object plus each shipped class's fit and checks) and
 // the class it gives.
@@ -94,10 +95,13 @@ int run_fit(const Options& o) {
   pcl::console::setVerbosityLevel(pcl::console::L_ALWAYS);  // "RANSAC found no model" on every box
   std::printf("\n== Primitive fitting per object: scenewatch fit_object vs PCL SACMODEL_CYLINDER (medians of %d runs)\n",
               o.repetitions);
-  std::printf("%-24s %6s %7s %7s %6s %9s %9s %9s %11s %-8s\n", "scene/object", "points", "ours ms", "pcl ms", "ratio", "best",
-              "ours r mm", "pcl r mm", "describe ms", "class");
-  std::vector<double> ratios, ours_all, pcl_all, describe_all;
+  std::printf("(ours: grid normals; kd: ours with the former kd-tree normals; nrm: their normals' share)\n");
+  std::printf("%-24s %6s %7s %7s %7s %6s %6s %6s %9s %9s %9s %9s %11s %-8s\n", "scene/object", "points", "ours ms", "kd ms",
+              "pcl ms", "nrm", "kd nrm", "ratio", "best", "ours r mm", "kd r mm", "pcl r mm", "describe ms", "class");
+  std::vector<double> ratios, ours_all, kd_all, pcl_all, describe_all, normals_all, kd_normals_all, radius_diffs;
   const ontology::FitConfig config;
+  ontology::FitConfig kd_config;
+  kd_config.normal_search = ontology::NormalSearch::kKdTree;
   auto classes = ontology::load_classes_file(std::filesystem::path(SCENEWATCH_SOURCE_DIR) / "config/ontology.yaml");
   if (!classes) {
     std::fprintf(stderr, "%s\n", classes.error().message.c_str());
@@ -113,30 +117,45 @@ int run_fit(const Options& o) {
       for (const auto& plane : seg.planes)
         if (plane.id == object.plane_id) up = plane.normal;
       const std::vector<int> same = subsample(cloud, object.indices, config.max_points);
-      std::vector<double> ours, theirs, described;
-      Result<ontology::ObjectFit> fit = invalid_argument("not run");
+      std::vector<double> ours, kd, theirs, described, normals, kd_normals;
+      Result<ontology::ObjectFit> fit = invalid_argument("not run"), kd_fit = invalid_argument("not run");
       Result<ontology::ObjectDescription> description = invalid_argument("not run");
       double pcl_radius = 0;
       for (int r = 0; r < o.repetitions; ++r) {
         ours.push_back(time_ms([&] { fit = ontology::fit_object(cloud, object.indices, config, up); }));
+        kd.push_back(time_ms([&] { kd_fit = ontology::fit_object(cloud, object.indices, kd_config, up); }));
         theirs.push_back(time_ms([&] { pcl_radius = pcl_cylinder_radius(cloud, same); }));
         described.push_back(time_ms([&] { description = ontology::describe(cloud, object.indices, up, *classes); }));
+        if (fit) normals.push_back(fit->normals_ms);
+        if (kd_fit) kd_normals.push_back(kd_fit->normals_ms);
       }
-      if (!fit) continue;
-      const double a = median(ours), b = median(theirs);
+      if (!fit || !kd_fit) continue;
+      const double a = median(ours), akd = median(kd), b = median(theirs);
       ratios.push_back(a / b);
       ours_all.push_back(a);
+      kd_all.push_back(akd);
       pcl_all.push_back(b);
+      normals_all.push_back(median(normals));
+      kd_normals_all.push_back(median(kd_normals));
       describe_all.push_back(median(described));
+      const double r_ours = fit->cylinder ? fit->cylinder->radius_m * 1000 : 0.0;
+      const double r_kd = kd_fit->cylinder ? kd_fit->cylinder->radius_m * 1000 : 0.0;
+      if (fit->cylinder && kd_fit->cylinder) radius_diffs.push_back(std::abs(r_ours - r_kd));
       const char* best = fit->best >= 0 ? ontology::to_string(fit->shapes[static_cast<std::size_t>(fit->best)].kind) : "-";
       const std::string name = scene.name + " #" + std::to_string(k);
-      std::printf("%-24s %6zu %7.1f %7.1f %6.2f %9s %9.1f %9.1f %11.1f %-8s\n", name.c_str(), same.size(), a, b, a / b, best,
-                  fit->cylinder ? fit->cylinder->radius_m * 1000 : 0.0, pcl_radius * 1000, median(described),
+      std::printf("%-24s %6zu %7.1f %7.1f %7.1f %6.1f %6.1f %6.2f %9s %9.1f %9.1f %9.1f %11.1f %-8s\n", name.c_str(), same.size(), a,
+                  akd, b, median(normals), median(kd_normals), a / b, best, r_ours, r_kd, pcl_radius * 1000, median(described),
                   description ? description->class_name.c_str() : "error");
     }
   }
-  std::printf("objects %zu: median ours %.1f ms, PCL cylinder %.1f ms, median ratio ours/PCL %.2f; median describe %.1f ms\n",
-              ratios.size(), median(ours_all), median(pcl_all), median(ratios), median(describe_all));
+  std::printf("objects %zu: median ours %.1f ms (normals %.1f), with kd-tree normals %.1f ms (normals %.1f), PCL cylinder %.1f ms, "
+              "median ratio ours/PCL %.2f; median describe %.1f ms\n",
+              ratios.size(), median(ours_all), median(normals_all), median(kd_all), median(kd_normals_all), median(pcl_all),
+              median(ratios), median(describe_all));
+  std::sort(radius_diffs.begin(), radius_diffs.end());
+  if (!radius_diffs.empty())
+    std::printf("refined cylinder radius, grid vs kd-tree normals, |difference| over %zu objects: median %.2f mm, max %.2f mm\n",
+                radius_diffs.size(), median(radius_diffs), radius_diffs.back());
   return 0;
 }
 

@@ -2,6 +2,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <functional>
@@ -480,7 +481,10 @@ int run_classes(const RemoteOptions& options) {
         json grasps = json::array();
         for (const auto& g : c.grasps()) grasps.push_back({{"name", g.name()}, {"kind", g.kind()}, {"height_fraction", g.height_fraction()}});
         json j = {{"name", c.name()}, {"shape", c.shape()}, {"axis", c.axis()}, {"top", c.top()}, {"grasps", grasps},
-                  {"allowed_dofs", std::vector<std::string>(c.allowed_dofs().begin(), c.allowed_dofs().end())}};
+                  {"allowed_dofs", std::vector<std::string>(c.allowed_dofs().begin(), c.allowed_dofs().end())},
+                  {"defined_dofs", std::vector<std::string>(c.defined_dofs().begin(), c.defined_dofs().end())},
+                  {"learnt_free_dofs", std::vector<std::string>(c.learnt_free_dofs().begin(), c.learnt_free_dofs().end())},
+                  {"learnt_frozen_dofs", std::vector<std::string>(c.learnt_frozen_dofs().begin(), c.learnt_frozen_dofs().end())}};
         if (c.has_radius_m()) j["radius_m"] = {c.radius_m().min(), c.radius_m().max()};
         if (c.has_height_m()) j["height_m"] = {c.height_m().min(), c.height_m().max()};
         if (c.has_taper_deg()) j["taper_deg"] = {c.taper_deg().min(), c.taper_deg().max()};
@@ -503,8 +507,22 @@ int run_classes(const RemoteOptions& options) {
       for (int i = 0; i < c.size_m_size(); ++i) std::cout << (i == 0 ? ", sides " : " x ") << mm(c.size_m(i));
       std::cout << ", axis " << c.axis() << ", top " << c.top() << "; grasps";
       for (const auto& g : c.grasps()) std::cout << " " << g.name() << " (" << g.kind() << ")";
+      // Allowed motions: those defined (config, DefineClass), then those only learnt from handled
+      // instances, then what handling never moved.
       std::cout << "; motions";
-      for (const auto& d : c.allowed_dofs()) std::cout << " " << d;
+      for (const auto& d : c.defined_dofs()) std::cout << " " << d;
+      std::cout << (c.defined_dofs_size() == 0 ? " none defined" : " (defined)");
+      std::string learnt_only;
+      for (const auto& d : c.learnt_free_dofs())
+        if (std::find(c.defined_dofs().begin(), c.defined_dofs().end(), d) == c.defined_dofs().end()) learnt_only += " " + d;
+      if (!learnt_only.empty()) std::cout << " +" << learnt_only << " (learnt)";
+      if (c.learnt_free_dofs_size() + c.learnt_frozen_dofs_size() > 0) {
+        std::cout << "; learnt from handling: free";
+        for (const auto& d : c.learnt_free_dofs()) std::cout << " " << d;
+        std::cout << ", frozen";
+        for (const auto& d : c.learnt_frozen_dofs()) std::cout << " " << d;
+        if (c.learnt_frozen_dofs_size() == 0) std::cout << " none";
+      }
       std::cout << "\n";
     }
     std::cout << std::flush;

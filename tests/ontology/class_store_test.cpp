@@ -202,5 +202,65 @@ TEST(ClassCatalogTest, StoredClassesOverlayTheFileAndPersist) {
   EXPECT_NE(library.find("cup"), nullptr);
 }
 
+// What the daemon records: instances, and the learnt motions of a class from its handled
+// instances (union of their free DoFs; the rest frozen), visible at once, in the store after a
+// flush, and back after a restart. An unhandled instance teaches nothing; unknown objects never do.
+TEST(ClassCatalogTest, RecordsInstancesAndLearntMotionsThatPersist) {
+  test::TempDir dir("class-catalog-learnt");
+  const auto classes_file = test::source_dir() / "config/ontology.yaml";
+  const auto store = dir / kClassStoreFile;
+  DofFlags turned{};  // carried and turned about its axis: x y z yaw
+  turned[static_cast<std::size_t>(Dof::kX)] = turned[static_cast<std::size_t>(Dof::kY)] = true;
+  turned[static_cast<std::size_t>(Dof::kZ)] = turned[static_cast<std::size_t>(Dof::kYaw)] = true;
+  DofFlags tilted{};  // only tilted
+  tilted[static_cast<std::size_t>(Dof::kRoll)] = true;
+  {
+    auto catalog = ClassCatalog::open(classes_file, store);
+    ASSERT_TRUE(catalog.ok()) << catalog.error().message;
+    ClassCatalog& c = **catalog;
+    c.record({0, "cup", R"({"radius_m":0.04})", 1.0});  // seen, not handled
+    EXPECT_TRUE(c.learnt().empty());
+    c.record({0, "cup", R"({"radius_m":0.04})", 2.0}, turned);
+    c.record({0, "unknown", "{}", 2.5}, tilted);  // no class to teach
+    ASSERT_EQ(c.learnt().size(), 1u);
+    EXPECT_EQ(c.learnt().at("cup").names(true), (std::vector<std::string>{"x", "y", "z", "yaw"}));
+    EXPECT_EQ(c.learnt().at("cup").names(false), (std::vector<std::string>{"roll", "pitch"}));
+    c.record({0, "cup", R"({"radius_m":0.041})", 3.0}, tilted);  // a second cup, tilted: roll joins
+    EXPECT_EQ(c.learnt().at("cup").names(false), (std::vector<std::string>{"pitch"}));
+    ASSERT_TRUE(c.flush().ok());
+    auto reader = ClassStore::open(store);  // a second connection sees the committed rows
+    ASSERT_TRUE(reader.ok()) << reader.error().message;
+    auto instances = reader->instances();
+    ASSERT_TRUE(instances.ok());
+    ASSERT_EQ(instances->size(), 4u);
+    EXPECT_EQ((*instances)[3].parameters_json, R"({"radius_m":0.041})");
+    EXPECT_DOUBLE_EQ((*instances)[3].time_s, 3.0);
+    auto constraints = reader->constraints();
+    ASSERT_TRUE(constraints.ok());
+    EXPECT_EQ(constraints->size(), 6u) << "one row per DoF of cup, none of unknown";
+    c.record({0, "cup", "{}", 4.0});  // queued only: written when the catalog closes
+  }
+  auto catalog = ClassCatalog::open(classes_file, store);
+  ASSERT_TRUE(catalog.ok()) << catalog.error().message;
+  const auto learnt = (*catalog)->learnt();
+  ASSERT_EQ(learnt.count("cup"), 1u);
+  EXPECT_EQ(learnt.at("cup").names(true), (std::vector<std::string>{"x", "y", "z", "roll", "yaw"}));
+  EXPECT_EQ(learnt.at("cup").names(false), (std::vector<std::string>{"pitch"}));
+  auto reader = ClassStore::open(store);
+  ASSERT_TRUE(reader.ok());
+  EXPECT_EQ(reader->instances("cup")->size(), 4u);
+}
+
+// Without a store the learnt motions live in memory and flush has nothing to wait for.
+TEST(ClassCatalogTest, LearnsWithoutAStore) {
+  auto catalog = ClassCatalog::open(test::source_dir() / "config/ontology.yaml", {});
+  ASSERT_TRUE(catalog.ok()) << catalog.error().message;
+  DofFlags free{};
+  free[static_cast<std::size_t>(Dof::kZ)] = true;
+  (*catalog)->record({0, "ball", "{}", 1.0}, free);
+  EXPECT_TRUE((*catalog)->flush().ok());
+  EXPECT_EQ((*catalog)->learnt().at("ball").names(true), (std::vector<std::string>{"z"}));
+}
+
 }  // namespace
 }  // namespace scenewatch::ontology

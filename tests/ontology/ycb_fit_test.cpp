@@ -30,9 +30,10 @@ struct Outcome {
   std::optional<CylinderFit> cylinder;
   double tilt_deg = 0;  // of the axis from the supporting plane's normal
   std::size_t points = 0;
+  std::optional<ObjectFit> fit;
 };
 
-Outcome fit_can(const CanView& can, AxisPrior prior) {
+Outcome fit_can(const CanView& can, AxisPrior prior, NormalSearch normals = NormalSearch::kGrid) {
   Outcome out;
   io::SequenceOptions options;
   options.depth_scale_m = 1e-4;
@@ -63,11 +64,13 @@ Outcome fit_can(const CanView& can, AxisPrior prior) {
     if (plane.id == object->plane_id) up = plane.normal;
   FitConfig config;
   config.axis_prior = prior;
+  config.normal_search = normals;
   auto fit = fit_object(cloud, object->indices, config, up);
   EXPECT_TRUE(fit.ok()) << (fit.ok() ? "" : fit.error().message);
   if (!fit.ok()) return out;
   out.points = object->indices.size();
   out.cylinder = fit->cylinder;
+  out.fit = *fit;
   if (out.cylinder) out.tilt_deg = std::acos(std::min(1.0, std::abs(out.cylinder->axis.dot(up)))) * 180.0 / M_PI;
   return out;
 }
@@ -114,6 +117,34 @@ void check(const CanView& can) {
 TEST_F(YcbFitTest, SoupCanFrame3) { check(kSoupFrame3); }
 TEST_F(YcbFitTest, SoupCanFrame1) { check(kSoupFrame1); }
 TEST_F(YcbFitTest, TunaCanFrame4) { check(kTunaFrame4); }
+
+// The grid's k nearest neighbours against PCL's kd-tree (the oracle, exact k-NN) on the real cans:
+// the same points get a normal, the normals agree (angles between them, degrees), and so do the
+// refined cylinders.
+TEST_F(YcbFitTest, GridNormalsAgreeWithTheKdTreeOracle) {
+  for (const CanView* can : {&kSoupFrame3, &kSoupFrame1, &kTunaFrame4}) {
+    SCOPED_TRACE(can->frame);
+    const Outcome grid = fit_can(*can, AxisPrior::kUpright, NormalSearch::kGrid);
+    const Outcome kd = fit_can(*can, AxisPrior::kUpright, NormalSearch::kKdTree);
+    ASSERT_TRUE(grid.fit && kd.fit && grid.cylinder && kd.cylinder);
+    ASSERT_EQ(grid.fit->sample_points.size(), kd.fit->sample_points.size());
+    std::vector<double> angles;
+    for (std::size_t i = 0; i < grid.fit->sample_points.size(); ++i) {
+      ASSERT_EQ(grid.fit->sample_points[i], kd.fit->sample_points[i]);
+      angles.push_back(std::acos(std::min(1.0, grid.fit->sample_normals[i].dot(kd.fit->sample_normals[i]))) * 180.0 / M_PI);
+    }
+    std::sort(angles.begin(), angles.end());
+    const double median = angles[angles.size() / 2], p99 = angles[angles.size() * 99 / 100];
+    std::printf("%s: %zu normals, angle to the kd-tree's: median %.3f deg, 99th percentile %.3f deg, max %.1f deg; "
+                "radius %.2f mm (kd-tree %.2f mm)\n",
+                can->frame, angles.size(), median, p99, angles.back(), grid.cylinder->radius_m * 1000, kd.cylinder->radius_m * 1000);
+    // Measured: median 0.000 on all three (the same neighbours), 99th percentile up to 1.6 degrees
+    // (frame 1: ties at the k-th neighbour, PCL's float covariance), radii within 0.01 mm.
+    EXPECT_LT(median, 0.01);
+    EXPECT_LT(p99, 2.0);
+    EXPECT_NEAR(grid.cylinder->radius_m, kd.cylinder->radius_m, 0.0001);
+  }
+}
 
 }  // namespace
 }  // namespace scenewatch::ontology

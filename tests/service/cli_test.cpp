@@ -203,6 +203,9 @@ TEST_F(CliTest, ClassesAndDefineClass) {
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.out.find("6 classes"), std::string::npos) << result.out;
   EXPECT_NE(result.out.find("kettle: cylinder, radius 60..120 mm"), std::string::npos) << result.out;
+  // Allowed motions say where they come from (nothing handled yet: only the defined ones).
+  EXPECT_NE(result.out.find("rim (rim); motions x y z yaw (defined)\n"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find("; motions none defined\n"), std::string::npos) << result.out;  // kettle
   // Without the token file: refused.
   result = cli({"define-class", (tmp_ / "kettle.yaml").string(), "--port", std::to_string(daemon_.port()), "--token-file",
                 (tmp_ / "no-token").string()});

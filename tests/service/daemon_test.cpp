@@ -13,6 +13,7 @@
 #include "daemon_harness.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/io/sequence.h"
+#include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/sim/simulator.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/service/frame_parser.h"
@@ -314,6 +315,85 @@ TEST_F(DaemonTest, SimulatedChangesReachTheSubscriberOnceEach) {
     ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
     std::error_code ec;
     fs::remove_all(model_dir_, ec);  // the next case starts from an empty model
+  }
+}
+
+// Issue 13's persistence through the daemon: the simulator's hand_picks_cup_upright (320x240, all
+// its frames: a hand lifts the cup, carries it and turns it about its axis, puts it down) streamed
+// over TCP. Describing the objects records them as instances in MODEL_DIR/ontology.sqlite, and the
+// handled cup teaches the cup class its motions (free x y z yaw, frozen roll pitch), which
+// ListClasses shows beside the defined ones and a restarted daemon still knows.
+TEST_F(DaemonTest, HandledObjectsTeachTheirClassMotionsThatSurviveARestart) {
+  auto loaded = sim::load_scenario(source_dir() / "sample_clouds/scenarios/hand_picks_cup_upright.yaml");
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  const sim::Scenario scenario = sim::with_resolution(*loaded, 320, 240);
+  auto simulator = sim::Simulator::create(scenario);
+  ASSERT_TRUE(simulator.ok()) << simulator.error().message;
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+  Client client = daemon_.connect();
+  double stamp = 0;
+  for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
+    for (int f = 0; f < simulator->frame_count(phase); ++f) {
+      auto frame = sim::as_frame(simulator->render(phase, f), simulator->scenario().intrinsics, stamp += 1.0 / 30);
+      ASSERT_TRUE(frame.ok());
+      proto::Request r;
+      *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+      ASSERT_EQ(call(client, r).status().code(), proto::Status::OK);
+    }
+  }
+  const auto described = call(client, request([](proto::Request& r) { r.mutable_get_objects()->set_describe(true); }));
+  ASSERT_EQ(described.status().code(), proto::Status::OK) << described.status().message();
+  const proto::Object* cup = nullptr;
+  for (const auto& o : described.objects().objects())
+    if (o.foreground()) cup = &o;
+  ASSERT_NE(cup, nullptr) << "the cup was promoted to the foreground";
+  ASSERT_EQ(cup->ontology().class_name(), "cup");
+  ASSERT_EQ(std::vector<std::string>(cup->free_dofs().begin(), cup->free_dofs().end()),
+            (std::vector<std::string>{"x", "y", "z", "yaw"}));
+  // Asked again at once: the cached description, no second instance.
+  ASSERT_EQ(call(client, request([](proto::Request& r) { r.mutable_get_objects()->set_describe(true); })).status().code(),
+            proto::Status::OK);
+
+  // The class as defined allows fewer motions than were learnt: ListClasses says which is which.
+  proto::Request define;
+  define.mutable_define_class()->set_yaml(
+      "classes:\n  - {name: cup, shape: frustum, radius_m: [0.025, 0.07], height_m: [0.04, 0.18], taper_deg: [-5, 15],"
+      " top: open, max_rms_m: 0.005, min_explained: 0.4, allowed_dofs: [z]}\n");
+  ASSERT_EQ(call(client, define).status().code(), proto::Status::OK);
+  auto cup_class = [](const proto::Response& listed) {
+    proto::ObjectClass found;
+    for (const auto& c : listed.list_classes().classes())
+      if (c.name() == "cup") found = c;
+    return found;
+  };
+  auto strings = [](const google::protobuf::RepeatedPtrField<std::string>& field) {
+    return std::vector<std::string>(field.begin(), field.end());
+  };
+  const auto list = request([](proto::Request& r) { r.mutable_list_classes(); });
+  for (int run = 0; run < 2; ++run) {
+    SCOPED_TRACE(run == 0 ? "before the restart" : "after the restart");
+    const proto::ObjectClass c = cup_class(call(client, list));
+    EXPECT_EQ(strings(c.defined_dofs()), (std::vector<std::string>{"z"}));
+    EXPECT_EQ(strings(c.learnt_free_dofs()), (std::vector<std::string>{"x", "y", "z", "yaw"}));
+    EXPECT_EQ(strings(c.learnt_frozen_dofs()), (std::vector<std::string>{"roll", "pitch"}));
+    EXPECT_EQ(strings(c.allowed_dofs()), (std::vector<std::string>{"x", "y", "z", "yaw"}));
+    if (run == 1) break;
+    ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
+    {  // Every object described once (the second GetObjects used the cache), the cup among them.
+      auto store = ontology::ClassStore::open(model_dir_ / ontology::kClassStoreFile);
+      ASSERT_TRUE(store.ok()) << store.error().message;
+      auto instances = store->instances();
+      ASSERT_TRUE(instances.ok()) << instances.error().message;
+      const auto with_class = std::count_if(described.objects().objects().begin(), described.objects().objects().end(),
+                                            [](const proto::Object& o) { return !o.ontology().class_name().empty(); });
+      EXPECT_EQ(instances->size(), static_cast<std::size_t>(with_class));
+      auto cups = store->instances("cup");
+      ASSERT_TRUE(cups.ok());
+      ASSERT_GE(cups->size(), 1u);
+      EXPECT_NE(cups->back().parameters_json.find("\"radius_m\""), std::string::npos) << cups->back().parameters_json;
+    }
+    ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+    client = daemon_.connect();
   }
 }
 

@@ -64,8 +64,10 @@ Result<ObjectFit> fit_object(const Cloud& cloud, const std::vector<int>& indices
   for (std::size_t i = 0; i < valid.size(); i += stride) used.push_back(valid[i]);
 
   auto t0 = Clock::now();
-  const std::vector<Eigen::Vector3d> all_normals =
-      detail::estimate_normals(cloud, used, std::min<int>(config.normal_neighbours, static_cast<int>(used.size()) - 1), sensor_origin);
+  const int k = std::min<int>(config.normal_neighbours, static_cast<int>(used.size()) - 1);
+  const std::vector<Eigen::Vector3d> all_normals = config.normal_search == NormalSearch::kGrid
+                                                       ? detail::estimate_normals(cloud, used, k, sensor_origin)
+                                                       : detail::estimate_normals_kdtree(cloud, used, k, sensor_origin);
   std::vector<int> kept;  // cloud indices of points with a normal
   std::vector<Eigen::Vector3d> points, normals;
   for (std::size_t i = 0; i < used.size(); ++i) {

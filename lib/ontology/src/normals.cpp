@@ -1,18 +1,168 @@
-// PCL's NormalEstimation rather than CGAL's jet or PCA estimation: PCL ships it precompiled for
-// our point type (no template instantiation on the 2-core machine, CGAL stays in one translation
-// unit), and it orients normals towards the viewpoint, which a single view knows exactly.
+// Normals by PCA of k nearest neighbours. The kd-tree version is PCL's NormalEstimation (precompiled
+// for our point type, orients normals towards the viewpoint, which a single view knows exactly).
+// The default finds the neighbours in a hash grid instead: on objects of about 5000 points, PCL's
+// k-NN queries (FLANN) took most of the fit's time.
 #include "normals.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <numeric>
+#include <unordered_map>
 
+#include <Eigen/Eigenvalues>
 #include <pcl/features/normal_3d.h>
 #include <pcl/search/kdtree.h>
 
 namespace scenewatch::ontology::detail {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+/// Rings of cells searched around a point before it is compared with every point.
+constexpr int kMaxRings = 4;
+
+/// A cell's key: 21 bits per coordinate (cells of a few mm span kilometres).
+std::uint64_t cell_key(const Eigen::Vector3i& c) {
+  constexpr std::int64_t kOffset = 1 << 20;
+  const auto part = [](int v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(v) + kOffset) & 0x1fffff; };
+  return part(c.x()) | (part(c.y()) << 21) | (part(c.z()) << 42);
+}
+
+/// The 90th percentile over a sample of up to 32 points of the distance to their k-th nearest
+/// neighbour (brute force: 32 x n distances): a cell that wide holds the k nearest of 9 in 10
+/// points within the 27 cells around them.
+double typical_kth_distance(const std::vector<Eigen::Vector3d>& p, int k) {
+  const std::size_t n = p.size();
+  const std::size_t step = std::max<std::size_t>(1, n / 32);
+  std::vector<double> d2(n), kth;
+  for (std::size_t i = 0; i < n; i += step) {
+    for (std::size_t j = 0; j < n; ++j) d2[j] = (p[j] - p[i]).squaredNorm();
+    // Index k: the point itself is the nearest (0), its k-th neighbour the (k+1)-th smallest.
+    std::nth_element(d2.begin(), d2.begin() + k, d2.end());
+    kth.push_back(std::sqrt(d2[static_cast<std::size_t>(k)]));
+  }
+  const std::size_t at = kth.size() * 9 / 10;
+  std::nth_element(kth.begin(), kth.begin() + static_cast<std::ptrdiff_t>(at), kth.end());
+  return kth[at];
+}
+
+}  // namespace
 
 std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vector<int>& indices, int k,
                                               const Eigen::Vector3d& sensor_origin) {
+  const std::size_t n = indices.size();
+  std::vector<Eigen::Vector3d> out(n, Eigen::Vector3d::Constant(kNaN));
+  if (k < 3 || n < static_cast<std::size_t>(k) + 1) return out;
+  std::vector<Eigen::Vector3d> p(n);
+  for (std::size_t i = 0; i < n; ++i) p[i] = cloud.points[static_cast<std::size_t>(indices[i])].getVector3fMap().cast<double>();
+
+  const double cell = typical_kth_distance(p, k);
+  if (!(cell > 0)) return out;  // all points in one spot
+  // The grid: points sorted by cell, and each cell's range in that order.
+  std::vector<Eigen::Vector3i> cell_of(n);
+  std::vector<std::uint64_t> key(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    cell_of[i] = (p[i] / cell).array().floor().cast<int>();
+    key[i] = cell_key(cell_of[i]);
+  }
+  std::vector<std::uint32_t> order(n);
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key[a] < key[b]; });
+  std::unordered_map<std::uint64_t, std::pair<std::uint32_t, std::uint32_t>> cells;
+  cells.reserve(n);
+  for (std::uint32_t s = 0; s < n;) {
+    std::uint32_t e = s;
+    while (e < n && key[order[e]] == key[order[s]]) ++e;
+    cells.emplace(key[order[s]], std::make_pair(s, e));
+    s = e;
+  }
+
+  std::vector<std::pair<double, std::uint32_t>> candidates;
+  std::vector<std::uint32_t> block;  // the points of the 27 cells around one cell
+  candidates.reserve(512);
+  block.reserve(512);
+  const std::size_t want = std::min<std::size_t>(n, static_cast<std::size_t>(k));  // the point and k - 1 others, as PCL counts
+  // Finds the k nearest of point i into candidates[0, want) by rings of cells around its cell:
+  // after ring r every point within r cells' width is a candidate, so the k nearest are exact once
+  // the k-th candidate is that near (an outlier far from all others is compared with every point).
+  const auto search_rings = [&](std::size_t i) {
+    candidates.clear();
+    for (int ring = 1;; ++ring) {
+      for (int dx = -ring; dx <= ring; ++dx)
+        for (int dy = -ring; dy <= ring; ++dy)
+          for (int dz = -ring; dz <= ring; ++dz) {
+            if (ring > 1 && std::max({std::abs(dx), std::abs(dy), std::abs(dz)}) != ring) continue;  // inner rings done
+            const auto found = cells.find(cell_key(cell_of[i] + Eigen::Vector3i(dx, dy, dz)));
+            if (found == cells.end()) continue;
+            for (std::uint32_t s = found->second.first; s < found->second.second; ++s)
+              candidates.emplace_back((p[order[s]] - p[i]).squaredNorm(), order[s]);
+          }
+      if (ring == kMaxRings) {
+        candidates.clear();
+        for (std::uint32_t j = 0; j < n; ++j) candidates.emplace_back((p[j] - p[i]).squaredNorm(), j);
+      }
+      if (candidates.size() < want) continue;
+      std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(want - 1), candidates.end());
+      const double reach = ring * cell;
+      if (candidates[want - 1].first <= reach * reach || ring >= kMaxRings) return;
+    }
+  };
+  // Cell by cell: the 27 cells around a cell are looked up once for all of its points; a point
+  // whose k-th nearest among them lies beyond one cell's width searches further on its own.
+  for (const auto& [cell_key_value, range] : cells) {
+    (void)cell_key_value;
+    const std::size_t first = order[range.first];
+    block.clear();
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const auto found = cells.find(cell_key(cell_of[first] + Eigen::Vector3i(dx, dy, dz)));
+          if (found == cells.end()) continue;
+          for (std::uint32_t s = found->second.first; s < found->second.second; ++s) block.push_back(order[s]);
+        }
+    for (std::uint32_t s = range.first; s < range.second; ++s) {
+      const std::size_t i = order[s];
+      // The block holds every point within `reach` of p[i]: one cell's width plus p[i]'s distance
+      // to the nearest face of its own cell. Only those can be among the k nearest found here:
+      // when there are k of them, the k nearest of those are exact; else the rings decide.
+      const Eigen::Vector3d offset = p[i] / cell - cell_of[i].cast<double>();  // in [0, 1) per axis
+      const double reach = cell * (1.0 + std::min(offset.minCoeff(), 1.0 - offset.maxCoeff()));
+      candidates.clear();
+      for (const std::uint32_t j : block) {
+        const double d2 = (p[j] - p[i]).squaredNorm();
+        if (d2 <= reach * reach) candidates.emplace_back(d2, j);
+      }
+      if (candidates.size() >= want) {
+        std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(want - 1), candidates.end());
+      } else {
+        search_rings(i);
+      }
+      // The covariance from sums relative to p[i], in one pass.
+      const std::size_t count = std::min(candidates.size(), want);
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      Eigen::Matrix3d squares = Eigen::Matrix3d::Zero();
+      for (std::size_t j = 0; j < count; ++j) {
+        const Eigen::Vector3d d = p[candidates[j].second] - p[i];
+        sum += d;
+        squares.noalias() += d * d.transpose();
+      }
+      if (count < 3) continue;
+      const Eigen::Matrix3d covariance = squares - sum * sum.transpose() / static_cast<double>(count);
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+      solver.computeDirect(covariance);
+      Eigen::Vector3d normal = solver.eigenvectors().col(0);  // smallest eigenvalue first
+      if (!normal.allFinite() || normal.norm() < 0.5) continue;
+      normal.normalize();
+      if (normal.dot(sensor_origin - p[i]) < 0) normal = -normal;
+      out[i] = normal;
+    }
+  }
+  return out;
+}
+
+std::vector<Eigen::Vector3d> estimate_normals_kdtree(const Cloud& cloud, const std::vector<int>& indices, int k,
+                                                     const Eigen::Vector3d& sensor_origin) {
   // A copy of the object's points: with setIndices on the whole cloud, PCL builds its search tree
   // over every point of the frame (33 ms for VGA) and takes neighbours from other objects.
   auto object = std::make_shared<Cloud>();
@@ -30,7 +180,7 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
   pcl::PointCloud<pcl::Normal> normals;
   estimation.compute(normals);
 
-  std::vector<Eigen::Vector3d> out(indices.size(), Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN()));
+  std::vector<Eigen::Vector3d> out(indices.size(), Eigen::Vector3d::Constant(kNaN));
   for (std::size_t i = 0; i < normals.size() && i < out.size(); ++i) {
     const Eigen::Vector3d n = normals[i].getNormalVector3fMap().cast<double>();
     if (n.allFinite() && n.norm() > 0.5) out[i] = n.normalized();

@@ -23,11 +23,14 @@ Result<background::Keyframe> as_image(const Frame& frame) {
 AppearanceStage::AppearanceStage(const background::AppearanceConfig& appearance, const surprise::SurpriseConfig& surprise)
     : appearance_config_(appearance), config_(surprise), kernel_(surprise.prior, surprise.min_samples), memory_(appearance) {}
 
-Result<std::shared_ptr<SurpriseResult>> AppearanceStage::compute(const Frame& frame, const background::Keyframe& observed) const {
+Result<std::shared_ptr<SurpriseResult>> AppearanceStage::compute(const Frame& frame, const background::Keyframe& observed,
+                                                                 const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known) const {
   const auto t0 = Clock::now();
   const Pose pose = frame.pose_or_identity();
   auto result = std::make_shared<SurpriseResult>();
-  const surprise::ExpectedView view = surprise::render_expected_view(memory_, pose, *frame.intrinsics, config_.view);
+  surprise::ExpectedView view = surprise::render_expected_view(memory_, pose, *frame.intrinsics, config_.view);
+  // Described objects' completed surfaces: their sides the keyframes never saw (issue 13).
+  for (const auto& surface : known) result->known_surface_pixels += surprise::splat_surface(view, *surface, config_.view.depth_tolerance_m);
   auto map = surprise::compute_surprise(view, observed.color, kernel_, &config_.robust);
   if (!map) return map.error();
   for (const auto& region : surprise::find_regions(*map, view, &observed.depth, config_.regions)) {
@@ -55,7 +58,8 @@ bool AppearanceStage::familiar(const Pose& T_world_camera) const {
   return false;
 }
 
-std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& frame) {
+std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& frame,
+                                                              const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known) {
   if (!appearance_config_.enabled && !config_.enabled) return nullptr;
   // Without a pose the camera frame would be taken as the world: keyframes from a moving camera
   // would then be placed wrongly, so only posed frames take part.
@@ -66,7 +70,7 @@ std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& fram
   {
     std::shared_lock<std::shared_mutex> read(mutex_);
     if (config_.enabled && memory_.size() > 0) {
-      auto computed = compute(frame, *observed);
+      auto computed = compute(frame, *observed, known);
       if (computed) {
         (*computed)->familiar_view = familiar(observed->T_world_camera);
         result = std::move(*computed);

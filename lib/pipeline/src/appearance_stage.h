@@ -19,9 +19,10 @@ class AppearanceStage {
   AppearanceStage(const background::AppearanceConfig& appearance, const surprise::SurpriseConfig& surprise);
 
   /// A frame with a pose, intrinsics and an organized colour cloud: its surprise against the
-  /// memory (when the memory has keyframes), then the keyframe update. Other frames are skipped
-  /// (null result). Events come without ids.
-  std::shared_ptr<const SurpriseResult> process(const Frame& frame);
+  /// memory (when the memory has keyframes; the expected view with the `known` surfaces splatted
+  /// in), then the keyframe update. Other frames are skipped (null result). Events come without ids.
+  std::shared_ptr<const SurpriseResult> process(const Frame& frame,
+                                                const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known = {});
 
   /// The surprise of an observation against the memory; nothing changes.
   Result<std::shared_ptr<const SurpriseResult>> evaluate(const Frame& observation) const;
@@ -37,7 +38,8 @@ class AppearanceStage {
   std::size_t memory_bytes() const;
 
  private:
-  Result<std::shared_ptr<SurpriseResult>> compute(const Frame& frame, const background::Keyframe& observed) const;
+  Result<std::shared_ptr<SurpriseResult>> compute(const Frame& frame, const background::Keyframe& observed,
+                                                  const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known = {}) const;
   /// A keyframe within twice the keyframe spacing, taken at least familiar_after_frames before.
   /// The caller holds mutex_.
   bool familiar(const Pose& T_world_camera) const;

@@ -175,6 +175,34 @@ struct WorkingMemory::Impl {
 
   std::shared_ptr<const SceneSnapshot> snapshot;  // read and written with std::atomic_load/store
 
+  // Known surfaces of described objects (set_known_surface), by object id.
+  struct Known {
+    Eigen::Vector3d centroid_world;
+    std::shared_ptr<const surprise::KnownSurface> surface;
+  };
+  std::mutex known_mutex;
+  std::map<std::uint64_t, Known> known;
+
+  /// The known surfaces of objects still in the last snapshot within 2 cm of where they were
+  /// described; the others are forgotten.
+  std::vector<std::shared_ptr<const surprise::KnownSurface>> current_known_surfaces() {
+    constexpr double kMovedM = 0.02;
+    const auto scene = std::atomic_load(&snapshot);
+    std::lock_guard<std::mutex> lock(known_mutex);
+    std::vector<std::shared_ptr<const surprise::KnownSurface>> out;
+    for (auto it = known.begin(); it != known.end();) {
+      const auto object = std::find_if(scene->objects.begin(), scene->objects.end(),
+                                       [&](const TrackedObject& o) { return o.id == it->first; });
+      if (object == scene->objects.end() || (object->cluster.centroid - it->second.centroid_world).norm() > kMovedM) {
+        it = known.erase(it);
+        continue;
+      }
+      out.push_back(it->second.surface);
+      ++it;
+    }
+    return out;
+  }
+
   mutable std::mutex events_mutex;
   std::deque<Event> events;
   std::uint64_t next_event_id = 1;
@@ -350,10 +378,11 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   // frame: the image surprise (keyframes and mesh), the geometric change detection with the map
   // update (the octree), and the segmentation of the frame (this thread). None reads what another
   // writes; the tracker and the event fusion below need all three.
+  const auto known_surfaces = m.current_known_surfaces();
   const auto t_parallel = Clock::now();
   auto surprise = std::async(std::launch::async, [&] {
     const auto t_surprise = Clock::now();
-    result.surprise = m.appearance.process(seen);  // then its keyframe update
+    result.surprise = m.appearance.process(seen, known_surfaces);  // then its keyframe update
     result.surprise_ms = ms_since(t_surprise);
   });
   auto map_update = std::async(std::launch::async, [&] { return m.update_map(seen, T, config_, result); });
@@ -482,6 +511,10 @@ void WorkingMemory::reset() {
     impl_->map.reset();
   }
   impl_->appearance.reset();
+  {
+    std::lock_guard<std::mutex> known_lock(impl_->known_mutex);
+    impl_->known.clear();
+  }
   impl_->tracker.reset();
   impl_->changes.reset();
   impl_->fusion.reset();
@@ -737,5 +770,14 @@ Result<std::shared_ptr<const SurpriseResult>> WorkingMemory::surprise(const Fram
 std::shared_ptr<const SurpriseResult> WorkingMemory::last_surprise() const { return impl_->appearance.last(); }
 
 Status WorkingMemory::write_mesh(const fs::path& path) const { return impl_->appearance.write_mesh(path); }
+
+void WorkingMemory::set_known_surface(std::uint64_t object_id, const Eigen::Vector3d& centroid_world, surprise::KnownSurface surface) {
+  std::lock_guard<std::mutex> lock(impl_->known_mutex);
+  if (surface.points_world.empty()) {
+    impl_->known.erase(object_id);
+    return;
+  }
+  impl_->known[object_id] = {centroid_world, std::make_shared<const surprise::KnownSurface>(std::move(surface))};
+}
 
 }  // namespace scenewatch::pipeline

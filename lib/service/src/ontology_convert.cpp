@@ -1,5 +1,7 @@
 #include "ontology_convert.h"
 
+#include <algorithm>
+
 #include "proto_convert.h"
 
 namespace scenewatch::service::convert {
@@ -12,7 +14,7 @@ void to_proto(const ontology::Range& r, proto::Range* out) {
 
 }  // namespace
 
-void to_proto(const ontology::ObjectClass& c, proto::ObjectClass* out) {
+void to_proto(const ontology::ObjectClass& c, const ontology::LearntMotions* learnt, proto::ObjectClass* out) {
   out->set_name(c.name);
   out->set_shape(ontology::to_string(c.shape));
   if (c.shape != ontology::ClassShape::kBox) to_proto(c.radius_m, out->mutable_radius_m());
@@ -31,7 +33,16 @@ void to_proto(const ontology::ObjectClass& c, proto::ObjectClass* out) {
     p->set_kind(ontology::to_string(g.kind));
     p->set_height_fraction(g.height_fraction);
   }
-  for (const auto& d : c.allowed_dofs) out->add_allowed_dofs(d);
+  for (const auto& d : c.allowed_dofs) out->add_defined_dofs(d);
+  for (int k = 0; k < kDofCount; ++k) {
+    const std::string dof = to_string(static_cast<Dof>(k));
+    const bool defined = std::find(c.allowed_dofs.begin(), c.allowed_dofs.end(), dof) != c.allowed_dofs.end();
+    if (defined || (learnt && learnt->free[static_cast<std::size_t>(k)])) out->add_allowed_dofs(dof);
+  }
+  if (learnt) {
+    for (const auto& d : learnt->names(true)) out->add_learnt_free_dofs(d);
+    for (const auto& d : learnt->names(false)) out->add_learnt_frozen_dofs(d);
+  }
   out->set_description(c.description);
 }
 

@@ -9,6 +9,8 @@
 #include <mutex>
 #include <optional>
 
+#include <google/protobuf/util/json_util.h>
+
 #include "live_frame.h"
 #include "ontology_convert.h"
 #include "scenewatch/ontology/describe.h"
@@ -411,8 +413,7 @@ struct RequestHandler::Impl {
     auto& cached = described[id];
     const bool fresh = cached.points == points->second.get() || now - cached.at_s < kDescribeAgainS;
     if (!fresh || !cached.info) {
-      ontology::DescribeConfig dc;
-      dc.completion_spacing_m = 0;  // no completed surface on the wire
+      ontology::DescribeConfig dc;  // the completed surface goes to the expected view, not on the wire
       // Up is the normal of the plane the object stands on, turned towards the camera.
       Eigen::Vector3d up = snapshot.up_world;
       for (const auto& plane : snapshot.planes) {
@@ -425,8 +426,34 @@ struct RequestHandler::Impl {
       else cached.info->set_class_name(ontology::kUnknownClass);
       cached.points = points->second.get();
       cached.at_s = now;
+      record(object, *cached.info);
+      // The completed primitive predicts the object's unseen side in later frames' expected view
+      // (none for unknown objects: that removes an earlier one).
+      surprise::KnownSurface surface;
+      if (d) surface.points_world = std::move(d->completed_points);
+      surface.spacing_m = dc.completion_spacing_m;
+      surface.rgb = object.cluster.mean_rgb;
+      memory.set_known_surface(id, object.cluster.centroid, std::move(surface));
     }
     *out = *cached.info;
+  }
+
+  // Each new description is an instance seen (class, the fitted primitive as JSON, when the object
+  // was last seen); a handled object's learnt free DoFs also teach its class's motions. The catalog
+  // queues the writes for its own thread: nothing here waits for the disk.
+  void record(const TrackedObject& object, const proto::ObjectClassInfo& info) {
+    ontology::InstanceRecord instance;
+    instance.class_name = info.class_name();
+    instance.time_s = object.last_seen_s;
+    google::protobuf::util::JsonPrintOptions options;
+    options.preserve_proto_field_names = true;
+    if (info.has_primitive() && !google::protobuf::util::MessageToJsonString(info.primitive(), &instance.parameters_json, options).ok()) {
+      instance.parameters_json.clear();
+    }
+    if (instance.parameters_json.empty()) instance.parameters_json = "{}";
+    std::optional<DofFlags> handled_free;
+    if (object.foreground && !object.foreground->handlings.empty()) handled_free = object.foreground->free;
+    config.classes->record(instance, handled_free);
   }
 
   Status get_hands(proto::Response& response) {
@@ -540,7 +567,11 @@ struct RequestHandler::Impl {
     if (Status s = require_classes(); !s) return s;
     const ontology::ClassLibrary library = config.classes->library();
     auto* out = response.mutable_list_classes();
-    for (const auto& c : library.classes()) convert::to_proto(c, out->add_classes());
+    const auto learnt = config.classes->learnt();
+    for (const auto& c : library.classes()) {
+      const auto found = learnt.find(c.name);
+      convert::to_proto(c, found == learnt.end() ? nullptr : &found->second, out->add_classes());
+    }
     out->set_yaml(ontology::to_yaml(library.classes()));
     return {};
   }

@@ -244,4 +244,45 @@ ColorImage expected_color(const ExpectedView& view) {
   return img;
 }
 
+std::size_t splat_surface(ExpectedView& view, const KnownSurface& surface, double tolerance_m) {
+  if (view.width <= 0 || view.height <= 0 || !(surface.spacing_m > 0) || view.depth_m.size() != view.pixel_count() ||
+      view.count.size() != view.pixel_count())
+    return 0;
+  const Pose T_camera_world = view.T_world_camera.inverse();
+  const Intrinsics& K = view.intrinsics;
+  float opponent[kChannels];
+  to_opponent(static_cast<std::uint8_t>(std::clamp(surface.rgb.x(), 0.0f, 255.0f)),
+              static_cast<std::uint8_t>(std::clamp(surface.rgb.y(), 0.0f, 255.0f)),
+              static_cast<std::uint8_t>(std::clamp(surface.rgb.z(), 0.0f, 255.0f)), opponent);
+  // The splat's depth first (nearest point per pixel), then what it changes.
+  std::vector<float> splat(view.pixel_count(), 0.0f);
+  for (const Eigen::Vector3d& p_world : surface.points_world) {
+    const Eigen::Vector3d p = T_camera_world * p_world;
+    if (!(p.z() > 0.05)) continue;
+    const double u = K.fx * p.x() / p.z() + K.cx, v = K.fy * p.y() / p.z() + K.cy;
+    const int half = std::max(0, static_cast<int>(std::ceil(0.5 * surface.spacing_m * K.fx / p.z())));
+    const int u0 = static_cast<int>(std::floor(u)), v0 = static_cast<int>(std::floor(v));
+    for (int y = std::max(0, v0 - half); y <= std::min(view.height - 1, v0 + half); ++y)
+      for (int x = std::max(0, u0 - half); x <= std::min(view.width - 1, u0 + half); ++x) {
+        float& z = splat[static_cast<std::size_t>(y) * view.width + x];
+        if (z <= 0.0f || p.z() < z) z = static_cast<float>(p.z());
+      }
+  }
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < splat.size(); ++i) {
+    const float z = splat[i];
+    if (z <= 0.0f) continue;
+    const float expected = view.depth_m[i];
+    if (expected > 0.0f && z >= expected - static_cast<float>(tolerance_m)) continue;
+    view.depth_m[i] = z;
+    view.count[i] = 1;
+    for (int c = 0; c < kChannels; ++c) {
+      view.mean[static_cast<std::size_t>(c)][i] = opponent[c];
+      view.ssd[static_cast<std::size_t>(c)][i] = 0.0f;
+    }
+    ++changed;
+  }
+  return changed;
+}
+
 }  // namespace scenewatch::surprise

@@ -20,8 +20,15 @@ enum class AxisPrior {
              ///< detected cylinder, an upright one is started from a circle fit of the side points
 };
 
+/// How the k nearest neighbours of the normal estimation are found.
+enum class NormalSearch {
+  kGrid,    ///< a hash grid sized to the points' typical k-th neighbour distance (about 10x faster)
+  kKdTree,  ///< PCL's NormalEstimation over a kd-tree: the former estimate, the benchmark's baseline
+};
+
 struct FitConfig {
   int normal_neighbours = 24;        ///< k nearest neighbours of the normal estimation
+  NormalSearch normal_search = NormalSearch::kGrid;
   /// Objects with more valid points are subsampled (every n-th point) to about this many for the
   /// normals, the shape detection and the refinement (fit time stays bounded).
   int max_points = 6000;

@@ -55,6 +55,9 @@ struct SurpriseResult {
   /// report a change (a view seen for the first time differs in ways that are not change:
   /// reflections, transparency, what was hidden before).
   bool familiar_view = false;
+  /// Pixels of the expected view that described objects' completed surfaces set (nearer than the
+  /// mesh or where it had none; WorkingMemory::set_known_surface).
+  std::size_t known_surface_pixels = 0;
   Pose T_world_camera = Pose::Identity();
   Intrinsics intrinsics;
   double stamp_s = 0.0;
@@ -189,6 +192,14 @@ class WorkingMemory {
   std::shared_ptr<const SurpriseResult> last_surprise() const;
   /// Writes the background's textured mesh as PLY. kNotFound before any keyframe.
   Status write_mesh(const std::filesystem::path& path) const;
+
+  /// A surface of an object that the mesh may lack (the ontology's completed primitive of a
+  /// described object, world frame): the expected view of the frames processed from now on
+  /// includes it (surprise::splat_surface), so the object's unseen side is predicted when a new
+  /// view shows it. Kept while the object is in the scene within 2 cm of `centroid_world` (where
+  /// it was when described); a newer surface of the same object replaces it, an empty one removes
+  /// it. Not saved with the model. Thread safe.
+  void set_known_surface(std::uint64_t object_id, const Eigen::Vector3d& centroid_world, surprise::KnownSurface surface);
 
   const Config& config() const { return config_; }
 

@@ -55,6 +55,21 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
                                   const Pose& T_world_camera, const Intrinsics& intrinsics,
                                   const ExpectedViewConfig& config = {});
 
+/// A surface the mesh may lack, in the world frame: a described object's completed primitive
+/// (issue 13: its whole surface, the side never seen included), which predicts that object when it
+/// is seen from a new side.
+struct KnownSurface {
+  std::vector<Eigen::Vector3d> points_world;
+  double spacing_m = 0.004;                       ///< between neighbouring points
+  Eigen::Vector3f rgb = Eigen::Vector3f::Zero();  ///< 0..255, the object's mean colour
+};
+
+/// Splats `surface` into `view` as a z-buffer: each point covers the pixels of a square of
+/// spacing_m at its depth; where it is nearer than the expected depth by more than tolerance_m, or
+/// the mesh has no surface there, it becomes the expected depth, and its colour the pixel's only
+/// sample (the mesh's samples there belong to a surface it now hides). Returns the pixels changed.
+std::size_t splat_surface(ExpectedView& view, const KnownSurface& surface, double tolerance_m = 0.01);
+
 /// The virtual image: the mean colour per pixel (the seed's Fig. 4.4 right); black where no sample.
 ColorImage expected_color(const ExpectedView& view);
 
