@@ -183,6 +183,7 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("promote_translation_m", f.promote_translation_m); },
                            [&] { return s.read("promote_rotation_deg", f.promote_rotation_deg); },
                            [&] { return s.read("vacated_fraction", f.vacated_fraction); },
+                           [&] { return s.read("promote_lift_m", f.promote_lift_m); },
                            [&] { return s.read("touch_timeout_frames", f.touch_timeout_frames); },
                            [&] { return s.read("release_frames", f.release_frames); },
                            [&] { return s.read("dof_translation_m", f.dof.translation_m); },
