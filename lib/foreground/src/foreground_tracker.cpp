@@ -7,6 +7,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "point_model.h"
 #include "skin_model.h"
 #include "voxel_set.h"
 
@@ -196,7 +197,12 @@ bool mostly_skin(const Cloud& cloud, const std::vector<int>& indices) {
 }  // namespace
 
 struct ForegroundTracker::Impl {
-  explicit Impl(ForegroundConfig c) : config(std::move(c)) {}
+  explicit Impl(ForegroundConfig c) : config(std::move(c)) {
+    growth.voxel_m = config.model_voxel_m;
+    growth.max_points = config.max_model_points;
+    growth.max_rmse_m = config.grow_max_rmse_m;
+    growth.min_inlier_fraction = config.grow_min_inlier_fraction;
+  }
 
   struct Object {
     std::uint64_t id = 0;
@@ -221,6 +227,7 @@ struct ForegroundTracker::Impl {
   };
 
   ForegroundConfig config;
+  ModelGrowth growth;
   std::vector<Object> objects;  // candidates and foreground objects, in the order first touched
   std::map<std::uint64_t, Eigen::Vector3d> first_seen_at;  // background objects: where they were first seen
   Pose T_support = Pose::Identity();
@@ -481,6 +488,8 @@ Status validate(const ForegroundConfig& c) {
   if (c.release_frames < 1 || c.touch_timeout_frames < 1) return invalid_argument("foreground.release_frames and touch_timeout_frames: must be >= 1");
   if (!positive(c.search_radius_m) || c.search_radius_m > 2) return invalid_argument("foreground.search_radius_m: must be in (0, 2] m");
   if (!positive(c.mask_m) || !positive(c.model_voxel_m) || !positive(c.target_voxel_m)) return invalid_argument("foreground.mask_m, model_voxel_m, target_voxel_m: must be > 0");
+  if (!positive(c.grow_max_rmse_m)) return invalid_argument("foreground.grow_max_rmse_m: must be > 0");
+  if (!(c.grow_min_inlier_fraction >= 0 && c.grow_min_inlier_fraction <= 1)) return invalid_argument("foreground.grow_min_inlier_fraction: must be in [0, 1]");
   if (c.max_model_points < 50) return invalid_argument("foreground.max_model_points: must be >= 50");
   return {};
 }
@@ -512,7 +521,10 @@ std::vector<int> ForegroundTracker::track(const FrameView& f) {
     o.visible = true;
     o.lost_in_hand = false;
     o.pixels = m.pixels_on(o, c);
-    if (o.promoted) pixels.insert(pixels.end(), o.pixels.begin(), o.pixels.end());
+    if (!o.promoted) continue;
+    pixels.insert(pixels.end(), o.pixels.begin(), o.pixels.end());
+    if (m.config.grow_model && worth_merging(r, m.growth))
+      o.model = merged(o.model, *f.cloud, o.pixels, o.T.inverse() * f.T_world_camera, m.growth);
   }
   return pixels;
 }

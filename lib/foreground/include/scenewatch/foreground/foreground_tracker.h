@@ -49,6 +49,13 @@ struct ForegroundConfig {
   double target_voxel_m = 0.005;        ///< registration targets are thinned to one point per voxel
   double model_voxel_m = 0.005;         ///< and so is the model
   std::size_t max_model_points = 4000;
+  /// A foreground object's model grows from its registered views (the frame's points of the
+  /// object, skin left out, one per model_voxel_m voxel, up to max_model_points) when the
+  /// registration's inlier rmse is at most grow_max_rmse_m and it explains at least
+  /// grow_min_inlier_fraction of the model's visible side. false: the model of the first view.
+  bool grow_model = true;
+  double grow_max_rmse_m = 0.005;
+  double grow_min_inlier_fraction = 0.8;
   double mask_m = 0.012;                ///< frame points this close to a registered model are the object's
   double reacquire_radius_m = 0.8;      ///< a lost object is searched for among clusters this close to its last place
 };
