@@ -162,13 +162,13 @@ TEST(ForegroundTrackerTest, AnUprightCarryPromotesTheCupAndFreesXYZAndYawOnly) {
     if (e.kind == EventKind::kObjectPromoted) ++promoted, promoted_at = k;
     if (e.kind == EventKind::kFrozenDofMotion) ++frozen;
   }
-  // Measured with the model grown from the registered views: mean 0.60 cm, worst 1.07 cm (after
-  // the release, as the hand withdraws) and 16.1 degrees over the 83 frames after promotion; with
+  // Measured with the model grown from the registered views: mean 0.60 cm, worst 1.18 cm (after
+  // the release, as the hand withdraws) and 14.0 degrees over the 83 frames after promotion; with
   // the first view's model only (grow_model false): 0.60 cm, 0.85 cm, 18.0 degrees.
   const TrackingError error = report_tracking(o);
   EXPECT_LT(error.mean_cm, 0.7);
-  EXPECT_LT(error.worst_cm, 1.2);
-  EXPECT_LT(error.worst_deg, 18.0);
+  EXPECT_LT(error.worst_cm, 1.3);
+  EXPECT_LT(error.worst_deg, 16.0);
   EXPECT_EQ(promoted, 1u);
   EXPECT_EQ(frozen, 0u);
   // The cup is grasped at frame 35 and lifted from there to frame 50 (the scenario's keys, eased:
@@ -181,7 +181,7 @@ TEST(ForegroundTrackerTest, AnUprightCarryPromotesTheCupAndFreesXYZAndYawOnly) {
   const auto& f = *o.objects[0].foreground;
   // The model grows from the registered views: the sides the 40 degree turn shows join it.
   std::printf("model points: %.0f at promotion, %zu after the carry\n", first_model_points(o), f.model_points);
-  EXPECT_GT(static_cast<double>(f.model_points), 2.0 * first_model_points(o));  // measured 879 -> 2318
+  EXPECT_GT(static_cast<double>(f.model_points), 2.0 * first_model_points(o));  // measured 879 -> 2316
   ASSERT_EQ(f.handlings.size(), 1u);
   const auto free = names(f.free, true);
   std::printf("free DoFs after the carry:");
@@ -201,13 +201,13 @@ TEST(ForegroundTrackerTest, TiltingAnUprightCupRaisesOneFrozenDofMotion) {
     if (e.kind == EventKind::kObjectPromoted) ++promoted, promoted_at = k;
     if (e.kind == EventKind::kFrozenDofMotion) frozen.push_back(e);
   }
-  // Measured with the grown model: mean 0.79 cm, worst 1.35 cm, worst 39.2 degrees over the 170
+  // Measured with the grown model: mean 0.78 cm, worst 1.44 cm, worst 26.3 degrees over the 170
   // frames after promotion (part of the 60 degree tilt is still lost); with the first view's model
   // only: 1.45 cm, 1.85 cm, 62.7 degrees.
   const TrackingError error = report_tracking(o);
   EXPECT_LT(error.mean_cm, 0.9);
-  EXPECT_LT(error.worst_cm, 1.5);
-  EXPECT_LT(error.worst_deg, 45.0);
+  EXPECT_LT(error.worst_cm, 1.6);
+  EXPECT_LT(error.worst_deg, 30.0);
   EXPECT_EQ(promoted, 1u);
   // Grasped at frame 28 and lifted from there (it rises 2.4 mm by frame 29, 19 mm by 31):
   // measured promoted at frame 31 (tracked lift 9.1 mm), the 3 frames.
