@@ -3,6 +3,8 @@
 // registration TU of the module.
 #include "scenewatch/foreground/registration.h"
 
+#include "nearest_search.h"
+
 #include <pcl/console/print.h>
 #include <pcl/search/kdtree.h>
 #include <pcl/registration/correspondence_estimation.h>
@@ -117,7 +119,7 @@ Registration register_model(const Cloud& model, const Cloud& target, const Pose&
     icp.setCorrespondenceEstimation(estimation);
   }
   // One k-d tree of the target serves ICP's correspondences, the spin search and the inlier count.
-  auto tree = std::make_shared<pcl::search::KdTree<PointT>>();
+  auto tree = std::make_shared<NearestSearch>();
   tree->setInputCloud(target_ptr);
   if (config.colour_weight_m <= 0) icp.setSearchMethodTarget(tree, true);
   icp.setMaximumIterations(config.iterations);
