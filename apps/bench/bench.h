@@ -47,5 +47,6 @@ int run_stream(const Options& o);
 int run_pipeline(const Options& o);
 int run_memory(const Options& o);
 int run_fit(const Options& o);
+int run_foreground(const Options& o);
 
 }  // namespace scenewatch::bench

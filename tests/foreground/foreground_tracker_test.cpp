@@ -118,6 +118,13 @@ std::vector<std::string> names(const DofFlags& f, bool value) {
   return out;
 }
 
+// The size of the cup's model when it was promoted (the event's evidence).
+double first_model_points(const Outcome& o) {
+  for (const auto& [k, e] : o.events)
+    if (e.kind == EventKind::kObjectPromoted) return e.evidence.at("model_points");
+  return 0;
+}
+
 struct TrackingError {
   double mean_cm = 0, worst_cm = 0, worst_deg = 0;
 };
@@ -155,20 +162,26 @@ TEST(ForegroundTrackerTest, AnUprightCarryPromotesTheCupAndFreesXYZAndYawOnly) {
     if (e.kind == EventKind::kObjectPromoted) ++promoted, promoted_at = k;
     if (e.kind == EventKind::kFrozenDofMotion) ++frozen;
   }
-  // Measured: mean 0.57 cm, worst 0.80 cm and 14.0 degrees over the 81 frames after promotion.
+  // Measured with the model grown from the registered views: mean 0.60 cm, worst 1.18 cm (after
+  // the release, as the hand withdraws) and 14.0 degrees over the 83 frames after promotion; with
+  // the first view's model only (grow_model false): 0.60 cm, 0.85 cm, 18.0 degrees.
   const TrackingError error = report_tracking(o);
   EXPECT_LT(error.mean_cm, 0.7);
-  EXPECT_LT(error.worst_cm, 1.0);
-  EXPECT_LT(error.worst_deg, 18.0);
+  EXPECT_LT(error.worst_cm, 1.3);
+  EXPECT_LT(error.worst_deg, 16.0);
   EXPECT_EQ(promoted, 1u);
   EXPECT_EQ(frozen, 0u);
-  // The cup is grasped at frame 35 and lifted from there to frame 50 (the scenario's keys):
-  // promoted 5 frames after the lift's start (the issue asks for 3): the 2 cm threshold is
-  // reached at frame 38 and the tracked pose lags the true one by about a frame.
+  // The cup is grasped at frame 35 and lifted from there to frame 50 (the scenario's keys, eased:
+  // it rises 1.5 mm by frame 36, 12.5 mm by 38). Promoted when its tracked lift along the
+  // table's normal exceeds promote_lift_m: measured at frame 38 (tracked lift 9.6 mm), within
+  // the 3 frames the issue allows, and never before the lift starts.
   EXPECT_GE(promoted_at, 36);
-  EXPECT_LE(promoted_at, 40);
+  EXPECT_LE(promoted_at, 38);
   ASSERT_EQ(o.objects.size(), 1u);
   const auto& f = *o.objects[0].foreground;
+  // The model grows from the registered views: the sides the 40 degree turn shows join it.
+  std::printf("model points: %.0f at promotion, %zu after the carry\n", first_model_points(o), f.model_points);
+  EXPECT_GT(static_cast<double>(f.model_points), 2.0 * first_model_points(o));  // measured 879 -> 2316
   ASSERT_EQ(f.handlings.size(), 1u);
   const auto free = names(f.free, true);
   std::printf("free DoFs after the carry:");
@@ -182,17 +195,24 @@ TEST(ForegroundTrackerTest, TiltingAnUprightCupRaisesOneFrozenDofMotion) {
   const Outcome o = run("hand_tilts_cup", 320, 240);
   std::vector<Event> frozen;
   std::size_t promoted = 0;
+  int promoted_at = -1;
   for (const auto& [k, e] : o.events) {
     std::printf("frame %d %s %s\n", k, to_string(e.kind), e.detail.c_str());
-    if (e.kind == EventKind::kObjectPromoted) ++promoted;
+    if (e.kind == EventKind::kObjectPromoted) ++promoted, promoted_at = k;
     if (e.kind == EventKind::kFrozenDofMotion) frozen.push_back(e);
   }
-  // Measured: mean 1.42 cm, worst 1.82 cm over the 169 frames after promotion; the rotation is
-  // lost during the 60 degree tilt (worst 58.7 degrees), but the tilt is seen.
+  // Measured with the grown model: mean 0.78 cm, worst 1.44 cm, worst 26.3 degrees over the 170
+  // frames after promotion (part of the 60 degree tilt is still lost); with the first view's model
+  // only: 1.45 cm, 1.85 cm, 62.7 degrees.
   const TrackingError error = report_tracking(o);
-  EXPECT_LT(error.mean_cm, 1.6);
-  EXPECT_LT(error.worst_cm, 2.2);
+  EXPECT_LT(error.mean_cm, 0.9);
+  EXPECT_LT(error.worst_cm, 1.6);
+  EXPECT_LT(error.worst_deg, 30.0);
   EXPECT_EQ(promoted, 1u);
+  // Grasped at frame 28 and lifted from there (it rises 2.4 mm by frame 29, 19 mm by 31):
+  // measured promoted at frame 31 (tracked lift 9.1 mm), the issue's 3 frames.
+  EXPECT_GE(promoted_at, 29);
+  EXPECT_LE(promoted_at, 31);
   ASSERT_EQ(frozen.size(), 1u);
   const auto dof = static_cast<Dof>(static_cast<int>(frozen[0].evidence.at("dof")));
   EXPECT_TRUE(dof == Dof::kRoll || dof == Dof::kPitch) << to_string(dof);

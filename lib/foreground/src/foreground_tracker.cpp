@@ -7,6 +7,7 @@
 #include <sstream>
 #include <unordered_set>
 
+#include "point_model.h"
 #include "skin_model.h"
 #include "voxel_set.h"
 
@@ -120,6 +121,45 @@ struct Crop {
   std::vector<Eigen::Vector3d> points;
 };
 
+// The pixels whose points can lie within `radius` of `centre` (camera frame): the image box of
+// the sphere's bounding box; the whole image when the camera is unknown or inside the sphere.
+struct PixelWindow {
+  int u0 = 0, v0 = 0, u1 = 0, v1 = 0;  // [u0, u1) x [v0, v1)
+};
+
+PixelWindow pixel_window(const FrameView& f, const Eigen::Vector3f& centre, double radius) {
+  const Cloud& cloud = *f.cloud;
+  PixelWindow w{0, 0, static_cast<int>(cloud.width), static_cast<int>(cloud.height)};
+  const double near = centre.z() - radius, far = centre.z() + radius;
+  if (!f.K || cloud.height <= 1 || near <= 0.01) return w;
+  auto span = [&](double c, double focal, double principal, int size, int& lo, int& hi) {
+    const double a = (c - radius) / near, b = (c - radius) / far, d = (c + radius) / near, e = (c + radius) / far;
+    lo = std::max(0, static_cast<int>(std::floor(principal + focal * std::min({a, b, d, e}))) - 1);
+    hi = std::min(size, static_cast<int>(std::ceil(principal + focal * std::max({a, b, d, e}))) + 2);
+  };
+  span(centre.x(), f.K->fx, f.K->cx, w.u1, w.u0, w.u1);
+  span(centre.y(), f.K->fy, f.K->cy, w.v1, w.v0, w.v1);
+  return w;
+}
+
+// Adds pixel i to the crop when its point lies within the sphere and is neither an agent's nor
+// on a supporting plane.
+void add_to_crop(const FrameView& f, std::size_t i, const Eigen::Vector3f& centre_cam, float r2,
+                 const std::vector<const Plane*>& supports, VoxelSet& kept, Crop& c) {
+  const PointT& p = f.cloud->points[i];
+  if (!is_valid(p) || (p.getVector3fMap() - centre_cam).squaredNorm() > r2) return;
+  if (f.hands && f.hands->is_agent(static_cast<int>(i))) return;
+  const Eigen::Vector3d w = world(p, f.T_world_camera);
+  for (const Plane* pl : supports)
+    if (std::abs(pl->signed_distance(w)) < kSupportBandM) return;
+  c.pixels.push_back(static_cast<int>(i));
+  c.points.push_back(w);
+  if (!kept.insert(w)) return;
+  PointT q = p;
+  q.getVector3fMap() = w.cast<float>();
+  c.target.push_back(q);
+}
+
 Crop crop(const FrameView& f, const Eigen::Vector3d& centre_world, double radius, double voxel) {
   Crop c;
   const Pose& T = f.T_world_camera;
@@ -133,21 +173,12 @@ Crop crop(const FrameView& f, const Eigen::Vector3d& centre_world, double radius
   }
   VoxelSet kept(voxel);
   const Cloud& cloud = *f.cloud;
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const PointT& p = cloud.points[i];
-    if (!is_valid(p) || (p.getVector3fMap() - centre_cam).squaredNorm() > r2) continue;
-    if (f.hands && f.hands->is_agent(static_cast<int>(i))) continue;
-    const Eigen::Vector3d w = world(p, T);
-    bool on_support = false;
-    for (const Plane* pl : supports) on_support = on_support || std::abs(pl->signed_distance(w)) < kSupportBandM;
-    if (on_support) continue;
-    c.pixels.push_back(static_cast<int>(i));
-    c.points.push_back(w);
-    if (!kept.insert(w)) continue;
-    PointT q = p;
-    q.getVector3fMap() = w.cast<float>();
-    c.target.push_back(q);
-  }
+  const PixelWindow w = pixel_window(f, centre_cam, radius);
+  for (int v = w.v0; v < w.v1; ++v)
+    for (int u = w.u0; u < w.u1; ++u) {
+      const std::size_t i = static_cast<std::size_t>(v) * cloud.width + static_cast<std::size_t>(u);
+      add_to_crop(f, i, centre_cam, r2, supports, kept, c);
+    }
   c.target.width = static_cast<std::uint32_t>(c.target.size());
   c.target.height = 1;
   return c;
@@ -196,7 +227,12 @@ bool mostly_skin(const Cloud& cloud, const std::vector<int>& indices) {
 }  // namespace
 
 struct ForegroundTracker::Impl {
-  explicit Impl(ForegroundConfig c) : config(std::move(c)) {}
+  explicit Impl(ForegroundConfig c) : config(std::move(c)) {
+    growth.voxel_m = config.model_voxel_m;
+    growth.max_points = config.max_model_points;
+    growth.max_rmse_m = config.grow_max_rmse_m;
+    growth.min_inlier_fraction = config.grow_min_inlier_fraction;
+  }
 
   struct Object {
     std::uint64_t id = 0;
@@ -208,6 +244,7 @@ struct ForegroundTracker::Impl {
     bool visible = true;
     bool in_hand = false;
     bool lost_in_hand = false;            // its track was lost while a hand held it
+    bool piece = false;                   // a candidate found to be a piece of a foreground object
     CloudPtr sparse;                      // the model thinned for registration
     const Cloud* sparse_of = nullptr;     // the model it was thinned from
     std::vector<int> pixels;              // this frame
@@ -220,6 +257,7 @@ struct ForegroundTracker::Impl {
   };
 
   ForegroundConfig config;
+  ModelGrowth growth;
   std::vector<Object> objects;  // candidates and foreground objects, in the order first touched
   std::map<std::uint64_t, Eigen::Vector3d> first_seen_at;  // background objects: where they were first seen
   Pose T_support = Pose::Identity();
@@ -376,19 +414,60 @@ struct ForegroundTracker::Impl {
     o.handling_raised = true;
   }
 
-  void promote(Object& o, const FrameView& f, double moved_m, double turned_deg, double filled, ForegroundUpdate& out) {
+  // How far a candidate went from where it stood.
+  struct Departure {
+    double moved_m = 0, turned_deg = 0, lifted_m = 0, sideways_m = 0;
+  };
+
+  Departure departure(const Object& o, const FrameView& f) const {
+    const Eigen::Vector3d d = o.T.translation() - o.T_home.translation();
+    const Eigen::Vector3d up = f.up_world.normalized();
+    Departure out;
+    out.moved_m = d.norm();
+    out.turned_deg = rotation_deg(o.T, o.T_home);
+    out.lifted_m = d.dot(up);
+    out.sideways_m = (d - out.lifted_m * up).norm();
+    return out;
+  }
+
+  // A touched object (a candidate: a hand touched it within touch_timeout_frames) is promoted
+  // once it left its place: lifted off its support (a pick starts along the support's normal,
+  // and while a cup's side wall still hides its old place none of that place is seen empty yet;
+  // no contact is asked in this frame, as the hand that grasps a cup is often hidden behind it),
+  // or moved or turned beyond the promotion thresholds with its old place seen empty.
+  void promote_if_due(Object& o, const FrameView& f, ForegroundUpdate& out) {
+    const Departure d = departure(o, f);
+    if (d.lifted_m > config.promote_lift_m && d.lifted_m > d.sideways_m) {
+      promote(o, f, d, "lifted off its support", out);
+      return;
+    }
+    if (d.moved_m <= config.promote_translation_m && d.turned_deg <= config.promote_rotation_deg) return;
+    // Lifted off its support, the object empties only the band under it (a cylinder's side wall
+    // stays where it was): then that band is evidence enough.
+    const bool lifted = d.lifted_m > config.promote_translation_m;
+    const double filled = still_filled(o, f);
+    if (filled > 1.0 - (lifted ? kLiftedVacatedFraction : config.vacated_fraction)) return;
+    std::ostringstream why;
+    why.precision(3);
+    why << "its old place is " << 100 * (1 - filled) << " % empty";
+    promote(o, f, d, why.str(), out);
+  }
+
+  void promote(Object& o, const FrameView& f, const Departure& d, const std::string& why, ForegroundUpdate& out) {
     o.promoted = true;
     o.info.foreground = ForegroundState{};
     o.info.foreground->promoted_s = f.stamp_s;
     Event e = event_for(o, EventKind::kObjectPromoted, EventLevel::kPrediction, f);
-    e.score = std::max(moved_m / config.promote_translation_m, turned_deg / config.promote_rotation_deg);
+    e.score = std::max({d.moved_m / config.promote_translation_m, d.turned_deg / config.promote_rotation_deg,
+                        d.lifted_m / config.promote_lift_m});
     std::ostringstream detail;
     detail.precision(3);
-    detail << "touched by a hand and moved " << moved_m << " m, turned " << turned_deg << " deg; its old place is "
-           << 100 * (1 - filled) << " % empty";
+    detail << "touched by a hand and moved " << d.moved_m << " m (lifted " << d.lifted_m << " m), turned "
+           << d.turned_deg << " deg; " << why;
     e.detail = detail.str();
-    e.evidence["moved_m"] = moved_m;
-    e.evidence["turned_deg"] = turned_deg;
+    e.evidence["moved_m"] = d.moved_m;
+    e.evidence["lifted_m"] = d.lifted_m;
+    e.evidence["turned_deg"] = d.turned_deg;
     e.evidence["model_points"] = static_cast<double>(o.model->size());
     e.displacement_world = o.T.translation() - o.T_home.translation();
     out.events.push_back(std::move(e));
@@ -431,6 +510,7 @@ Status validate(const ForegroundConfig& c) {
   auto positive = [](double v) { return std::isfinite(v) && v > 0; };
   if (!positive(c.contact_m) || c.contact_m > 0.5) return invalid_argument("foreground.contact_m: must be in (0, 0.5] m");
   if (!positive(c.promote_translation_m)) return invalid_argument("foreground.promote_translation_m: must be > 0");
+  if (!positive(c.promote_lift_m)) return invalid_argument("foreground.promote_lift_m: must be > 0");
   if (!positive(c.promote_rotation_deg)) return invalid_argument("foreground.promote_rotation_deg: must be > 0");
   if (!(c.vacated_fraction > 0 && c.vacated_fraction <= 1)) return invalid_argument("foreground.vacated_fraction: must be in (0, 1]");
   if (!positive(c.dof.translation_m)) return invalid_argument("foreground.dof_translation_m: must be > 0");
@@ -438,6 +518,8 @@ Status validate(const ForegroundConfig& c) {
   if (c.release_frames < 1 || c.touch_timeout_frames < 1) return invalid_argument("foreground.release_frames and touch_timeout_frames: must be >= 1");
   if (!positive(c.search_radius_m) || c.search_radius_m > 2) return invalid_argument("foreground.search_radius_m: must be in (0, 2] m");
   if (!positive(c.mask_m) || !positive(c.model_voxel_m) || !positive(c.target_voxel_m)) return invalid_argument("foreground.mask_m, model_voxel_m, target_voxel_m: must be > 0");
+  if (!positive(c.grow_max_rmse_m)) return invalid_argument("foreground.grow_max_rmse_m: must be > 0");
+  if (!(c.grow_min_inlier_fraction >= 0 && c.grow_min_inlier_fraction <= 1)) return invalid_argument("foreground.grow_min_inlier_fraction: must be in [0, 1]");
   if (c.max_model_points < 50) return invalid_argument("foreground.max_model_points: must be >= 50");
   return {};
 }
@@ -469,7 +551,10 @@ std::vector<int> ForegroundTracker::track(const FrameView& f) {
     o.visible = true;
     o.lost_in_hand = false;
     o.pixels = m.pixels_on(o, c);
-    if (o.promoted) pixels.insert(pixels.end(), o.pixels.begin(), o.pixels.end());
+    if (!o.promoted) continue;
+    pixels.insert(pixels.end(), o.pixels.begin(), o.pixels.end());
+    if (m.config.grow_model && worth_merging(r, m.growth))
+      o.model = merged(o.model, *f.cloud, o.pixels, o.T.inverse() * f.T_world_camera, m.growth);
   }
   return pixels;
 }
@@ -586,25 +671,31 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
   }
   m.first_seen_at.swap(seen);
 
-  // Contacts, handlings, promotion, and the candidates that were touched but never moved.
-  for (auto& o : m.objects) {
+  // Contacts, handlings, promotion, and the candidates that were touched but never moved. A
+  // candidate whose model now lies mostly on a foreground object is a piece of it (a small cluster
+  // beside a toy, registered onto the toy as it is carried off): dropped, never promoted.
+  auto piece_of_foreground = [&](std::size_t k) {
+    const auto pts = posed_points(*m.objects[k].model, m.objects[k].T);
+    for (std::size_t j = 0; j < m.objects.size(); ++j) {
+      if (j == k || !m.objects[j].promoted) continue;
+      const VoxelSet& surface = surface_of(j);
+      std::size_t near = 0;
+      for (const auto& p : pts) near += surface.contains(p) ? 1 : 0;
+      if (2 * near > pts.size()) return true;
+    }
+    return false;
+  };
+  for (std::size_t k = 0; k < m.objects.size(); ++k) {
+    auto& o = m.objects[k];
     const bool contact = touches(posed_points(*o.model, o.T));
     o.in_hand = contact;
     m.handle(o, contact, f, out);
-    if (!o.promoted && o.visible) {
-      const double moved = (o.T.translation() - o.T_home.translation()).norm();
-      const double turned = rotation_deg(o.T, o.T_home);
-      if (moved > cfg.promote_translation_m || turned > cfg.promote_rotation_deg) {
-        // Lifted off its support, the object empties only the band under it (a cylinder's side
-        // wall stays where it was): then that band is evidence enough.
-        const bool lifted = (o.T.translation() - o.T_home.translation()).dot(f.up_world) > cfg.promote_translation_m;
-        const double filled = m.still_filled(o, f);
-        if (filled <= 1.0 - (lifted ? kLiftedVacatedFraction : cfg.vacated_fraction)) m.promote(o, f, moved, turned, filled, out);
-      }
-    }
+    if (o.promoted || !o.visible) continue;
+    o.piece = piece_of_foreground(k);
+    if (!o.piece) m.promote_if_due(o, f, out);
   }
   m.objects.erase(std::remove_if(m.objects.begin(), m.objects.end(), [&](const Impl::Object& o) {
-                    return !o.promoted && f.frame_index - o.last_contact > static_cast<std::uint64_t>(cfg.touch_timeout_frames);
+                    return !o.promoted && (o.piece || f.frame_index - o.last_contact > static_cast<std::uint64_t>(cfg.touch_timeout_frames));
                   }), m.objects.end());
 
   for (auto& o : m.objects) {

@@ -3,8 +3,10 @@
 // registration TU of the module.
 #include "scenewatch/foreground/registration.h"
 
+#include "nearest_search.h"
+
 #include <pcl/console/print.h>
-#include <pcl/kdtree/kdtree_flann.h>
+#include <pcl/search/kdtree.h>
 #include <pcl/registration/correspondence_estimation.h>
 #include <pcl/registration/icp.h>
 
@@ -54,7 +56,7 @@ float colour_distance2(const PointT& a, const PointT& b) {
 }
 
 // The turn about the vertical through the model's centre whose colours agree best with the frame.
-Pose best_spin(const Cloud& model, const Pose& T, const pcl::KdTreeFLANN<PointT>& tree, const Cloud& target,
+Pose best_spin(const Cloud& model, const Pose& T, const pcl::search::KdTree<PointT>& tree, const Cloud& target,
                const Eigen::Vector3d& up, const RegistrationConfig& config) {
   if (config.spin_search_deg <= 0 || config.spin_step_deg <= 0) return T;
   const float gate2 = static_cast<float>(config.inlier_m * config.inlier_m);
@@ -116,8 +118,15 @@ Registration register_model(const Cloud& model, const Cloud& target, const Pose&
     estimation->setPointRepresentation(std::make_shared<const XyzRgbRepresentation>(static_cast<float>(config.colour_weight_m)));
     icp.setCorrespondenceEstimation(estimation);
   }
+  // One k-d tree of the target serves ICP's correspondences, the spin search and the inlier count.
+  auto tree = std::make_shared<NearestSearch>();
+  tree->setInputCloud(target_ptr);
+  if (config.colour_weight_m <= 0) icp.setSearchMethodTarget(tree, true);
   icp.setMaximumIterations(config.iterations);
-  icp.setTransformationEpsilon(1e-8);
+  // An iteration that moves the model by less than converged_m and turns it by less than
+  // converged_deg ends the gate (PCL's thresholds: squared translation, cosine of the angle).
+  icp.setTransformationEpsilon(config.converged_m * config.converged_m);
+  icp.setTransformationRotationEpsilon(std::cos(config.converged_deg * M_PI / 180.0));
   icp.setEuclideanFitnessEpsilon(1e-8);
   Eigen::Matrix4f total = Eigen::Matrix4f::Identity();
   Cloud aligned;
@@ -146,9 +155,7 @@ Registration register_model(const Cloud& model, const Cloud& target, const Pose&
       delta.translation() = moved - delta.linear() * centre;
     }
   }
-  pcl::KdTreeFLANN<PointT> tree;
-  tree.setInputCloud(target_ptr);
-  r.T_world_object = best_spin(model, delta * T_guess, tree, *target_ptr, up_world, config);
+  r.T_world_object = best_spin(model, delta * T_guess, *tree, *target_ptr, up_world, config);
   pcl::transformPointCloud(model, *source, r.T_world_object.matrix().cast<float>());
 
   // How much of the visible side of the model the frame explains.
@@ -158,7 +165,7 @@ Registration register_model(const Cloud& model, const Cloud& target, const Pose&
   double sum2 = 0;
   const double gate2 = config.inlier_m * config.inlier_m;
   for (int i : facing) {
-    if (tree.nearestKSearch(source->points[static_cast<std::size_t>(i)], 1, k, d2) < 1) continue;
+    if (tree->nearestKSearch(source->points[static_cast<std::size_t>(i)], 1, k, d2) < 1) continue;
     if (d2[0] > gate2) continue;
     ++r.inliers;
     sum2 += d2[0];

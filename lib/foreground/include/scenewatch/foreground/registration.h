@@ -17,7 +17,9 @@ struct RegistrationConfig {
   /// position only. Off: on the simulator's cup it lost the turn about the axis that the colour
   /// search below follows (worst 56 against 14 degrees of error), and it is slower.
   double colour_weight_m = 0.0;
-  int iterations = 8;                ///< per correspondence gate
+  int iterations = 8;                ///< per correspondence gate, at most
+  double converged_m = 0.0002;       ///< a gate ends when an iteration moves the model less than this...
+  double converged_deg = 0.05;       ///< ...and turns it less than this
   double min_inlier_fraction = 0.35;  ///< of the model points that face the camera
   std::size_t min_inliers = 40;
   /// After ICP, turns about the vertical through the model's centre are searched in steps of
