@@ -139,11 +139,9 @@ std::vector<Piece> join_occluded_pieces(const Cloud& cloud, std::vector<Piece> p
       if (pieces[a].plane != pieces[b].plane) continue;
       if (std::abs(stats[a].top - stats[b].top) > params.max_height_difference_m) continue;
       const int ia = static_cast<int>(a), ib = static_cast<int>(b);
-      // Both ways: each side's surface, carried across, must meet the other.
-      if (hidden_continuation(cloud, owner, ia, ib, stats[a], stats[b], params) &&
-          hidden_continuation(cloud, owner, ib, ia, stats[b], stats[a], params)) {
-        uf.unite(ia, ib);
-      }
+      // One walk: the profile is fitted to both sides at once, so the walk back would test the
+      // same pixels again.
+      if (hidden_continuation(cloud, owner, ia, ib, stats[a], stats[b], params)) uf.unite(ia, ib);
     }
   }
   return join_pieces(pieces, uf);
