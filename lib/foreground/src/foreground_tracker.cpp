@@ -212,13 +212,7 @@ bool beside_person(const HandDetection& d, const std::vector<int>& indices, int 
 // True when most of the cluster's pixels have skin colour.
 bool mostly_skin(const Cloud& cloud, const std::vector<int>& indices) {
   if (indices.empty()) return false;
-  std::vector<std::uint8_t> rgb;
-  rgb.reserve(indices.size() * 3);
-  for (int i : indices) {
-    const PointT& p = cloud.points[static_cast<std::size_t>(i)];
-    rgb.insert(rgb.end(), {p.r, p.g, p.b});
-  }
-  const auto skin = skin_mask(rgb, static_cast<int>(indices.size()), 1);
+  const auto skin = skin_mask(cloud, indices);
   std::size_t n = 0;
   for (auto v : skin) n += v ? 1 : 0;
   return 2 * n > indices.size();

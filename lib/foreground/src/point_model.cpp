@@ -14,13 +14,7 @@ namespace {
 
 // The view's points that are not skin (a hand the detector left out, fingers over the object).
 std::vector<int> without_skin(const Cloud& cloud, const std::vector<int>& view) {
-  std::vector<std::uint8_t> rgb;
-  rgb.reserve(view.size() * 3);
-  for (int i : view) {
-    const PointT& p = cloud.points[static_cast<std::size_t>(i)];
-    rgb.insert(rgb.end(), {p.r, p.g, p.b});
-  }
-  const auto skin = skin_mask(rgb, static_cast<int>(view.size()), 1);
+  const auto skin = skin_mask(cloud, view);
   std::vector<int> out;
   out.reserve(view.size());
   for (std::size_t k = 0; k < view.size(); ++k)

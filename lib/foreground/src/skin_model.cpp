@@ -52,4 +52,14 @@ std::vector<std::uint8_t> skin_mask(const std::vector<std::uint8_t>& rgb, int wi
   return mask;
 }
 
+std::vector<std::uint8_t> skin_mask(const Cloud& cloud, const std::vector<int>& indices) {
+  std::vector<std::uint8_t> rgb;
+  rgb.reserve(indices.size() * 3);
+  for (int i : indices) {
+    const PointT& p = cloud.points[static_cast<std::size_t>(i)];
+    rgb.insert(rgb.end(), {p.r, p.g, p.b});
+  }
+  return skin_mask(rgb, static_cast<int>(indices.size()), 1);
+}
+
 }  // namespace scenewatch::foreground
