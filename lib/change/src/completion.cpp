@@ -164,6 +164,49 @@ ChangeCluster completed(const std::vector<ChangeCluster>& clusters, const std::v
   return c;
 }
 
+// A cluster of evidence over several explaining objects (evidence is grouped on a grid, so two
+// new objects side by side make one cluster) becomes one cluster per object: the evidence on each
+// object goes with it, the rest with the object carrying most of the evidence. The segmentation
+// says what an object is; the grid does not.
+void split_by_object(std::vector<ChangeCluster>& clusters, std::vector<std::vector<int>>& objects,
+                     const CompletionFrame& before, const CompletionFrame& after) {
+  std::vector<ChangeCluster> out_clusters;
+  std::vector<std::vector<int>> out_objects;
+  for (std::size_t i = 0; i < clusters.size(); ++i) {
+    if (objects[i].size() <= 1) {
+      out_clusters.push_back(std::move(clusters[i]));
+      out_objects.push_back(std::move(objects[i]));
+      continue;
+    }
+    const ObjectLabels& labels = *frame_of(clusters[i].kind, before, after).objects;
+    const std::vector<int>& explaining = objects[i];
+    std::vector<std::size_t> on(explaining.size(), 0);
+    auto part_of = [&](int index) {
+      const auto it = std::find(explaining.begin(), explaining.end(), labels.object_of[index]);
+      return it == explaining.end() ? -1 : static_cast<int>(it - explaining.begin());
+    };
+    for (int index : clusters[i].indices)
+      if (const int k = part_of(index); k >= 0) ++on[k];
+    const auto main = static_cast<int>(std::max_element(on.begin(), on.end()) - on.begin());
+    std::vector<ChangeCluster> parts(explaining.size());
+    for (int index : clusters[i].indices) {
+      const int k = part_of(index);
+      parts[k >= 0 ? k : main].indices.push_back(index);
+    }
+    const auto total = static_cast<double>(clusters[i].indices.size());
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+      parts[k].kind = clusters[i].kind;
+      parts[k].mean_gap_m = clusters[i].mean_gap_m;
+      parts[k].evidence_count = static_cast<std::size_t>(
+          std::lround(static_cast<double>(clusters[i].evidence_count) * static_cast<double>(parts[k].indices.size()) / total));
+      out_clusters.push_back(std::move(parts[k]));
+      out_objects.push_back({explaining[k]});
+    }
+  }
+  clusters = std::move(out_clusters);
+  objects = std::move(out_objects);
+}
+
 }  // namespace
 
 std::vector<int> explaining_objects(const std::vector<int>& evidence, const ObjectLabels& labels, const Config& config) {
@@ -192,6 +235,7 @@ std::vector<ChangeCluster> complete_clusters(std::vector<ChangeCluster> clusters
     const CompletionFrame& f = frame_of(clusters[i].kind, before, after);
     if (usable(f)) objects[i] = explaining_objects(clusters[i].indices, *f.objects, config);
   }
+  split_by_object(clusters, objects, before, after);
   const std::vector<char> claimed_before = claimed_objects(clusters, objects, ChangeKind::kRemoved, before);
   const std::vector<char> claimed_after = claimed_objects(clusters, objects, ChangeKind::kAdded, after);
   const Witness witness_before(before, claimed_before, config), witness_after(after, claimed_after, config);

@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <unordered_set>
 
 namespace scenewatch::change {
 namespace {
@@ -75,51 +74,43 @@ std::vector<TrueChange> true_changes_from_labels(const std::vector<Eigen::Vector
                                                  const std::vector<std::uint32_t>& bl,
                                                  const std::vector<Eigen::Vector3f>& ax,
                                                  const std::vector<std::uint32_t>& al, std::uint32_t divisor,
-                                                 std::uint32_t min_label, double near_m, std::size_t min_points) {
-  // Labelled object points of one side on a hash grid of near_m cells, for "within near_m" tests.
-  auto key = [near_m](const Eigen::Vector3f& p) {
-    auto c = [&](float x) { return static_cast<std::int64_t>(std::floor(x / near_m)) & 0x1fffff; };
-    return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
-  };
-  auto object_cells = [&](const std::vector<Eigen::Vector3f>& xyz, const std::vector<std::uint32_t>& labels) {
-    std::unordered_set<std::int64_t> cells;
-    for (std::size_t i = 0; i < xyz.size(); ++i)
-      if (labels[i] >= min_label && xyz[i].allFinite()) cells.insert(key(xyz[i]));
-    return cells;
-  };
-  auto near = [&](const std::unordered_set<std::int64_t>& cells, const Eigen::Vector3f& p) {
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz)
-          if (cells.count(key(p + Eigen::Vector3f(dx, dy, dz) * static_cast<float>(near_m)))) return true;
-    return false;
-  };
+                                                 std::uint32_t min_label, double near_m, std::size_t min_points,
+                                                 double kept_fraction) {
   auto objects = [&](const std::vector<Eigen::Vector3f>& xyz, const std::vector<std::uint32_t>& labels) {
     std::map<std::uint32_t, std::vector<int>> out;
     for (std::size_t i = 0; i < xyz.size(); ++i)
       if (labels[i] >= min_label && xyz[i].allFinite()) out[labels[i] / divisor].push_back(static_cast<int>(i));
     return out;
   };
-  const auto before_cells = object_cells(bx, bl), after_cells = object_cells(ax, al);
+  // One object's pixels read in the other scene: hidden where the other scene has a surface in
+  // front (occluded, or hidden before), kept where its depth is the same, changed otherwise.
+  const float near = static_cast<float>(near_m);
+  auto changed = [&](const std::vector<int>& idx, const std::vector<Eigen::Vector3f>& own,
+                     const std::vector<Eigen::Vector3f>& other) {
+    std::size_t hidden = 0, seen = 0, kept = 0;
+    for (int i : idx) {
+      if (static_cast<std::size_t>(i) >= other.size() || !other[i].allFinite()) continue;
+      const float dz = other[i].z() - own[i].z();
+      if (dz < -near) {
+        ++hidden;
+        continue;
+      }
+      ++seen;
+      kept += std::abs(dz) <= near ? 1 : 0;
+    }
+    if (2 * hidden >= idx.size() || seen == 0) return false;  // mostly out of sight: unknown
+    return static_cast<double>(kept) < kept_fraction * static_cast<double>(seen);
+  };
   std::vector<TrueChange> out;
   for (const auto& [id, idx] : objects(ax, al)) {
-    if (idx.size() < min_points) continue;
-    std::size_t there = 0;
-    for (int i : idx) there += near(before_cells, ax[i]) ? 1 : 0;
-    if (2 * there >= idx.size()) continue;
+    if (idx.size() < min_points || !changed(idx, ax, bx)) continue;
     TrueChange t;
     t.object_id = id;
     t.indices_after = idx;
     out.push_back(std::move(t));
   }
   for (const auto& [id, idx] : objects(bx, bl)) {
-    if (idx.size() < min_points) continue;
-    std::size_t there = 0, occluded = 0;
-    for (int i : idx) {
-      there += near(after_cells, bx[i]) ? 1 : 0;
-      occluded += ax[i].allFinite() && ax[i].z() < bx[i].z() - 0.01f ? 1 : 0;
-    }
-    if (2 * there >= idx.size() || 2 * occluded >= idx.size()) continue;
+    if (idx.size() < min_points || !changed(idx, bx, ax)) continue;
     TrueChange t;
     t.object_id = id;
     t.indices_before = idx;

@@ -27,8 +27,9 @@ struct CompletionFrame {
 /// Completes removed clusters from `before`, added ones from `after`: a cluster's indices
 /// become the union of its explaining objects plus its evidence that lies on no object, and its
 /// points, box, centroid, colour and pixel region are recomputed from them (`completed` set).
-/// A cluster no object explains stays as it is. Clusters of one kind that share an object are
-/// merged into one. Order: as given, a merged cluster at the place of its first member.
+/// A cluster no object explains stays as it is. A cluster several objects explain is first split
+/// into one per object (two new objects side by side are two additions). Clusters of one kind
+/// that share an object are merged into one. Order: as given, a merged cluster at the place of its first member.
 std::vector<ChangeCluster> complete_clusters(std::vector<ChangeCluster> clusters, const CompletionFrame& before,
                                              const CompletionFrame& after, const Config& config);
 

@@ -37,16 +37,25 @@ ChangeScore score_changes(const std::vector<Event>& events, const std::vector<Tr
                           double iou_threshold = 0.5);
 
 /// True changes of a same-camera pair from per-point object labels (mOSD: id = label / 10,
-/// labels below `min_label` are background). An object of AFTER is added when fewer than half of
-/// its points lie within `near_m` of any labelled object point of BEFORE; removed likewise the
-/// other way, unless most of its pixels are occluded in AFTER (valid AFTER depth in front of it).
-/// Objects with fewer than min_points labelled points are left out.
+/// labels below `min_label` are background), read pixel by pixel (the scenes are organized and
+/// the camera did not move). An object's pixels are read in the other scene: hidden where that
+/// scene has a surface more than `near_m` in front, kept where its depth is within `near_m`,
+/// changed otherwise. An object of AFTER is added, or one of BEFORE removed, when fewer than
+/// `kept_fraction` of its seen (not hidden) pixels are kept; so a move of 2 cm or a turn in place
+/// is a removal plus an addition, as the diff's OBJECT_MOVED should be. An object mostly hidden
+/// in the other scene is left out (occluded: unknown, not a change), as are objects with fewer
+/// than min_points labelled points.
+///
+/// `near_m` of 1 cm is 7x the Kinect's depth noise at 0.7 m (about 1.4 mm, Khoshelham and Oude
+/// Elberink 2012), so an unmoved surface keeps all but its flickering edge pixels; a rigid motion
+/// of 2 cm moves the depth of every face not parallel to it and uncovers a strip at each side.
 std::vector<TrueChange> true_changes_from_labels(const std::vector<Eigen::Vector3f>& before_xyz,
                                                  const std::vector<std::uint32_t>& before_labels,
                                                  const std::vector<Eigen::Vector3f>& after_xyz,
                                                  const std::vector<std::uint32_t>& after_labels,
                                                  std::uint32_t divisor = 10, std::uint32_t min_label = 10,
-                                                 double near_m = 0.01, std::size_t min_points = 100);
+                                                 double near_m = 0.01, std::size_t min_points = 100,
+                                                 double kept_fraction = 0.8);
 
 /// True when two labelled organized scenes come from one unmoved camera: most pixels both label
 /// as the support (`table_label`) have the same depth (to 0.1 mm; mOSD's sessions share the
