@@ -75,6 +75,7 @@ Status validate(const Config& c) {
   if (!(c.clamp_min > 0.0 && c.clamp_min < 0.5)) return bad("clamp_min", "must be in (0, 0.5), got " + std::to_string(c.clamp_min));
   if (!(c.clamp_max > 0.5 && c.clamp_max < 1.0)) return bad("clamp_max", "must be in (0.5, 1), got " + std::to_string(c.clamp_max));
   if (c.ray_stop_after < 0 || c.ray_stop_after > 1000) return bad("ray_stop_after", "must be in [0, 1000], got " + std::to_string(c.ray_stop_after));
+  if (c.insert_stride_px < 1 || c.insert_stride_px > 8) return bad("insert_stride_px", "must be in [1, 8], got " + std::to_string(c.insert_stride_px));
   return {};
 }
 
@@ -167,7 +168,7 @@ void cast_ray_back(const octomap::ColorOcTree& tree, const octomap::point3d& sen
 }
 }  // namespace
 
-InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world_camera) {
+InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world_camera, int stride) {
   auto& tree = impl_->tree;
   auto& endpoints = impl_->endpoints;
   auto& rays = impl_->rays;
@@ -222,11 +223,24 @@ InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world
 
   // 1. One endpoint per voxel, with the frame's mean colour in it; rays beyond max range are cut
   //    and end in a voxel that is freed, not hit.
+  //    Neighbouring pixels mostly end in one voxel: their colours are summed in a run that goes
+  //    into the hash map once, when the voxel changes.
   auto& clipped = impl_->clipped_ends;
   clipped.clear();
   OcTreeKey key;
-  for (const auto& p : points_camera.points) {
-    if (!is_valid(p)) continue;
+  std::uint64_t run_key = 0;
+  ColorSum run;
+  auto flush = [&] {
+    if (run.n == 0) return;
+    ColorSum& c = endpoints[run_key];
+    c.r += run.r;
+    c.g += run.g;
+    c.b += run.b;
+    c.n += run.n;
+    run = ColorSum{};
+  };
+  auto add = [&](const PointT& p) {
+    if (!is_valid(p)) return;
     ++stats.points;
     Eigen::Vector3f w = T * p.getVector3fMap();
     const Eigen::Vector3f d = w - origin_f;
@@ -234,15 +248,26 @@ InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world
     if (max_range > 0 && range > max_range) {
       w = origin_f + d * static_cast<float>(max_range / range);
       if (tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) clipped.push_back(pack(key));
-      continue;
+      return;
     }
-    if (!tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) continue;
-    ColorSum& c = endpoints[pack(key)];
-    c.r += p.r;
-    c.g += p.g;
-    c.b += p.b;
-    ++c.n;
-  }
+    if (!tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) return;
+    const std::uint64_t k = pack(key);
+    if (k != run_key) {
+      flush();
+      run_key = k;
+    }
+    run.r += p.r;
+    run.g += p.g;
+    run.b += p.b;
+    ++run.n;
+  };
+  const std::size_t n = points_camera.size();
+  const bool organized = points_camera.height > 1 && points_camera.width > 0;
+  const std::size_t width = organized ? points_camera.width : std::max<std::size_t>(n, 1);
+  const std::size_t step = organized && stride > 1 ? static_cast<std::size_t>(stride) : 1;
+  for (std::size_t row = 0; row < n; row += width * step)
+    for (std::size_t i = row; i < std::min(row + width, n); i += step) add(points_camera.points[i]);
+  flush();
   std::sort(clipped.begin(), clipped.end());
   clipped.erase(std::unique(clipped.begin(), clipped.end()), clipped.end());
   for (const auto& [k, c] : endpoints) grow(unpack(k));

@@ -58,7 +58,8 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("prob_hit", b.prob_hit); }, [&] { return s.read("prob_miss", b.prob_miss); },
                            [&] { return s.read("clamp_min", b.clamp_min); }, [&] { return s.read("clamp_max", b.clamp_max); },
                            [&] { return s.read("fast_insertion", b.fast_insertion); },
-                           [&] { return s.read("ray_stop_after", b.ray_stop_after); });
+                           [&] { return s.read("ray_stop_after", b.ray_stop_after); },
+                           [&] { return s.read("insert_stride_px", b.insert_stride_px); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;
@@ -101,7 +102,8 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); },
                            [&] { return s.read("confirm_frames", c.tracking.confirm_frames); },
                            [&] { return s.read("gone_frames", c.tracking.gone_frames); },
-                           [&] { return s.read("max_range_m", c.tracking.max_range_m); });
+                           [&] { return s.read("max_range_m", c.tracking.max_range_m); },
+                           [&] { return s.read("segmentation_stride_px", c.tracking.segmentation_stride_px); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

@@ -139,6 +139,17 @@ CloudConstPtr without_pending(const Cloud& cloud, const std::vector<change::Chan
   return masked;
 }
 
+// How many pixels apart a frame may be sampled for work on a grid of `spacing_m`: at most `most`,
+// and only as coarse as keeps the samples within one grid cell of each other on a surface facing
+// the camera at `range_m` (a VGA Kinect: 2 for the segmentation's 1 cm at 2 m and for the map's
+// 2 cm at 5 m; 320x240: 1).
+int sample_stride(const Frame& frame, double spacing_m, double range_m, int most) {
+  if (most <= 1 || frame.cloud->height <= 1 || !(range_m > 0)) return 1;
+  const auto K = change::observation_camera(*frame.cloud, frame.intrinsics);
+  if (!K) return 1;
+  return std::clamp(static_cast<int>(std::floor(spacing_m * std::min(K->fx, K->fy) / range_m)), 1, most);
+}
+
 }  // namespace
 
 /// What geometric change detection made of one frame.
@@ -270,8 +281,10 @@ struct WorkingMemory::Impl {
     CloudConstPtr to_insert = frame.cloud;
     if (!changed.pending.empty()) to_insert = without_pending(*frame.cloud, changed.pending, changed.K);
     const auto t_ins = Clock::now();
+    const background::Config& b = config.background;
+    const int stride = sample_stride(frame, b.resolution_m, b.max_range_m, b.insert_stride_px);
     std::unique_lock<std::shared_mutex> write(map_mutex);
-    result.insert_stats = map.insert(*to_insert, T);
+    result.insert_stats = map.insert(*to_insert, T, stride);
     for (const auto& c : changed.confirmed) {
       if (c.before) map.set_voxels(c.before->points_world, background::Occupancy::kFree);
       if (c.after) map.set_voxels(c.after->points_world, background::Occupancy::kOccupied);
@@ -346,6 +359,8 @@ Status validate(const Config& c) {
   if (c.tracking.confirm_frames < 1 || c.tracking.confirm_frames > 100) return invalid_argument("tracking.confirm_frames: must be in [1, 100]");
   if (c.tracking.gone_frames < 1 || c.tracking.gone_frames > 100) return invalid_argument("tracking.gone_frames: must be in [1, 100]");
   if (!(c.tracking.max_range_m > 0 && c.tracking.max_range_m <= 20)) return invalid_argument("tracking.max_range_m: must be in (0, 20] m");
+  if (c.tracking.segmentation_stride_px < 1 || c.tracking.segmentation_stride_px > 8)
+    return invalid_argument("tracking.segmentation_stride_px: must be in [1, 8]");
   if (c.max_event_log < 1) return invalid_argument("events.max_log: must be >= 1");
   if (c.fusion.persistence_frames < 1 || c.fusion.persistence_frames > 100) return invalid_argument("events.appearance_persistence_frames: must be in [1, 100]");
   if (!(c.fusion.match_m > 0 && c.fusion.match_m <= 1)) return invalid_argument("events.appearance_match_m: must be in (0, 1] m");
@@ -391,7 +406,10 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   segmentation::Config seg = config_.segmentation;
   if (seg.up) seg.up = T.linear().transpose() * *seg.up;
   const auto t_seg = Clock::now();
-  segmentation::Segmentation s = segmentation::segment(*seen.cloud, seg, Eigen::Vector3d::Zero());
+  segmentation::Segmentation s =
+      segmentation::segment_strided(
+      *seen.cloud, seg, Eigen::Vector3d::Zero(),
+      sample_stride(seen, seg.voxel_size_m, config_.tracking.max_range_m, config_.tracking.segmentation_stride_px));
   result.segment_ms = ms_since(t_seg);
   for (auto& p : s.planes) result.planes.push_back(to_world(std::move(p), T));
   for (auto& o : s.objects) result.objects.push_back(to_world(std::move(o), T));

@@ -26,6 +26,11 @@ struct Config {
   /// Fast insertion only: a ray is cast from its end back towards the sensor and stops after this
   /// many voxels in a row already freed by other rays of the frame (0: every ray to the sensor).
   int ray_stop_after = 16;
+  /// The working memory's frames (organized, fast insertion): rays end at every Nth pixel of
+  /// every Nth row, N at most this and at most what keeps the samples within one voxel of each
+  /// other at max_range_m on a surface facing the camera (floor(resolution_m fx / max_range_m):
+  /// 2 for a VGA Kinect at 2 cm and 5 m). 1: every pixel. insert() itself takes its stride.
+  int insert_stride_px = 2;
 };
 
 /// Validates ranges; the message names the key (e.g. "background.resolution_m").
@@ -86,8 +91,10 @@ class OccupancyMap {
   OccupancyMap& operator=(OccupancyMap&&) noexcept;
 
   /// Inserts a cloud given in the camera frame, placed with T_world_camera; rays start at the
-  /// camera origin. Invalid points are skipped.
-  InsertStats insert(const Cloud& points_camera, const Pose& T_world_camera);
+  /// camera origin. Invalid points are skipped. `stride` > 1 (organized clouds, fast insertion
+  /// only): only every stride-th pixel of every stride-th row ends a ray, for clouds whose pixels
+  /// are much finer than a voxel (a VGA Kinect's are 1 cm apart at 5 m, a voxel 2 cm).
+  InsertStats insert(const Cloud& points_camera, const Pose& T_world_camera, int stride = 1);
 
   Occupancy query(const Eigen::Vector3d& p_world) const;
   /// True when the last insert() cast a ray through the voxel of p (and did not end in it): the

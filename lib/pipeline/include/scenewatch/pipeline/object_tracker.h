@@ -27,6 +27,12 @@ struct TrackingConfig {
   int confirm_frames = 1;    ///< sightings before a cluster joins the object list (1: at first sight)
   int gone_frames = 2;       ///< frames of seen-free space before an object leaves the list
   double max_range_m = 2.0;  ///< clusters whose centroid is farther from the camera are ignored
+  /// Each organized frame is segmented for the object list on every Nth pixel of every Nth row,
+  /// the objects then carried back to every pixel (segmentation::segment_strided). N is at most
+  /// this, and at most what keeps the samples within one segmentation voxel of each other at
+  /// max_range_m on a surface facing the camera (floor(voxel_size_m fx / max_range_m): 2 for a
+  /// VGA Kinect, 1 at 320x240). 1: every pixel.
+  int segmentation_stride_px = 2;
 };
 
 /// One cluster of the frame, in world coordinates, with sample points of its surface.
