@@ -22,67 +22,43 @@ Cloud decimate(const Cloud& cloud, int stride) {
   return samples;
 }
 
-// The pixel grid of the samples over the full-resolution cloud: each pixel takes the label of the
-// nearest valid sample among the (up to) four around it, when that sample lies within `reach_m`.
-class Upsampler {
- public:
-  Upsampler(const Cloud& cloud, const std::vector<int>& label_of_sample, int stride, double reach_m)
-      : cloud_(cloud), label_(label_of_sample), stride_(stride), w_(static_cast<int>(cloud.width)),
-        h_(static_cast<int>(cloud.height)), sw_((w_ + stride - 1) / stride), sh_((h_ + stride - 1) / stride),
-        reach2_(static_cast<float>(reach_m * reach_m)) {}
-
-  // The full-resolution points of label `l` whose samples are `samples` (sample indices),
-  // ascending. Only the pixels around those samples are visited.
-  std::vector<int> members(const std::vector<int>& samples, int l) const {
-    int su0 = sw_, su1 = -1, sv0 = sh_, sv1 = -1;
-    for (int s : samples) {
-      su0 = std::min(su0, s % sw_);
-      su1 = std::max(su1, s % sw_);
-      sv0 = std::min(sv0, s / sw_);
-      sv1 = std::max(sv1, s / sw_);
-    }
-    std::vector<int> out;
-    out.reserve(samples.size() * static_cast<std::size_t>(stride_ * stride_));
-    for (int v = std::max(0, (sv0 - 1) * stride_); v <= std::min(h_ - 1, (sv1 + 1) * stride_); ++v)
-      for (int u = std::max(0, (su0 - 1) * stride_); u <= std::min(w_ - 1, (su1 + 1) * stride_); ++u)
-        if (nearest_label(u, v, l) == l) out.push_back(v * w_ + u);
-    return out;
-  }
-
- private:
-  // The label of the nearest valid sample around pixel (u, v) within reach, or -1; returns -1 at
-  // once when no sample around carries `hint` (most of a bounding box).
-  int nearest_label(int u, int v, int hint) const {
-    std::array<int, 4> around{-1, -1, -1, -1};
-    bool any = false;
-    for (int k = 0; k < 4; ++k) {
-      const int su = u / stride_ + (k & 1), sv = v / stride_ + (k >> 1);
-      if (su >= sw_ || sv >= sh_) continue;
-      around[k] = sv * sw_ + su;
-      any = any || label_[around[k]] == hint;
-    }
-    const PointT& p = cloud_.points[static_cast<std::size_t>(v) * w_ + u];
-    if (!any || !is_valid(p)) return -1;
-    float best = std::numeric_limits<float>::infinity();
-    int label = -1;
-    for (int s : around) {
-      if (s < 0) continue;
-      const PointT& q = cloud_.points[static_cast<std::size_t>(s / sw_ * stride_) * w_ + (s % sw_) * stride_];
-      if (!is_valid(q)) continue;
-      const float d2 = (q.getVector3fMap() - p.getVector3fMap()).squaredNorm();
-      if (d2 < best) {
-        best = d2;
-        label = label_[s];
+// Full-resolution members of each labelled sample set: each pixel takes the label of the nearest
+// valid sample among the (up to) four around it, when that sample lies within `reach_m`. One pass
+// over the image; a pixel with no labelled sample around it costs four label reads.
+std::vector<std::vector<int>> upsample(const Cloud& cloud, const std::vector<int>& label_of_sample, std::size_t labels,
+                                       int stride, double reach_m) {
+  const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height);
+  const int sw = (w + stride - 1) / stride, sh = (h + stride - 1) / stride;
+  const auto reach2 = static_cast<float>(reach_m * reach_m);
+  std::vector<std::vector<int>> members(labels);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) {
+      std::array<int, 4> around{-1, -1, -1, -1};
+      bool any = false;
+      for (int k = 0; k < 4; ++k) {
+        const int su = u / stride + (k & 1), sv = v / stride + (k >> 1);
+        if (su >= sw || sv >= sh) continue;
+        around[k] = sv * sw + su;
+        any = any || label_of_sample[around[k]] >= 0;
       }
+      const PointT& p = cloud.points[static_cast<std::size_t>(v) * w + u];
+      if (!any || !is_valid(p)) continue;
+      float best = std::numeric_limits<float>::infinity();
+      int label = -1;
+      for (int s : around) {
+        if (s < 0) continue;
+        const PointT& q = cloud.points[static_cast<std::size_t>(s / sw * stride) * w + (s % sw) * stride];
+        if (!is_valid(q)) continue;
+        const float d2 = (q.getVector3fMap() - p.getVector3fMap()).squaredNorm();
+        if (d2 < best) {
+          best = d2;
+          label = label_of_sample[s];
+        }
+      }
+      if (label >= 0 && best <= reach2) members[label].push_back(v * w + u);
     }
-    return best <= reach2_ ? label : -1;
-  }
-
-  const Cloud& cloud_;
-  const std::vector<int>& label_;
-  int stride_, w_, h_, sw_, sh_;
-  float reach2_;
-};
+  return members;
+}
 
 }  // namespace
 
@@ -102,11 +78,10 @@ Segmentation segment_strided(const Cloud& cloud, const Config& config, const Eig
   std::vector<int> label(samples.size(), -1);
   for (std::size_t o = 0; o < out.objects.size(); ++o)
     for (int s : out.objects[o].indices) label[s] = static_cast<int>(o);
-  const Upsampler up(cloud, label, stride, config.voxel_size_m);
+  std::vector<std::vector<int>> members = upsample(cloud, label, out.objects.size(), stride, config.voxel_size_m);
   for (std::size_t o = 0; o < out.objects.size(); ++o) {
-    ObjectCluster& object = out.objects[o];
-    object.indices = up.members(object.indices, static_cast<int>(o));
-    object.point_count = object.indices.size();
+    out.objects[o].indices = std::move(members[o]);
+    out.objects[o].point_count = out.objects[o].indices.size();
   }
   const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height), sw = static_cast<int>(samples.width);
   for (Plane& plane : out.planes) {
