@@ -163,7 +163,7 @@ struct ChangeOutcome {
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
       : map(c.background), appearance(c.appearance, c.surprise), changes(c.change), tracker(c.tracking), fusion(c.fusion),
-        foreground(c.foreground), up(c.segmentation.up), snapshot(std::make_shared<SceneSnapshot>()) {}
+        foreground(c.foreground), snapshot(std::make_shared<SceneSnapshot>()), up(c.segmentation.up) {}
 
   // process() and the other writers hold this for their whole duration.
   mutable std::mutex writer;
