@@ -76,9 +76,13 @@ double cpu_ms() {
   return ms(u.ru_utime) + ms(u.ru_stime);
 }
 
-void offline(const Sequence& s) {
-  pipeline::Config config;
-  if (s.z_up) config.segmentation.up = Eigen::Vector3d::UnitZ();
+struct OfflineRun {
+  double median_frame_ms = 0, p90_frame_ms = 0, cpu_per_frame_ms = 0;
+  std::size_t events = 0;
+};
+
+// The frames through one working memory; prints the stages when `print`.
+std::optional<OfflineRun> offline(const Sequence& s, const pipeline::Config& config, bool print) {
   pipeline::WorkingMemory memory(config);
   std::map<std::string, std::vector<double>> ms;
   std::size_t events = 0;
@@ -88,7 +92,7 @@ void offline(const Sequence& s) {
     auto r = memory.process(f);
     if (!r) {
       std::printf("  %s: %s\n", s.name.c_str(), r.error().message.c_str());
-      return;
+      return std::nullopt;
     }
     ms["1 segmentation"].push_back(r->segment_ms);
     ms["2 image surprise + keyframes"].push_back(r->surprise_ms);
@@ -103,15 +107,36 @@ void offline(const Sequence& s) {
     events += r->events.size();
   }
   const double cpu_per_frame = (cpu_ms() - cpu0) / static_cast<double>(s.frames.size());
+  OfflineRun run{median(ms["9 frame (process)"]), quantile(ms["9 frame (process)"], 0.9), cpu_per_frame, events};
+  if (!print) return run;
   std::printf("-- %s: %zu frames, %zu events; decoding (PNG + cloud, before process) median %.1f ms\n", s.name.c_str(),
               s.frames.size(), events, median(s.decode_ms));
   std::printf("   %-46s %10s %10s\n", "stage", "median ms", "p90 ms");
   for (const auto& [stage, v] : ms)
     std::printf("   %-46s %10.1f %10.1f\n", stage.substr(2).c_str(), median(v), quantile(v, 0.9));
-  const double m = median(ms["9 frame (process)"]);
+  const double m = run.median_frame_ms;
   std::printf("   => %.1f frames/s offline (median frame); target 15 (66 ms), goal 30 (33 ms)\n", m > 0 ? 1000.0 / m : 0.0);
   std::printf("   CPU per frame, all threads: %.1f ms (mean), %.2f cores busy during process()\n", cpu_per_frame,
               wall_ms > 0 ? cpu_per_frame * s.frames.size() / wall_ms : 0.0);
+  return run;
+}
+
+// The defaults, after the same frames with every pixel segmented and inserted (the strides of
+// issue 11 at 1), in the same run.
+void offline_side_by_side(const Sequence& s) {
+  pipeline::Config config;
+  if (s.z_up) config.segmentation.up = Eigen::Vector3d::UnitZ();
+  pipeline::Config every_pixel = config;
+  every_pixel.tracking.segmentation_stride_px = 1;
+  every_pixel.background.insert_stride_px = 1;
+  const auto before = offline(s, every_pixel, false);
+  const auto now = offline(s, config, true);
+  if (!before || !now) return;
+  std::printf("   every pixel segmented and inserted, same run: frame median %.1f ms (p90 %.1f), CPU %.1f ms per frame, "
+              "%zu events; the defaults %.2fx faster (median), %.2fx less CPU\n",
+              before->median_frame_ms, before->p90_frame_ms, before->cpu_per_frame_ms, before->events,
+              now->median_frame_ms > 0 ? before->median_frame_ms / now->median_frame_ms : 0.0,
+              now->cpu_per_frame_ms > 0 ? before->cpu_per_frame_ms / now->cpu_per_frame_ms : 0.0);
 }
 
 #ifdef SCENEWATCH_BENCH_HAS_SERVICE
@@ -167,7 +192,7 @@ int run_pipeline(const Options& o) {
       std::printf("  (a sequence could not be loaded; skipped)\n");
       continue;
     }
-    offline(*s);
+    offline_side_by_side(*s);
     over_tcp(*s);
   }
   return 0;
