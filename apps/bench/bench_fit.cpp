@@ -28,14 +28,14 @@ struct Scene {
   segmentation::Config segmentation;
 };
 
-// Every n-th valid point, at most max_points, as fit_object takes them.
+// Evenly spaced valid points, at most max_points, as fit_object takes them.
 std::vector<int> subsample(const Cloud& cloud, const std::vector<int>& indices, int max_points) {
   std::vector<int> valid;
   for (const int i : indices)
     if (is_valid(cloud.points[static_cast<std::size_t>(i)])) valid.push_back(i);
-  const std::size_t stride = (valid.size() + static_cast<std::size_t>(max_points) - 1) / static_cast<std::size_t>(max_points);
-  std::vector<int> out;
-  for (std::size_t i = 0; i < valid.size(); i += std::max<std::size_t>(1, stride)) out.push_back(valid[i]);
+  const std::size_t m = std::min(valid.size(), static_cast<std::size_t>(max_points));
+  std::vector<int> out(m);
+  for (std::size_t i = 0; i < m; ++i) out[i] = valid[i * valid.size() / m];
   return out;
 }
 
