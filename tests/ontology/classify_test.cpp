@@ -268,7 +268,7 @@ class ClassifyRealTest : public ::testing::Test {
 TEST_F(ClassifyRealTest, YcbSoupCanFrame3) { check_ycb({"frame-000003", 225, 400, 0.0329}, shipped_classes()); }
 TEST_F(ClassifyRealTest, YcbTunaCanFrame4) { check_ycb({"frame-000004", 270, 395, 0.0420}, shipped_classes()); }
 
-// Frame 1: its can is 7.7 mm too wide (ycb_fit_test); here only: no other object is a can.
+// Frame 1: the can is a can of its radius (+1.0 mm, ycb_fit_test), and no other object is a can.
 TEST_F(ClassifyRealTest, YcbFrame1NothingElseIsACan) {
   const ClassLibrary library = shipped_classes();
   const RealScene s = segment_ycb("frame-000001");
@@ -283,6 +283,8 @@ TEST_F(ClassifyRealTest, YcbFrame1NothingElseIsACan) {
     print("frame-000001 object " + std::to_string(i) + (is_the_can ? " (the can)" : ""), *d);
     if (is_the_can) {
       EXPECT_EQ(d->class_name, "can");
+      ASSERT_TRUE(d->primitive);
+      EXPECT_NEAR(d->primitive->radius_m, 0.0329, 0.003);
     } else {
       EXPECT_NE(d->class_name, "can") << "object " << i;
     }

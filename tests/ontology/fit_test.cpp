@@ -77,7 +77,9 @@ TEST(FitTest, IndexOutsideTheCloudAndBadConfigAreErrors) {
 
 TEST(FitTest, AnExactHalfSphereIsASphereOfItsRadius) {
   const Cloud cloud = sphere_cloud(Eigen::Vector3d(0.05, -0.02, 0.9), 0.045, 4000);
-  const auto fit = fit_object(cloud, all(cloud));
+  FitConfig every_point;  // the shape detection on all 4000, not the default subsample
+  every_point.max_points = 4000;
+  const auto fit = fit_object(cloud, all(cloud), every_point);
   ASSERT_TRUE(fit.ok()) << fit.error().message;
   ASSERT_GE(fit->best, 0);
   const Primitive& best = fit->shapes[static_cast<std::size_t>(fit->best)];
@@ -105,6 +107,7 @@ TEST(FitTest, TwoFacesOfABoxAreTwoPlanesWithTheirPoints) {
   }
   FitConfig planes_only;
   planes_only.detect_cylinder = planes_only.detect_sphere = planes_only.detect_cone = false;
+  planes_only.max_points = 4000;  // all of them, not the default subsample
   const auto fit = fit_object(cloud, all(cloud), planes_only);
   ASSERT_TRUE(fit.ok()) << fit.error().message;
   ASSERT_EQ(fit->shapes.size(), 2u);

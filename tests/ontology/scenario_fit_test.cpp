@@ -97,8 +97,12 @@ void check(const char* name, const Truth& truth, double radius_tolerance_m, doub
   EXPECT_LT(axis_error_deg(*free_axis.cylinder), axis_tolerance_deg) << name;
 }
 
-// The issue asks for 2 mm and 2 degrees; measured: can -0.36 mm, 0.04 deg; cup -0.72 mm, 0.17 deg
-// (CGAL explains the cup as a cone of 1.2 degrees, refined as a cylinder).
+// The issue asks for 2 mm and 2 degrees; measured: can -0.89 mm, 0.09 deg; cup -0.42 mm, 0.13 deg
+// (CGAL explains the cup as a cone of 1.5 degrees, refined as a cylinder). The can was -0.37 mm
+// before the refinement left out the points near depth edges (FitConfig::edge_margin_deg, 2 of
+// the simulator's pixels): it does not flatten its silhouettes as the Xtion does, and the
+// narrower arc fits a smaller circle (without the margin the radius moves by 0.2 mm over frames 0,
+// 7, 19 and 33 of the phase: the change is not noise).
 TEST(ScenarioFitTest, CanOfKnownRadiusAtAboutOneMetre) { check("can r 33 mm", {0, 0, 2, 0.033}, 0.001, 0.5); }
 TEST(ScenarioFitTest, CupOfKnownRadiusAtAboutOneMetre) { check("cup r 40 mm", {1, 0, 4, 0.040}, 0.001, 0.5); }
 

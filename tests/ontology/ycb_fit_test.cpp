@@ -80,15 +80,16 @@ class YcbFitTest : public ::testing::Test {
   void SetUp() override { SCENEWATCH_REQUIRE_DATA("ycb/frame-000003.depth.png"); }
 };
 
-// Tolerances a little above the errors measured (README, `scenewatch fit`). Frame 1's can comes
-// out 7.7 mm too wide: the arc it shows (113 degrees, partly hidden by the mustard bottle) is
-// flatter than the model's; the issue asks for 3 mm, this is a known shortfall, pinned so that it
-// cannot silently get worse.
-const CanView kSoupFrame3{"frame-000003", 225, 400, 0.0329, 0.001, 0.03};
-const CanView kSoupFrame1{"frame-000001", 430, 330, 0.0329, 0.0085};
+// Tolerances a little above the errors measured (README, `scenewatch fit`): frame 3 -1.4 mm,
+// frame 1 +1.0 mm, frame 4 -0.4 mm. Frame 1's can was 7.7 mm too wide while the points within a
+// few pixels of its silhouette and of the mustard bottle pulled the fit: the Xtion flattens the
+// depth there (FitConfig::edge_margin_deg); leaving them out costs frame 3 2.1 mm (+0.7 before)
+// and the simulator's can 0.5 mm (scenario_fit_test), whose seen arcs are wider.
+const CanView kSoupFrame3{"frame-000003", 225, 400, 0.0329, 0.0015, 0.03};
+const CanView kSoupFrame1{"frame-000001", 430, 330, 0.0329, 0.0015};
 // The tablet of frame 4 is mostly covered (by the pitcher, the mustard and the can): found as a
 // support from 0.02 m2 with up to 6 planes. The can is short and wide: shape detection calls it
-// a sphere, the cylinder comes from the upright circle fit (-0.6 mm).
+// a sphere, the cylinder comes from the upright circle fit (-0.4 mm).
 const CanView kTunaFrame4{"frame-000004", 270, 395, 0.0420, 0.001, 0.02, 6};
 
 void check(const CanView& can) {

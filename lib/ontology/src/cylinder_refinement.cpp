@@ -33,10 +33,12 @@ double cost(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& 
 }
 
 // Points within the band of the cylinder whose normals point away from its axis.
+// `excluded` (empty, or one flag per point): points left out.
 std::vector<int> select_band(const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
-                             const State& s, const FitConfig& config) {
+                             const State& s, const FitConfig& config, const std::vector<char>& excluded = {}) {
   std::vector<int> band;
   for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!excluded.empty() && excluded[i]) continue;
     const Eigen::Vector3d d = points[i] - s.c;
     const Eigen::Vector3d perp = d - d.dot(s.a) * s.a;
     const double dist = perp.norm();
@@ -139,13 +141,17 @@ double angular_coverage_deg(const std::vector<Eigen::Vector3d>& points, const Ei
 
 std::optional<CylinderFit> refine_cylinder(const std::vector<Eigen::Vector3d>& points,
                                            const std::vector<Eigen::Vector3d>& normals, const CylinderGuess& guess,
-                                           bool fix_axis, const FitConfig& config) {
+                                           bool fix_axis, const FitConfig& config, const std::vector<char>& untrusted) {
   State s{guess.point, guess.axis.normalized(), guess.radius_m};
   if (!s.c.allFinite() || !s.a.allFinite() || !(s.r > 0)) return std::nullopt;
   CylinderFit fit;
   std::vector<int> band;
   for (int round = 0; round < std::max(1, config.refine_rounds); ++round) {
-    band = select_band(points, normals, s, config);
+    band = select_band(points, normals, s, config, untrusted);
+    // Too few trusted points (a small or thin object, all near an edge): fit on all of them.
+    if (band.size() < static_cast<std::size_t>(config.min_points) && !untrusted.empty()) {
+      band = select_band(points, normals, s, config);
+    }
     if (band.size() < static_cast<std::size_t>(config.min_points)) return std::nullopt;
     recenter(points, band, s);
     fit.iterations += levenberg_marquardt(points, band, fix_axis, config.huber_m, s);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "depth_edges.h"
 #include "efficient_ransac.h"
 #include "normals.h"
 #include "scenewatch/ontology/cylinder_refinement.h"
@@ -34,6 +35,8 @@ Status validate(const FitConfig& c) {
   if (!(c.refine_min_normal_cos >= 0 && c.refine_min_normal_cos <= 1)) return bad("refine_min_normal_cos", "must be in [0, 1]");
   if (c.refine_rounds < 1) return bad("refine_rounds", "must be at least 1");
   if (!(c.huber_m > 0)) return bad("huber_m", "must be positive");
+  if (!(c.edge_margin_deg >= 0 && c.edge_margin_deg <= 10)) return bad("edge_margin_deg", "must be in [0, 10]");
+  if (!(c.edge_jump_m > 0)) return bad("edge_jump_m", "must be positive");
   if (!(c.cylinder_max_cone_deg >= 0 && c.cylinder_max_cone_deg < 90)) return bad("cylinder_max_cone_deg", "must be in [0, 90)");
   return {};
 }
@@ -58,10 +61,11 @@ Result<ObjectFit> fit_object(const Cloud& cloud, const std::vector<int>& indices
   }
   ObjectFit out;
   out.points = valid.size();
-  // Every n-th point: a bounded fit time for near, dense objects.
-  const std::size_t stride = (valid.size() + static_cast<std::size_t>(config.max_points) - 1) / static_cast<std::size_t>(config.max_points);
-  std::vector<int> used;
-  for (std::size_t i = 0; i < valid.size(); i += stride) used.push_back(valid[i]);
+  // Evenly spaced points, max_points of them (a fractional stride: 3184 points become 3000, not
+  // every second one): a bounded fit time for near, dense objects.
+  const std::size_t m = std::min(valid.size(), static_cast<std::size_t>(config.max_points));
+  std::vector<int> used(m);
+  for (std::size_t i = 0; i < m; ++i) used[i] = valid[i * valid.size() / m];
 
   auto t0 = Clock::now();
   const int k = std::min<int>(config.normal_neighbours, static_cast<int>(used.size()) - 1);
@@ -110,6 +114,8 @@ Result<ObjectFit> fit_object(const Cloud& cloud, const std::vector<int>& indices
   out.detection_ms = ms_since(t0);
 
   t0 = Clock::now();
+  const std::vector<char> near_edge = detail::near_depth_edge(cloud, kept, config.edge_margin_deg, config.edge_jump_m,
+                                                                  sensor_origin);
   const bool upright = config.axis_prior == AxisPrior::kUpright && up.has_value();
   const Eigen::Vector3d up_unit = up ? up->normalized() : Eigen::Vector3d::UnitZ();
   std::optional<CylinderFit> cylinder;
@@ -131,10 +137,10 @@ Result<ObjectFit> fit_object(const Cloud& cloud, const std::vector<int>& indices
     const double tilt_deg = std::acos(std::min(1.0, std::abs(c.direction.dot(up_unit)))) * 180.0 / M_PI;
     const bool fix = upright && tilt_deg <= config.upright_tolerance_deg;
     if (fix) guess.axis = up_unit;
-    cylinder = refine_cylinder(points, normals, guess, fix, config);
+    cylinder = refine_cylinder(points, normals, guess, fix, config, near_edge);
   } else if (upright && config.detect_cylinder) {
     if (auto guess = upright_guess(points, normals, up_unit, config)) {
-      cylinder = refine_cylinder(points, normals, *guess, true, config);
+      cylinder = refine_cylinder(points, normals, *guess, true, config, near_edge);
       if (cylinder) cylinder->from_detection = false;
     }
   }
@@ -148,6 +154,7 @@ Result<ObjectFit> fit_object(const Cloud& cloud, const std::vector<int>& indices
   out.refinement_ms = ms_since(t0);
   out.sample_points = std::move(points);
   out.sample_normals = std::move(normals);
+  out.sample_near_edge = near_edge;
   return out;
 }
 

@@ -69,7 +69,10 @@ std::pair<double, double> height_extent(ShapeFit& fit, const std::vector<Eigen::
   return {lo, hi};
 }
 
-void measure_vessel(ShapeFit& fit, const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals) {
+// `near_edge` (empty, or one flag per point): points near a depth edge, whose biased normals do
+// not count as the inside wall (the far rim of a can's lid seen at a grazing angle would).
+void measure_vessel(ShapeFit& fit, const std::vector<Eigen::Vector3d>& points, const std::vector<Eigen::Vector3d>& normals,
+                    const std::vector<char>& near_edge) {
   const double h = 0.5 * fit.height_m;
   std::size_t inner = 0;
   std::vector<Eigen::Vector3d> side;
@@ -87,7 +90,8 @@ void measure_vessel(ShapeFit& fit, const std::vector<Eigen::Vector3d>& points, c
       squares += (rho - r) * (rho - r);
     }
     // The inside wall, seen over the rim: inside the solid, above its lower fifth, facing the axis.
-    if (rho < r - 0.003 && rho > 0.3 * r && t > -h + 0.2 * fit.height_m && outward < -0.5) ++inner;
+    const bool trusted = near_edge.size() != points.size() || !near_edge[i];
+    if (trusted && rho < r - 0.003 && rho > 0.3 * r && t > -h + 0.2 * fit.height_m && outward < -0.5) ++inner;
   }
   fit.inner_fraction = points.empty() ? 0 : static_cast<double>(inner) / static_cast<double>(points.size());
   fit.coverage_deg = side.size() >= 3 ? angular_coverage_deg(side, fit.center, fit.axis) : 0.0;
@@ -104,7 +108,7 @@ std::optional<ShapeFit> fit_cylinder(const std::vector<Eigen::Vector3d>& points,
   fit.radius_m = fit.bottom_radius_m = fit.top_radius_m = object.cylinder->radius_m;
   height_extent(fit, points);
   fit.axis_tilt_deg = std::acos(std::min(1.0, std::abs(fit.axis.dot(up)))) * kDeg;
-  measure_vessel(fit, points, normals);
+  measure_vessel(fit, points, normals, object.sample_near_edge);
   return fit;
 }
 
@@ -162,7 +166,7 @@ std::optional<ShapeFit> fit_frustum(const std::vector<Eigen::Vector3d>& points, 
   if (!(fit.bottom_radius_m > 0 && fit.top_radius_m > 0)) return std::nullopt;
   fit.radius_m = 0.5 * (fit.bottom_radius_m + fit.top_radius_m);
   fit.taper_deg = std::atan(x(3)) * kDeg;
-  measure_vessel(fit, points, normals);
+  measure_vessel(fit, points, normals, object.sample_near_edge);
   return fit;
 }
 

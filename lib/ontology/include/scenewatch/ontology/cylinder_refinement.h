@@ -22,11 +22,15 @@ struct CylinderGuess {
 /// Refines `guess` on `points` (with unit `normals` of the same size, oriented towards the sensor,
 /// or empty: no normal test).
 /// With `fix_axis` the axis stays guess.axis (upright prior) and only position and radius move.
+/// `untrusted` (empty, or one flag per point) marks points that do not pull the fit (depth biased
+/// near a depth edge) unless fewer than config.min_points others lie near the cylinder; they are
+/// still reported among the inliers (height, rms, coverage: the seen surface).
 /// The indices of the result are positions in `points`. Empty when fewer than config.min_points
 /// points lie near the cylinder or the fit degenerates (radius <= 0 or not finite).
 std::optional<CylinderFit> refine_cylinder(const std::vector<Eigen::Vector3d>& points,
                                            const std::vector<Eigen::Vector3d>& normals, const CylinderGuess& guess,
-                                           bool fix_axis, const FitConfig& config);
+                                           bool fix_axis, const FitConfig& config,
+                                           const std::vector<char>& untrusted = {});
 
 /// An upright starting cylinder: algebraic circle fit (Kasa) of the points whose normals are
 /// within 60 degrees of horizontal, projected along `up`. Empty when too few such points.
