@@ -452,5 +452,34 @@ TEST(HandDetector, ConfigValidation) {
   EXPECT_TRUE(detect_hands(wall, off).hands.empty());
 }
 
+// The remembered support planes (HandMemory) against the detector that searches them in every
+// frame, the oracle: on the hrt1 recordings (fixed camera) the same hands, pixel for pixel or
+// nearly (a remembered plane is not refitted to the frame's noise).
+TEST(HandDetector, RememberedPlanesGiveTheSameHandsOnHrt1) {
+  for (const std::string name : {"pick_toy_1", "pick_toy_2"}) {
+    SCENEWATCH_REQUIRE_DATA("hrt1/" + name);
+    auto seq = io::open_sequence(test::data_dir() / "hrt1" / name);
+    ASSERT_TRUE(seq.ok());
+    HandMemory memory;
+    std::size_t same = 0, both = 0, frames = 0;
+    for (std::size_t f = 0; f < seq->frames.size(); ++f) {
+      auto frame = io::load_sequence_frame(*seq, f);
+      ASSERT_TRUE(frame.ok());
+      const HandDetection searched = detect_hands(*frame->cloud, HandConfig{});
+      const HandDetection remembered = detect_hands(*frame->cloud, HandConfig{}, &memory);
+      ++frames;
+      EXPECT_EQ(searched.hands.size(), remembered.hands.size()) << name << " frame " << f;
+      for (std::size_t i = 0; i < searched.labels.size(); ++i) {
+        const bool a = searched.labels[i] == AgentLabel::kHand, b = remembered.labels[i] == AgentLabel::kHand;
+        same += a && b;
+        both += a || b;
+      }
+    }
+    const double iou = both ? static_cast<double>(same) / both : 1.0;
+    std::printf("%s: hand proper's pixels, remembered vs searched planes: IoU %.4f over %zu frames\n", name.c_str(), iou, frames);
+    EXPECT_GT(iou, 0.95);
+  }
+}
+
 }  // namespace
 }  // namespace scenewatch::foreground

@@ -29,6 +29,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "frame_grid.h"
+#include "plane_memory.h"
 #include "skin_model.h"
 #include "support_plane.h"
 
@@ -99,7 +100,22 @@ struct Candidate {
 
 }  // namespace
 
+struct HandMemory::Planes {
+  PlaneMemory tables;  ///< near-horizontal: table and floor
+  PlaneMemory walls;
+};
+
+HandMemory::HandMemory() : planes_(std::make_unique<Planes>()) {}
+HandMemory::~HandMemory() = default;
+HandMemory::HandMemory(HandMemory&&) noexcept = default;
+HandMemory& HandMemory::operator=(HandMemory&&) noexcept = default;
+void HandMemory::reset() { *planes_ = Planes{}; }
+
 HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
+  return detect_hands(organized, config, nullptr);
+}
+
+HandDetection detect_hands(const Cloud& organized, const HandConfig& config, HandMemory* memory) {
   const auto t0 = Clock::now();
   HandDetection d;
   d.width = static_cast<int>(organized.width);
@@ -160,7 +176,8 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
     }
   }
   std::vector<std::uint8_t> coarse_table, coarse_wall;
-  const std::vector<SupportPlane> planes = find_support_planes(coarse_p, coarse_valid, cw, ch, plane_config, &coarse_table);
+  const std::vector<SupportPlane> planes = find_support_planes(coarse_p, coarse_valid, cw, ch, plane_config, &coarse_table,
+                                                                  memory ? &memory->planes().tables : nullptr);
   // Then walls: any plane covering a good part of what is left. A person's body is never that
   // large and flat; without this the body grows into a wall it stands close to.
   std::vector<std::uint8_t> rest(coarse_p.size(), 0);
@@ -168,7 +185,8 @@ HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
   SupportPlaneConfig wall_config = plane_config;
   wall_config.min_abs_normal_y = 0.0f;
   wall_config.min_fraction = kMinWallFraction;
-  const std::vector<SupportPlane> walls = find_support_planes(coarse_p, rest, cw, ch, wall_config, &coarse_wall);
+  const std::vector<SupportPlane> walls = find_support_planes(coarse_p, rest, cw, ch, wall_config, &coarse_wall,
+                                                                 memory ? &memory->planes().walls : nullptr);
   // Distance to the table or floor, for telling an arm held up from an object lying there.
   std::vector<float> plane_distance(n, std::numeric_limits<float>::infinity());
   cv::Mat on_support(g.h, g.w, CV_8U, cv::Scalar(0));

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace scenewatch::foreground {
 namespace {
@@ -62,9 +63,12 @@ Pose best_spin(const Cloud& model, const Pose& T, const pcl::search::KdTree<Poin
   const float gate2 = static_cast<float>(config.inlier_m * config.inlier_m);
   std::vector<int> k(1);
   std::vector<float> d2(1);
-  auto cost = [&](const Pose& P) {
+  // A turn's cost only grows point by point: once it reaches the best so far the turn has lost,
+  // and the rest of its points need no search (the same answer at a fraction of the queries).
+  auto cost = [&](const Pose& P, double bound) {
     double c = 0;
     for (const auto& p : model.points) {
+      if (c >= bound) return c;
       PointT q = p;
       q.getVector3fMap() = (P * p.getVector3fMap().cast<double>()).cast<float>();
       if (tree.nearestKSearch(q, 1, k, d2) < 1 || d2[0] > gate2) {
@@ -76,7 +80,7 @@ Pose best_spin(const Cloud& model, const Pose& T, const pcl::search::KdTree<Poin
     return c;
   };
   Pose best = T;
-  double best_cost = cost(T);
+  double best_cost = cost(T, std::numeric_limits<double>::infinity());
   const Eigen::Vector3d centre = T.translation();
   for (double a = -config.spin_search_deg; a <= config.spin_search_deg + 1e-9; a += config.spin_step_deg) {
     if (std::abs(a) < 1e-9) continue;
@@ -84,7 +88,7 @@ Pose best_spin(const Cloud& model, const Pose& T, const pcl::search::KdTree<Poin
     spin.linear() = Eigen::AngleAxisd(a * M_PI / 180.0, up.normalized()).toRotationMatrix();
     spin.translation() = centre - spin.linear() * centre;
     const Pose P = spin * T;
-    const double c = cost(P);
+    const double c = cost(P, best_cost);
     if (c < best_cost) best_cost = c, best = P;
   }
   return best;

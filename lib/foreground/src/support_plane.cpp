@@ -54,6 +54,14 @@ bool refit(const std::vector<Eigen::Vector3f>& points, const std::vector<int>& m
   return true;
 }
 
+}  // namespace
+
+std::size_t min_plane_inliers(const SupportPlaneConfig& config, std::size_t valid_points) {
+  return std::max<std::size_t>(50, static_cast<std::size_t>(config.min_fraction * valid_points));
+}
+
+namespace {
+
 void orient_towards_camera(SupportPlane* plane) {
   if (plane->d < 0) {
     plane->normal = -plane->normal;
@@ -73,7 +81,7 @@ std::vector<SupportPlane> find_support_planes(const std::vector<Eigen::Vector3f>
     if (valid[i]) remaining.push_back(static_cast<int>(i));
   }
   const std::size_t total = remaining.size();
-  const std::size_t min_inliers = std::max<std::size_t>(50, static_cast<std::size_t>(config.min_fraction * total));
+  const std::size_t min_inliers = min_plane_inliers(config, total);
   Lcg rng;
   for (int round = 0; round < config.max_planes && remaining.size() >= min_inliers; ++round) {
     // Score hypotheses on an evenly spaced subsample; count exactly on all remaining points after.
@@ -122,42 +130,50 @@ std::vector<SupportPlane> find_support_planes(const std::vector<Eigen::Vector3f>
       inliers.swap(refined_inliers);
       outliers.swap(refined_outliers);
     }
-    // Keep the large connected patches of inliers (8-connected on the grid).
-    cv::Mat mask(height, width, CV_8U, cv::Scalar(0));
-    for (int i : inliers) mask.data[i] = 1;
-    cv::Mat labels, stats, centroids;
-    const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
-    const int min_patch = std::max(20, static_cast<int>(config.min_patch_fraction * total));
-    std::vector<Eigen::Vector3d> sum(static_cast<std::size_t>(count), Eigen::Vector3d::Zero());
-    std::vector<Eigen::Matrix3d> outer(static_cast<std::size_t>(count), Eigen::Matrix3d::Zero());
-    for (int i : inliers) {
-      const int c = labels.ptr<int>()[i];
-      const Eigen::Vector3d q = points[i].cast<double>();
-      sum[c] += q;
-      outer[c] += q * q.transpose();
-    }
-    std::vector<std::uint8_t> keep(static_cast<std::size_t>(count), 0);
-    std::size_t kept = 0;
-    for (int c = 1; c < count; ++c) {
-      const int area = stats.at<int>(c, cv::CC_STAT_AREA);
-      if (area < min_patch) continue;
-      const Eigen::Vector3d mean = sum[c] / area;
-      const Eigen::Matrix3d cov = outer[c] / area - mean * mean.transpose();
-      const Eigen::Vector3d spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov, Eigen::EigenvaluesOnly).eigenvalues();
-      if (std::sqrt(std::max(0.0, spread(1))) < config.min_patch_width_m) continue;
-      keep[c] = 1;
-      kept += static_cast<std::size_t>(area);
-    }
     remaining.swap(outliers);  // all inliers leave, so the next round finds another plane
-    if (kept < min_inliers) continue;
-    for (int i : inliers) {
-      if (keep[labels.ptr<int>()[i]]) (*on_plane)[i] = 1;
-    }
+    const std::size_t kept = keep_large_patches(points, inliers, width, height, config, total, min_inliers, on_plane);
+    if (kept == 0) continue;
     best.inliers = kept;
     orient_towards_camera(&best);
     planes.push_back(best);
   }
   return planes;
+}
+
+std::size_t keep_large_patches(const std::vector<Eigen::Vector3f>& points, const std::vector<int>& inliers, int width,
+                               int height, const SupportPlaneConfig& config, std::size_t total, std::size_t min_inliers,
+                               std::vector<std::uint8_t>* on_plane) {
+  // Keep the large connected patches of inliers (8-connected on the grid).
+  cv::Mat mask(height, width, CV_8U, cv::Scalar(0));
+  for (int i : inliers) mask.data[i] = 1;
+  cv::Mat labels, stats, centroids;
+  const int count = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8, CV_32S);
+  const int min_patch = std::max(20, static_cast<int>(config.min_patch_fraction * total));
+  std::vector<Eigen::Vector3d> sum(static_cast<std::size_t>(count), Eigen::Vector3d::Zero());
+  std::vector<Eigen::Matrix3d> outer(static_cast<std::size_t>(count), Eigen::Matrix3d::Zero());
+  for (int i : inliers) {
+    const int c = labels.ptr<int>()[i];
+    const Eigen::Vector3d q = points[i].cast<double>();
+    sum[c] += q;
+    outer[c] += q * q.transpose();
+  }
+  std::vector<std::uint8_t> keep(static_cast<std::size_t>(count), 0);
+  std::size_t kept = 0;
+  for (int c = 1; c < count; ++c) {
+    const int area = stats.at<int>(c, cv::CC_STAT_AREA);
+    if (area < min_patch) continue;
+    const Eigen::Vector3d mean = sum[c] / area;
+    const Eigen::Matrix3d cov = outer[c] / area - mean * mean.transpose();
+    const Eigen::Vector3d spread = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov, Eigen::EigenvaluesOnly).eigenvalues();
+    if (std::sqrt(std::max(0.0, spread(1))) < config.min_patch_width_m) continue;
+    keep[c] = 1;
+    kept += static_cast<std::size_t>(area);
+  }
+  if (kept < min_inliers) return 0;
+  for (int i : inliers) {
+    if (keep[labels.ptr<int>()[i]]) (*on_plane)[i] = 1;
+  }
+  return kept;
 }
 
 }  // namespace scenewatch::foreground

@@ -45,4 +45,14 @@ std::vector<SupportPlane> find_support_planes(const std::vector<Eigen::Vector3f>
                                               const std::vector<std::uint8_t>& valid, int width, int height,
                                               const SupportPlaneConfig& config, std::vector<std::uint8_t>* on_plane);
 
+/// The fewest points on a plane for it to count as large, of `valid_points` valid ones.
+std::size_t min_plane_inliers(const SupportPlaneConfig& config, std::size_t valid_points);
+
+/// Of a plane's `inliers` (grid indices), the large and wide connected patches: sets on_plane[i] = 1
+/// for their points and returns how many they are, or 0 (and sets nothing) when fewer than
+/// `min_inliers`. `total`: the valid points of the grid, which min_patch_fraction is of.
+std::size_t keep_large_patches(const std::vector<Eigen::Vector3f>& points, const std::vector<int>& inliers, int width,
+                               int height, const SupportPlaneConfig& config, std::size_t total, std::size_t min_inliers,
+                               std::vector<std::uint8_t>* on_plane);
+
 }  // namespace scenewatch::foreground

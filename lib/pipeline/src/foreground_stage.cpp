@@ -98,7 +98,7 @@ Frame ForegroundStage::prepare(const Frame& frame, std::uint64_t frame_index, co
 
   const auto t_hands = Clock::now();
   if (config_.hands.enabled && frame.has_color && frame.cloud->height > 1) {
-    detection_ = foreground::detect_hands(*frame.cloud, config_.hands);
+    detection_ = foreground::detect_hands(*frame.cloud, config_.hands, &hand_memory_);
     drop_static_hands(*frame.cloud, T, occupied);
   }
   view_.hands = &detection_;
@@ -143,6 +143,7 @@ foreground::ForegroundUpdate ForegroundStage::update(const std::vector<ObjectClu
 
 void ForegroundStage::reset() {
   tracker_.reset();
+  hand_memory_.reset();
   recent_hands_.clear();
   hands_ = HandsSeen{};
   cloud_.reset();

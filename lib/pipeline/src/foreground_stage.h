@@ -37,6 +37,7 @@ class ForegroundStage {
  private:
   foreground::ForegroundConfig config_;
   foreground::ForegroundTracker tracker_;
+  foreground::HandMemory hand_memory_;  // the support planes, from frame to frame
   // This frame's, between prepare() and update().
   foreground::HandDetection detection_;
   foreground::FrameView view_;

@@ -7,6 +7,7 @@
 /// in view (body, head) is a dynamic agent: neither a background change nor an object, and never
 /// written into the background map.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "scenewatch/core/cloud.h"
@@ -76,5 +77,27 @@ Status validate(const HandConfig& config);
 /// wide as a forearm and cut by the border is a known source of false hands. Stateless: safe to
 /// call from several threads at once.
 HandDetection detect_hands(const Cloud& organized, const HandConfig& config);
+
+/// What the detector keeps between the frames of one stream: the table, floor and walls it found,
+/// which it checks cheaply on the next frames instead of searching for them again while they still
+/// explain the frame (a fixed camera's table does not move). NOT thread safe: one per stream.
+class HandMemory {
+ public:
+  HandMemory();
+  ~HandMemory();
+  HandMemory(HandMemory&&) noexcept;
+  HandMemory& operator=(HandMemory&&) noexcept;
+  /// Forgets the planes (a new stream, or the camera moved).
+  void reset();
+  struct Planes;  ///< private to the detector
+  Planes& planes() { return *planes_; }
+
+ private:
+  std::unique_ptr<Planes> planes_;
+};
+
+/// detect_hands for a stream of frames: the same detection, with the support planes taken from
+/// `memory` while they hold (memory == nullptr: as detect_hands above).
+HandDetection detect_hands(const Cloud& organized, const HandConfig& config, HandMemory* memory);
 
 }  // namespace scenewatch::foreground
