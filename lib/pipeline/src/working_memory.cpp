@@ -406,10 +406,8 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   segmentation::Config seg = config_.segmentation;
   if (seg.up) seg.up = T.linear().transpose() * *seg.up;
   const auto t_seg = Clock::now();
-  segmentation::Segmentation s =
-      segmentation::segment_strided(
-      *seen.cloud, seg, Eigen::Vector3d::Zero(),
-      sample_stride(seen, seg.voxel_size_m, config_.tracking.max_range_m, config_.tracking.segmentation_stride_px));
+  const int stride = sample_stride(seen, seg.voxel_size_m, config_.tracking.max_range_m, config_.tracking.segmentation_stride_px);
+  segmentation::Segmentation s = segmentation::segment_strided(*seen.cloud, seg, Eigen::Vector3d::Zero(), stride);
   result.segment_ms = ms_since(t_seg);
   for (auto& p : s.planes) result.planes.push_back(to_world(std::move(p), T));
   for (auto& o : s.objects) result.objects.push_back(to_world(std::move(o), T));
