@@ -139,14 +139,20 @@ CloudConstPtr without_pending(const Cloud& cloud, const std::vector<change::Chan
   return masked;
 }
 
-// How many pixels apart a frame may be sampled for work on a grid of `spacing_m`: at most `most`,
-// and only as coarse as keeps the samples within one grid cell of each other on a surface facing
-// the camera at `range_m` (a VGA Kinect: 2 for the segmentation's 1 cm at 2 m and for the map's
-// 2 cm at 5 m; 320x240: 1).
-int sample_stride(const Frame& frame, double spacing_m, double range_m, int most) {
-  if (most <= 1 || frame.cloud->height <= 1 || !(range_m > 0)) return 1;
-  const auto K = change::observation_camera(*frame.cloud, frame.intrinsics);
-  if (!K) return 1;
+// The camera a frame is seen with: its intrinsics, else recovered from its organized cloud (or a
+// virtual one for an unorganized cloud; change::observation_camera). Found once per frame.
+std::optional<Intrinsics> frame_camera(const Frame& frame) {
+  auto K = change::observation_camera(*frame.cloud, frame.intrinsics);
+  if (!K) return std::nullopt;
+  return *K;
+}
+
+// How many pixels apart an organized frame seen by camera K may be sampled for work on a grid of
+// `spacing_m`: at most `most`, and only as coarse as keeps the samples within one grid cell of each
+// other on a surface facing the camera at `range_m` (a VGA Kinect: 2 for the segmentation's 1 cm
+// at 2 m and for the map's 2 cm at 5 m; 320x240: 1).
+int sample_stride(const Frame& frame, const std::optional<Intrinsics>& K, double spacing_m, double range_m, int most) {
+  if (most <= 1 || frame.cloud->height <= 1 || !(range_m > 0) || !K) return 1;
   return std::clamp(static_cast<int>(std::floor(spacing_m * std::min(K->fx, K->fy) / range_m)), 1, most);
 }
 
@@ -251,9 +257,9 @@ struct WorkingMemory::Impl {
   // against the model that predates them (OctoMap's log-odds would absorb a new object, or erode
   // a removed one, within a few frames). A frame whose region is too large for a dense grid is
   // left without change detection.
-  ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const change::Config& config) {
+  ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
+                               const change::Config& config) {
     ChangeOutcome out;
-    auto K = change::observation_camera(*frame.cloud, frame.intrinsics);
     if (!K) return out;
     out.K = *K;
     std::shared_lock<std::shared_mutex> read(map_mutex);
@@ -270,11 +276,12 @@ struct WorkingMemory::Impl {
   // Change detection against the map as it stands before this frame, then the frame into the
   // map (without the points of unconfirmed candidates); confirmed changes are written into it at
   // once. Runs beside the segmentation and the image surprise, which do not read the map.
-  ChangeOutcome update_map(const Frame& frame, const Pose& T, const Config& config, FrameResult& result) {
+  ChangeOutcome update_map(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                           FrameResult& result) {
     ChangeOutcome changed;
     if (config.change_enabled && frames > 0) {
       const auto t_change = Clock::now();
-      changed = detect_changes(frame, T, config.change);
+      changed = detect_changes(frame, T, K, config.change);
       result.change_ms = ms_since(t_change);
       result.change_candidates = changes.candidates();
     }
@@ -282,7 +289,7 @@ struct WorkingMemory::Impl {
     if (!changed.pending.empty()) to_insert = without_pending(*frame.cloud, changed.pending, changed.K);
     const auto t_ins = Clock::now();
     const background::Config& b = config.background;
-    const int stride = sample_stride(frame, b.resolution_m, b.max_range_m, b.insert_stride_px);
+    const int stride = sample_stride(frame, K, b.resolution_m, b.max_range_m, b.insert_stride_px);
     std::unique_lock<std::shared_mutex> write(map_mutex);
     result.insert_stats = map.insert(*to_insert, T, stride);
     for (const auto& c : changed.confirmed) {
@@ -394,19 +401,21 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   // update (the octree), and the segmentation of the frame (this thread). None reads what another
   // writes; the tracker and the event fusion below need all three.
   const auto known_surfaces = m.current_known_surfaces();
+  const std::optional<Intrinsics> camera = frame_camera(seen);
   const auto t_parallel = Clock::now();
   auto surprise = std::async(std::launch::async, [&] {
     const auto t_surprise = Clock::now();
     result.surprise = m.appearance.process(seen, known_surfaces);  // then its keyframe update
     result.surprise_ms = ms_since(t_surprise);
   });
-  auto map_update = std::async(std::launch::async, [&] { return m.update_map(seen, T, config_, result); });
+  auto map_update = std::async(std::launch::async, [&] { return m.update_map(seen, T, camera, config_, result); });
 
   // Segment in the camera frame (indices stay those of the input cloud), then move to the world.
   segmentation::Config seg = config_.segmentation;
   if (seg.up) seg.up = T.linear().transpose() * *seg.up;
   const auto t_seg = Clock::now();
-  const int stride = sample_stride(seen, seg.voxel_size_m, config_.tracking.max_range_m, config_.tracking.segmentation_stride_px);
+  const int stride =
+      sample_stride(seen, camera, seg.voxel_size_m, config_.tracking.max_range_m, config_.tracking.segmentation_stride_px);
   segmentation::Segmentation s = segmentation::segment_strided(*seen.cloud, seg, Eigen::Vector3d::Zero(), stride);
   result.segment_ms = ms_since(t_seg);
   for (auto& p : s.planes) result.planes.push_back(to_world(std::move(p), T));
