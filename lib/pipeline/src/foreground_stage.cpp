@@ -1,5 +1,6 @@
 #include "foreground_stage.h"
 
+#include <cmath>
 #include <limits>
 
 #include "timing.h"
@@ -7,13 +8,19 @@
 namespace scenewatch::pipeline {
 
 Eigen::Vector3d up_direction(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
-                             const Eigen::Vector3d& camera_world) {
+                             const Pose& T_world_camera) {
   if (configured && configured->norm() > 0) return configured->normalized();
+  const Eigen::Vector3d camera = T_world_camera.translation();
+  const Eigen::Vector3d camera_up = -T_world_camera.linear().col(1);
+  const double cos_max = std::cos(M_PI / 4);
   const Plane* largest = nullptr;
+  const Plane* upright = nullptr;
   for (const auto& p : planes) {
     if (!largest || p.area_m2 > largest->area_m2) largest = &p;
+    if (p.normal_towards(camera).dot(camera_up) >= cos_max && (!upright || p.area_m2 > upright->area_m2)) upright = &p;
   }
-  return largest ? largest->normal_towards(camera_world) : Eigen::Vector3d::UnitZ();
+  if (upright) return upright->normal_towards(camera);
+  return largest ? largest->normal_towards(camera) : Eigen::Vector3d::UnitZ();
 }
 
 namespace {
@@ -90,7 +97,7 @@ Frame ForegroundStage::prepare(const Frame& frame, std::uint64_t frame_index, co
   view_.stamp_s = frame.stamp_s;
   view_.frame_index = frame_index;
   view_.planes = &planes_;
-  view_.up_world = up_direction(configured_up, planes, T.translation());
+  view_.up_world = up_direction(configured_up, planes, T);
   K_ = frame.intrinsics;
   view_.K = K_ ? &*K_ : nullptr;
   detection_ = foreground::HandDetection{};

@@ -185,7 +185,7 @@ struct WorkingMemory::Impl {
   EventFusion fusion;
   ForegroundStage foreground;
   std::vector<Plane> planes;
-  Eigen::Vector3d last_camera = Eigen::Vector3d::Zero();
+  Pose last_camera = Pose::Identity();
   std::uint64_t frames = 0, points = 0;
   double total_ms = 0, last_ms = 0;
   double last_stamp_s = 0.0;
@@ -247,7 +247,7 @@ struct WorkingMemory::Impl {
       }
     }
     s->up_world = up_direction(up, planes, last_camera);
-    s->camera_world = last_camera;
+    s->camera_world = last_camera.translation();
     s->last_stamp_s = last_stamp_s;
     std::atomic_store(&snapshot, std::shared_ptr<const SceneSnapshot>(std::move(s)));
   }
@@ -452,7 +452,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
 
   m.planes = result.planes;
   for (auto& p : m.planes) p.indices.clear();
-  m.last_camera = T.translation();
+  m.last_camera = T;
   ++m.frames;
   m.last_stamp_s = frame.stamp_s;
   m.points += result.points;

@@ -31,9 +31,8 @@ struct TrackingConfig {
   /// the objects then carried back to every pixel (segmentation::segment_strided). N is at most
   /// this, and at most what keeps the samples within one segmentation voxel of each other at
   /// max_range_m on a surface facing the camera (floor(voxel_size_m fx / max_range_m): 2 for a
-  /// VGA Kinect, 1 at 320x240). 1: every pixel (the default: at 2, hrt1 pick_toy_1's toy is
-  /// promoted at frame 24 instead of 15, the objects near the hand coming apart differently).
-  int segmentation_stride_px = 1;
+  /// VGA Kinect, 1 at 320x240). 1: every pixel.
+  int segmentation_stride_px = 2;
 };
 
 /// One cluster of the frame, in world coordinates, with sample points of its surface.
