@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <deque>
 #include <filesystem>
 #include <functional>
 #include <fstream>
@@ -182,9 +183,8 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
   const bool show_progress = !options.json && ::isatty(STDOUT_FILENO) == 1;
   int failures = 0;
 
-  // Sends one request; false when the connection is gone (no point going on).
-  auto send = [&](proto::Request request, const std::string& source, ProgressBar* bar) {
-    auto response = client->call(std::move(request), options.timeout_s);
+  // The answer to one request; false when the connection is gone (no point going on).
+  auto take = [&](Result<proto::Response> response, const std::string& source, ProgressBar* bar) {
     if (bar != nullptr) bar->clear();
     if (!response) {
       fail(response.error().message);
@@ -198,6 +198,9 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
     }
     print_ingest(options, source, response->ingest());
     return true;
+  };
+  auto send = [&](proto::Request request, const std::string& source, ProgressBar* bar) {
+    return take(client->call(std::move(request), options.timeout_s), source, bar);
   };
 
   for (const std::string& path : paths) {
@@ -224,8 +227,16 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       if (auto skipped = io::skipped_summary(*sequence, sequence_options); !skipped.empty()) {
         std::cerr << "scenewatch: " << path << ": " << skipped << "\n";
       }
+      // Two frames in flight: the next frame is read from disk, sent and decoded by the daemon
+      // while the one before it is processed; the answers come in the order sent.
       ProgressBar bar(show_progress);
       const std::size_t total = sequence->frames.size();
+      std::deque<std::pair<std::uint64_t, std::string>> in_flight;  // request id, source
+      auto answer_oldest = [&] {
+        const auto [id, source] = in_flight.front();
+        in_flight.pop_front();
+        return take(client->wait_for(id, options.timeout_s), source, &bar);
+      };
       for (std::size_t i = 0; i < total; ++i) {
         const std::string source = (fs::path(path) / sequence->frames[i].name).string();
         bar.draw(i, total, sequence->frames[i].name);
@@ -239,7 +250,13 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
         frame->source = source;
         proto::Request request;
         *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
-        if (!send(std::move(request), source, &bar)) return kExitError;
+        auto id = client->start(std::move(request));
+        if (!id) return fail(id.error().message);
+        in_flight.emplace_back(*id, source);
+        if (in_flight.size() >= 2 && !answer_oldest()) return kExitError;
+      }
+      while (!in_flight.empty()) {
+        if (!answer_oldest()) return kExitError;
       }
       continue;
     }

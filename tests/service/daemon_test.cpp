@@ -70,6 +70,20 @@ class DaemonTest : public ::testing::Test {
     return r;
   }
 
+  /// The first n frames of 7-Scenes redkitchen as IngestFrame requests (fewer on a read error).
+  std::vector<proto::Request> kitchen_frames(std::size_t n) const {
+    std::vector<proto::Request> out;
+    auto seq = io::open_sequence(data_dir() / "redkitchen");
+    EXPECT_TRUE(seq.ok()) << seq.error().message;
+    for (std::size_t i = 0; seq.ok() && i < n && i < seq->frames.size(); ++i) {
+      auto frame = io::load_sequence_frame(*seq, i);
+      EXPECT_TRUE(frame.ok()) << frame.error().message;
+      if (!frame.ok()) break;
+      *out.emplace_back().mutable_ingest_frame() = service::make_ingest_frame(*frame);
+    }
+    return out;
+  }
+
   fs::path tmp_, data_root_, model_dir_;
   Daemon daemon_;
 };
@@ -216,6 +230,53 @@ TEST_F(DaemonTest, RealKitchenStreamedOverTcpIsCalm) {
   EXPECT_EQ(stats.stats().events_emitted(), 0u);
 }
 
+TEST_F(DaemonTest, FramesSentAheadAreAnsweredInOrderAsIfSentOneByOne) {
+  // A client that sends the next frame before the reply to the one before (`scenewatch ingest`
+  // keeps two in flight; the daemon decodes the next while it processes the one before): the
+  // replies come in request order and say what the same frames sent one by one say. A request
+  // sent behind the frames, without waiting, sees all of them.
+  SCENEWATCH_REQUIRE_DATA("redkitchen/frame-000150.color.png");
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
+  constexpr std::uint64_t kFrames = 6;
+  const std::vector<proto::Request> frames = kitchen_frames(kFrames);
+  ASSERT_EQ(frames.size(), kFrames);
+  // What a reply says, without its timings.
+  auto summary = [](const proto::IngestReply& r) {
+    std::string s = std::to_string(r.frame_index()) + " " + std::to_string(r.points()) + " planes " +
+                    std::to_string(r.planes_size()) + " events " + std::to_string(r.events_size()) + " clusters";
+    for (const auto& c : r.clusters()) s += " " + std::to_string(c.point_count());
+    return s;
+  };
+  Client client = daemon_.connect();
+  std::vector<std::string> one_by_one;
+  for (const auto& r : frames) {
+    const auto response = call(client, r);
+    ASSERT_EQ(response.status().code(), proto::Status::OK) << response.status().message();
+    one_by_one.push_back(summary(response.ingest()));
+  }
+  ASSERT_EQ(call(client, request([](proto::Request& r) { r.mutable_reset(); })).status().code(), proto::Status::OK);
+
+  std::vector<std::uint64_t> ids;
+  for (const auto& r : frames) {
+    auto id = client.start(r);
+    ASSERT_TRUE(id.ok()) << id.error().message;
+    ids.push_back(*id);
+  }
+  auto planes_id = client.start(get_planes());
+  ASSERT_TRUE(planes_id.ok());
+  for (std::uint64_t i = 0; i < kFrames; ++i) {
+    auto reply = client.receive(120);
+    ASSERT_TRUE(reply.ok()) << reply.error().message;
+    ASSERT_EQ(reply->id(), ids[i]) << "replies come in request order";
+    ASSERT_EQ(reply->status().code(), proto::Status::OK) << reply->status().message();
+    EXPECT_EQ(summary(reply->ingest()), one_by_one[i]) << "frame " << i;
+  }
+  auto planes = client.receive(120);
+  ASSERT_TRUE(planes.ok()) << planes.error().message;
+  ASSERT_EQ(planes->id(), *planes_id);
+  EXPECT_EQ(planes->planes().frames_processed(), kFrames) << "a query behind the frames waits for all of them";
+}
+
 TEST_F(DaemonTest, ALiveStreamThatOutpacesTheModelSkipsToTheNewestFrame) {
   // A live sensor sends 30 frames/s without waiting for replies; a room frame takes longer than
   // 33 ms. Eight VGA kitchen frames sent back to back as live frames: the first is processed at
@@ -223,16 +284,10 @@ TEST_F(DaemonTest, ALiveStreamThatOutpacesTheModelSkipsToTheNewestFrame) {
   // processed. Every request gets its reply, in order. Frames not marked live are never skipped.
   SCENEWATCH_REQUIRE_DATA("redkitchen/frame-000150.color.png");
   ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
-  auto seq = io::open_sequence(data_dir() / "redkitchen");
-  ASSERT_TRUE(seq.ok()) << seq.error().message;
   constexpr std::uint64_t kFrames = 8;
-  std::vector<proto::Request> requests(kFrames);
-  for (std::uint64_t i = 0; i < kFrames; ++i) {
-    auto frame = io::load_sequence_frame(*seq, i);
-    ASSERT_TRUE(frame.ok()) << frame.error().message;
-    *requests[i].mutable_ingest_frame() = service::make_ingest_frame(*frame);
-    requests[i].set_id(i + 1);
-  }
+  std::vector<proto::Request> requests = kitchen_frames(kFrames);
+  ASSERT_EQ(requests.size(), kFrames);
+  for (std::uint64_t i = 0; i < kFrames; ++i) requests[i].set_id(i + 1);
   auto send_all = [&](bool live) {
     Client client = daemon_.connect();
     for (auto& r : requests) {

@@ -203,9 +203,19 @@ Result<proto::Response> Client::receive(double timeout_s) {
 }
 
 Result<proto::Response> Client::call(proto::Request request, double timeout_s) {
+  auto id = start(std::move(request));
+  if (!id) return id.error();
+  return wait_for(*id, timeout_s);
+}
+
+Result<std::uint64_t> Client::start(proto::Request request) {
   request.set_id(next_id_++);
   if (request.token().empty() && !token_.empty()) request.set_token(token_);
   if (Status s = send(request); !s) return s.error();
+  return request.id();
+}
+
+Result<proto::Response> Client::wait_for(std::uint64_t id, double timeout_s) {
   const auto deadline = deadline_after(timeout_s);
   for (;;) {
     double left = 0;
@@ -215,7 +225,7 @@ Result<proto::Response> Client::call(proto::Request request, double timeout_s) {
     }
     auto response = receive(left);
     if (!response) return response.error();
-    if (response->id() == request.id()) return response;
+    if (response->id() == id) return response;
     if (response->id() == 0 && response->has_event()) {
       events_.push_back(response->event());
       continue;

@@ -58,6 +58,7 @@ LiveFramePeek peek_live_frame(std::string_view payload) {
     }
   }
   if (!in.ConsumedEntireMessage()) return {};
+  peek.frame = is_frame;
   peek.live = is_frame && live;
   return peek;
 }

@@ -9,6 +9,7 @@
 namespace scenewatch::service {
 
 struct LiveFramePeek {
+  bool frame = false;    ///< an IngestFrame, live or not
   bool live = false;     ///< an IngestFrame with live = true
   std::uint64_t id = 0;  ///< the request's id
   std::string token;     ///< the request's access token (Request.token)

@@ -155,17 +155,25 @@ struct RequestHandler::Impl {
       done(execute(*request, &context));
       return;
     }
+    if (request->call_case() == proto::Request::kIngestFrame) {
+      // Decoded here, on the connection's thread, while the frame before it may still be
+      // processing on the model's strand (a client may send the next frame before the reply).
+      auto frame = std::make_shared<const Result<Frame>>(decode_frame(request->ingest_frame()));
+      executor([this, request, frame, done = std::move(done)] { done(execute(*request, nullptr, frame.get())); });
+      return;
+    }
     executor([this, request, done = std::move(done)] { done(execute(*request, nullptr)); });
   }
 
-  /// Runs one call and encodes its response. `context` is null off the connection's thread.
-  Reply execute(const proto::Request& request, SessionContext* context) {
+  /// Runs one call and encodes its response. `context` is null off the connection's thread;
+  /// `decoded`, when given, is the request's IngestFrame decoded already.
+  Reply execute(const proto::Request& request, SessionContext* context, const Result<Frame>* decoded = nullptr) {
     proto::Response response;
     response.set_id(request.id());
     std::string call = call_name(request);
     Status status;
     try {
-      status = dispatch(request, context, response);
+      status = dispatch(request, context, response, decoded);
     } catch (const std::exception& e) {
       // A bug or out of memory: answer the client, keep serving the others.
       status = Error{ErrorCode::kInternal, std::string("unexpected exception: ") + e.what()};
@@ -179,14 +187,18 @@ struct RequestHandler::Impl {
     return finish(response, std::move(call));
   }
 
-  Status dispatch(const proto::Request& request, SessionContext* context, proto::Response& response) {
+  Status dispatch(const proto::Request& request, SessionContext* context, proto::Response& response,
+                  const Result<Frame>* decoded) {
     if (route_of(request.call_case()) == Route::kMutate && stopping) {
       return unavailable("the server is shutting down");
     }
     switch (request.call_case()) {
       case proto::Request::kHealth: return health(response);
       case proto::Request::kStats: return stats(response);
-      case proto::Request::kIngestFrame: return ingest_frame(request.ingest_frame(), response);
+      case proto::Request::kIngestFrame:
+        if (decoded == nullptr) return ingest_frame(request.ingest_frame(), response);
+        if (!*decoded) return decoded->error();
+        return process(**decoded, response);
       case proto::Request::kIngestFile: return ingest_file(request.ingest_file(), response);
       case proto::Request::kGetPlanes: return get_planes(response);
       case proto::Request::kGetObjects: return get_objects(request.get_objects(), response);
@@ -624,6 +636,8 @@ RequestHandler::~RequestHandler() = default;
 void RequestHandler::handle(std::string payload, SessionContext& context, std::function<void(Reply)> done) {
   impl_->handle(std::move(payload), context, std::move(done), /*use_executors=*/true);
 }
+
+bool RequestHandler::is_ingest_frame(std::string_view payload) const { return peek_live_frame(payload).frame; }
 
 bool RequestHandler::is_live_frame(std::string_view payload) const {
   // A frame without the right token is not skipped: it is refused like any other.

@@ -154,7 +154,7 @@ void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
   maybe_resume_reading();
 }
 
-bool Session::idle() const { return !in_flight_ && pending_.empty() && outgoing_.empty(); }
+bool Session::idle() const { return in_flight_ == 0 && pending_.empty() && outgoing_.empty(); }
 
 void Session::maybe_resume_reading() {
   resume_reading();
@@ -209,18 +209,29 @@ void Session::resume_reading() {
   }
 }
 
+// One request at a time, so that each sees what the ones before it did; the one exception is a
+// frame that follows a frame: it is started (parsed and decoded on this strand) while the one
+// before it is still processing, and the model's strand runs the two in order. Replies go out in
+// the order the requests came. Not a live frame: that one waits, as a newer one may supersede it.
 void Session::dispatch_next() {
-  if (in_flight_ || pending_.empty() || closing_ || closed_) return;
-  skip_superseded_live_frames();
-  in_flight_ = true;
-  std::string payload = std::move(pending_.front());
-  pending_.pop_front();
-  pending_bytes_ -= payload.size();
-  auto self = shared_from_this();
-  handler_.handle(std::move(payload), context_, [self](Reply reply) {
-    // Possibly on a worker thread: continue on the strand.
-    asio::post(self->executor_, [self, reply = std::move(reply)]() mutable { self->on_reply(std::move(reply)); });
-  });
+  while (!pending_.empty() && !closing_ && !closed_) {
+    skip_superseded_live_frames();
+    const bool frame = handler_.is_ingest_frame(pending_.front()) && !handler_.is_live_frame(pending_.front());
+    if (in_flight_ > 0 && !(in_flight_ == 1 && frame_in_flight_ && frame)) return;
+    ++in_flight_;
+    frame_in_flight_ = frame;
+    std::string payload = std::move(pending_.front());
+    pending_.pop_front();
+    pending_bytes_ -= payload.size();
+    auto self = shared_from_this();
+    const std::uint64_t sequence = next_started_++;
+    handler_.handle(std::move(payload), context_, [self, sequence](Reply reply) {
+      // Possibly on a worker thread: continue on the strand.
+      asio::post(self->executor_, [self, sequence, reply = std::move(reply)]() mutable {
+        self->on_reply(sequence, std::move(reply));
+      });
+    });
+  }
 }
 
 // A live stream that outpaces the model: a live frame with a newer live frame waiting behind it
@@ -234,22 +245,35 @@ void Session::skip_superseded_live_frames() {
     Reply reply = handler_.skip_live_frame(pending_.front());
     pending_bytes_ -= pending_.front().size();
     pending_.pop_front();
-    log(LogLevel::kDebug, reply.call);
-    enqueue(std::move(reply.payload));
+    answer(next_started_++, std::move(reply));  // after the reply of a frame still in flight
   }
 }
 
-void Session::on_reply(Reply reply) {
-  in_flight_ = false;
+void Session::on_reply(std::uint64_t sequence, Reply reply) {
+  --in_flight_;
   if (closed_ || closing_) return;
+  answer(sequence, std::move(reply));
+  dispatch_next();
+  maybe_resume_reading();
+}
+
+void Session::answer(std::uint64_t sequence, Reply reply) {
+  early_replies_.emplace(sequence, std::move(reply));
+  for (auto next = early_replies_.find(next_answered_); next != early_replies_.end();
+       next = early_replies_.find(next_answered_)) {
+    send_reply(std::move(next->second));
+    early_replies_.erase(next);
+    ++next_answered_;
+  }
+}
+
+void Session::send_reply(Reply reply) {
   if (reply.ok) {
     log(LogLevel::kDebug, reply.call + " ok");
   } else {
     log(LogLevel::kWarning, reply.call + " failed: " + reply.error);
   }
   enqueue(std::move(reply.payload));
-  dispatch_next();
-  maybe_resume_reading();
 }
 
 void Session::push_event(std::string payload) {

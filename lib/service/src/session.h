@@ -8,6 +8,7 @@
 #include <atomic>
 #include <cstdint>
 #include <deque>
+#include <map>
 #include <memory>
 #include <chrono>
 #include <optional>
@@ -78,7 +79,10 @@ class Session : public std::enable_shared_from_this<Session> {
   void dispatch_next();
   /// Answers the live frames that a newer waiting live frame supersedes (see IngestFrame.live).
   void skip_superseded_live_frames();
-  void on_reply(Reply reply);
+  void on_reply(std::uint64_t sequence, Reply reply);
+  /// Sends the reply of the request started as `sequence` once those started before it are sent.
+  void answer(std::uint64_t sequence, Reply reply);
+  void send_reply(Reply reply);
   void push_event(std::string payload);
   void enqueue(std::string payload);
   void do_write();
@@ -109,7 +113,13 @@ class Session : public std::enable_shared_from_this<Session> {
   bool reading_ = false;        ///< a read is outstanding
   std::deque<std::string> pending_;  ///< requests received, not yet started
   std::size_t pending_bytes_ = 0;    ///< payload bytes in pending_
-  bool in_flight_ = false;      ///< a request is being handled
+  /// Requests being handled: one, or two frames in a row (the next frame is decoded while the
+  /// one before it is processed; see dispatch_next()).
+  std::size_t in_flight_ = 0;
+  bool frame_in_flight_ = false;     ///< the last request started is an IngestFrame, not live
+  std::uint64_t next_started_ = 0;   ///< sequence number of the next request started
+  std::uint64_t next_answered_ = 0;  ///< sequence number of the next reply to send
+  std::map<std::uint64_t, Reply> early_replies_;  ///< replies that overtook one started before them
   std::deque<Outgoing> outgoing_;
   std::size_t queued_bytes_ = 0;
   bool writing_ = false;

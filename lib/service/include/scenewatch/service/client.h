@@ -39,6 +39,11 @@ class Client {
   /// Sends a request (its id is set to the next free one) and waits for the response with that
   /// id; events pushed meanwhile are kept for next_event(). timeout_s <= 0: wait forever.
   Result<proto::Response> call(proto::Request request, double timeout_s = 0);
+  /// call() in two halves, for a client that keeps several requests in flight: start() sends the
+  /// request (id and token set as call() sets them) and returns its id; wait_for() waits for the
+  /// response with that id. Wait in the order of start(): the daemon answers in that order.
+  Result<std::uint64_t> start(proto::Request request);
+  Result<proto::Response> wait_for(std::uint64_t id, double timeout_s = 0);
 
   /// The next pushed event (after a Subscribe call). timeout_s <= 0: wait forever.
   Result<proto::Event> next_event(double timeout_s = 0);

@@ -79,6 +79,8 @@ class RequestHandler {
   /// executor's thread. `context` is only used before handle() returns.
   void handle(std::string payload, SessionContext& context, std::function<void(Reply)> done);
 
+  /// True when the payload is an IngestFrame (live or not), read without decoding it.
+  bool is_ingest_frame(std::string_view payload) const;
   /// True when the payload is a live IngestFrame (IngestFrame.live) carrying the right token, read
   /// without decoding it.
   bool is_live_frame(std::string_view payload) const;
