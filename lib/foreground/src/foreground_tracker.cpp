@@ -23,6 +23,7 @@ constexpr int kMinObservations = 3;        // frames a background object was see
 constexpr double kStillM = 0.03;           // a candidate moved at most this far since it was first seen
 constexpr double kSearchMarginM = 0.08;    // registration targets reach this far beyond the model
 constexpr std::size_t kRegistrationPoints = 300;  // model points registration uses
+constexpr double kBoxSlackM = 0.02;       // a cluster's points lie this close to its box at most
 constexpr double kLiftedVacatedFraction = 0.1;     // of its old place a lifted object must have emptied
 
 Eigen::Vector3d world(const PointT& p, const Pose& T) { return T * p.getVector3fMap().cast<double>(); }
@@ -76,6 +77,13 @@ CloudPtr thinned(const Cloud& in, double voxel, std::size_t max_points) {
 }
 
 // A cluster's points (world frame).
+// The world box around a cluster's oriented box (clusters come in the world frame).
+Aabb world_box(const ObjectCluster& c) {
+  const Eigen::Matrix3d R = c.box.rotation.toRotationMatrix();
+  const Eigen::Vector3d half = (R.cwiseAbs() * c.box.extents) / 2;
+  return {c.box.center - half, c.box.center + half};
+}
+
 std::vector<Eigen::Vector3d> world_points(const FrameView& f, const ObjectCluster& c) {
   std::vector<Eigen::Vector3d> out;
   out.reserve(c.indices.size());
@@ -174,6 +182,9 @@ Crop crop(const FrameView& f, const Eigen::Vector3d& centre_world, double radius
   VoxelSet kept(voxel);
   const Cloud& cloud = *f.cloud;
   const PixelWindow w = pixel_window(f, centre_cam, radius);
+  const std::size_t area = static_cast<std::size_t>(std::max(0, w.u1 - w.u0)) * static_cast<std::size_t>(std::max(0, w.v1 - w.v0));
+  c.pixels.reserve(area / 2);
+  c.points.reserve(area / 2);
   for (int v = w.v0; v < w.v1; ++v)
     for (int u = w.u0; u < w.u1; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * cloud.width + static_cast<std::size_t>(u);
@@ -563,17 +574,27 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
   // Where the hands are: the hand proper (the forearm touches nothing it carries).
   VoxelSet hand_points(cfg.contact_m);
   bool any_hand = false;
+  Aabb hand_box{Eigen::Vector3d::Constant(1e30), Eigen::Vector3d::Constant(-1e30)};
   if (f.hands) {
     for (const auto& h : f.hands->hands) {
       for (int i : h.tip_indices.empty() ? h.indices : h.tip_indices) {
         const PointT& p = f.cloud->points[static_cast<std::size_t>(i)];
         if (!is_valid(p)) continue;
-        hand_points.insert(world(p, f.T_world_camera));
+        const Eigen::Vector3d w = world(p, f.T_world_camera);
+        hand_points.insert(w);
+        hand_box.min = hand_box.min.cwiseMin(w);
+        hand_box.max = hand_box.max.cwiseMax(w);
         any_hand = true;
       }
     }
   }
   const VoxelSet hand = hand_points.dilated();
+  // Where a touch can be at all: a point in a cell next to a hand point's is at most two cells
+  // from it. A cluster whose box lies farther needs none of its points looked at (the box of a
+  // cluster segmented on every second pixel is its samples': its other pixels lie within one
+  // segmentation voxel of them, hence kBoxSlackM).
+  const Aabb reach = hand_box.grown(2 * cfg.contact_m + kBoxSlackM);
+  auto may_touch = [&](const ObjectCluster& c) { return any_hand && reach.overlaps(world_box(c)); };
   auto touches = [&](const std::vector<Eigen::Vector3d>& pts) {
     if (!any_hand) return false;
     for (const auto& p : pts)
@@ -589,7 +610,7 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
     if (o.lost_in_hand && any_hand) {
       for (std::size_t ci = 0; ci < clusters.size() && !o.visible; ++ci) {
         const ObjectCluster& c = clusters[ci];
-        if (claimed[ci] || c.box.extents.maxCoeff() > kMaxObjectExtentM || mostly_skin(*f.cloud, c.indices)) continue;
+        if (claimed[ci] || c.box.extents.maxCoeff() > kMaxObjectExtentM || !may_touch(c) || mostly_skin(*f.cloud, c.indices)) continue;
         if (!touches(world_points(f, c))) continue;
         o.T = object_frame(c, o.T.linear());
         o.model = thinned(cluster_cloud(f, c, o.T.inverse()), cfg.model_voxel_m, cfg.max_model_points);
@@ -619,7 +640,7 @@ ForegroundUpdate ForegroundTracker::update(const FrameView& f, const std::vector
   if (any_hand) {
     for (std::size_t ci = 0; ci < clusters.size(); ++ci) {
       const ObjectCluster& c = clusters[ci];
-      if (claimed[ci] || c.box.extents.maxCoeff() > kMaxObjectExtentM) continue;
+      if (claimed[ci] || c.box.extents.maxCoeff() > kMaxObjectExtentM || !may_touch(c)) continue;
       const std::vector<Eigen::Vector3d> pts = world_points(f, c);
       if (!touches(pts)) continue;
       // A piece of an object already touched (a cup the hand splits in two) is that object.
