@@ -1,6 +1,7 @@
 // Real data: the labelled Kinect tabletop scenes of mOSD and PCL's mug scene.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "scenewatch/io/cloud_io.h"
@@ -16,15 +17,21 @@ struct SceneFigures {
   double table_iou = 0;
 };
 
-SceneFigures run_scene(const std::filesystem::path& path, bool print) {
+SceneFigures run_scene(const std::filesystem::path& path, bool print, int stride = 1) {
   auto file = io::read_cloud(path);
   EXPECT_TRUE(file.ok()) << (file.ok() ? "" : file.error().message);
   if (!file.ok()) return {};
   auto labels = io::read_pcd_labels(path);
   EXPECT_TRUE(labels.ok());
-  const Segmentation seg = segment(*file->cloud, Config{});
+  const Segmentation seg = stride > 1 ? segment_strided(*file->cloud, Config{}, Eigen::Vector3d::Zero(), stride)
+                                      : segment(*file->cloud, Config{});
   std::vector<std::vector<int>> clusters;
-  for (const auto& o : seg.objects) clusters.push_back(o.indices);
+  for (const auto& o : seg.objects) {
+    EXPECT_TRUE(std::is_sorted(o.indices.begin(), o.indices.end())) << path;
+    EXPECT_EQ(std::adjacent_find(o.indices.begin(), o.indices.end()), o.indices.end()) << path;
+    EXPECT_EQ(o.point_count, o.indices.size());
+    clusters.push_back(o.indices);
+  }
   const std::vector<int> none;
   const LabelScore score = score_against_labels(clusters, seg.planes.empty() ? none : seg.planes[0].indices, *labels);
   if (print) {
@@ -112,6 +119,28 @@ TEST(Mosd, MugIsOneClusterOnTheTable) {
       EXPECT_LT(seg.objects[i].point_count, mug.point_count / 20);
     }
   }
+}
+
+// The pipeline's segmentation for the object list: every second pixel of every second row, each
+// object then carried back to every pixel (tracking.segmentation_stride_px, 2 by default). The
+// same strict scoring against the labels as the full segmentation above.
+TEST(Mosd, EverySecondPixelFindsTheSameObjects) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
+  std::size_t objects = 0, matched = 0, clusters = 0, correct = 0, tables = 0;
+  for (int i = 0; i <= 44; ++i) {
+    const SceneFigures f = run_scene(test::data_dir() / "mosd/learn" / ("learn" + std::to_string(i) + ".pcd"), false, 2);
+    objects += f.objects;
+    matched += f.matched;
+    clusters += f.clusters;
+    correct += f.correct;
+    tables += f.table_iou >= 0.8 ? 1 : 0;
+  }
+  std::printf("mOSD learn at stride 2: table IoU>=0.8 in %zu of 45, recall %zu/%zu, precision %zu/%zu\n", tables, matched,
+              objects, correct, clusters);
+  EXPECT_EQ(tables, 45u);
+  EXPECT_GE(matched, 109u);  // measured 109 of 112 (every pixel: 111)
+  EXPECT_GE(correct, 109u);  // of 113 clusters (every pixel: 111 of 112)
+  EXPECT_LE(clusters, 113u);
 }
 
 }  // namespace

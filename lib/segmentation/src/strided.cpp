@@ -23,40 +23,51 @@ Cloud decimate(const Cloud& cloud, int stride) {
 }
 
 // Full-resolution members of each labelled sample set: each pixel takes the label of the nearest
-// valid sample among the (up to) four around it, when that sample lies within `reach_m`. One pass
-// over the image; a pixel with no labelled sample around it costs four label reads.
+// valid sample among the (up to) four around it, when that sample lies within `reach_m`. The
+// pixels of a block (the stride x stride pixels whose top-left sample is the block's) share their
+// four samples, so blocks without a labelled corner are passed over: on a room frame objects
+// cover a small part of the image. Rows in order, so each member list comes out sorted.
 std::vector<std::vector<int>> upsample(const Cloud& cloud, const std::vector<int>& label_of_sample, std::size_t labels,
                                        int stride, double reach_m) {
   const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height);
   const int sw = (w + stride - 1) / stride, sh = (h + stride - 1) / stride;
   const auto reach2 = static_cast<float>(reach_m * reach_m);
-  std::vector<std::vector<int>> members(labels);
-  for (int v = 0; v < h; ++v)
-    for (int u = 0; u < w; ++u) {
-      std::array<int, 4> around{-1, -1, -1, -1};
-      bool any = false;
+  auto corner = [&](int su, int sv, int k) {
+    const int cu = su + (k & 1), cv = sv + (k >> 1);
+    return cu < sw && cv < sh ? cv * sw + cu : -1;
+  };
+  std::vector<char> labelled_block(static_cast<std::size_t>(sw) * sh, 0);
+  for (int sv = 0; sv < sh; ++sv)
+    for (int su = 0; su < sw; ++su)
       for (int k = 0; k < 4; ++k) {
-        const int su = u / stride + (k & 1), sv = v / stride + (k >> 1);
-        if (su >= sw || sv >= sh) continue;
-        around[k] = sv * sw + su;
-        any = any || label_of_sample[around[k]] >= 0;
+        const int s = corner(su, sv, k);
+        if (s >= 0 && label_of_sample[s] >= 0) labelled_block[static_cast<std::size_t>(sv) * sw + su] = 1;
       }
-      const PointT& p = cloud.points[static_cast<std::size_t>(v) * w + u];
-      if (!any || !is_valid(p)) continue;
-      float best = std::numeric_limits<float>::infinity();
-      int label = -1;
-      for (int s : around) {
-        if (s < 0) continue;
-        const PointT& q = cloud.points[static_cast<std::size_t>(s / sw * stride) * w + (s % sw) * stride];
-        if (!is_valid(q)) continue;
-        const float d2 = (q.getVector3fMap() - p.getVector3fMap()).squaredNorm();
-        if (d2 < best) {
-          best = d2;
-          label = label_of_sample[s];
+  std::vector<std::vector<int>> members(labels);
+  for (int v = 0; v < h; ++v) {
+    const int sv = v / stride;
+    for (int su = 0; su < sw; ++su) {
+      if (!labelled_block[static_cast<std::size_t>(sv) * sw + su]) continue;
+      for (int u = su * stride; u < std::min(w, (su + 1) * stride); ++u) {
+        const PointT& p = cloud.points[static_cast<std::size_t>(v) * w + u];
+        if (!is_valid(p)) continue;
+        float best = std::numeric_limits<float>::infinity();
+        int label = -1;
+        for (int k = 0; k < 4; ++k) {
+          const int s = corner(su, sv, k);
+          if (s < 0) continue;
+          const PointT& q = cloud.points[static_cast<std::size_t>(s / sw * stride) * w + (s % sw) * stride];
+          if (!is_valid(q)) continue;
+          const float d2 = (q.getVector3fMap() - p.getVector3fMap()).squaredNorm();
+          if (d2 < best) {
+            best = d2;
+            label = label_of_sample[s];
+          }
         }
+        if (label >= 0 && best <= reach2) members[label].push_back(v * w + u);
       }
-      if (label >= 0 && best <= reach2) members[label].push_back(v * w + u);
     }
+  }
   return members;
 }
 
