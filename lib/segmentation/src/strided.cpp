@@ -9,8 +9,9 @@
 namespace scenewatch::segmentation {
 namespace {
 
-// Every stride-th pixel of every stride-th row, as an organized cloud.
-Cloud decimate(const Cloud& cloud, int stride) {
+// Every stride-th pixel of every stride-th row, as an organized cloud; samples farther than
+// max_range_m from the sensor (when > 0) left out (NaN).
+Cloud decimate(const Cloud& cloud, int stride, const Eigen::Vector3d& sensor_origin, double max_range_m) {
   const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height);
   Cloud samples;
   samples.width = static_cast<std::uint32_t>((w + stride - 1) / stride);
@@ -19,6 +20,13 @@ Cloud decimate(const Cloud& cloud, int stride) {
   samples.points.reserve(static_cast<std::size_t>(samples.width) * samples.height);
   for (int v = 0; v < h; v += stride)
     for (int u = 0; u < w; u += stride) samples.points.push_back(cloud.points[static_cast<std::size_t>(v) * w + u]);
+  if (max_range_m > 0) {
+    const Eigen::Vector3f origin = sensor_origin.cast<float>();
+    const auto range2 = static_cast<float>(max_range_m * max_range_m);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (PointT& p : samples.points)
+      if (is_valid(p) && (p.getVector3fMap() - origin).squaredNorm() > range2) p.x = p.y = p.z = nan;
+  }
   return samples;
 }
 
@@ -73,14 +81,15 @@ std::vector<std::vector<int>> upsample(const Cloud& cloud, const std::vector<int
 
 }  // namespace
 
-Segmentation segment_strided(const Cloud& cloud, const Config& config, const Eigen::Vector3d& sensor_origin, int stride) {
+Segmentation segment_strided(const Cloud& cloud, const Config& config, const Eigen::Vector3d& sensor_origin, int stride,
+                             double max_range_m) {
   if (cloud.height <= 1 || stride <= 1) return segment(cloud, config, sensor_origin);
   // The same least surface: a sample stands for stride^2 pixels.
   Config sampled = config;
   const int area = stride * stride;
   sampled.min_cluster_points = std::max(1, config.min_cluster_points / area);
   sampled.max_cluster_points = std::max(sampled.min_cluster_points, config.max_cluster_points / area);
-  const Cloud samples = decimate(cloud, stride);
+  const Cloud samples = decimate(cloud, stride, sensor_origin, max_range_m);
   Segmentation out = segment(samples, sampled, sensor_origin);
 
   // Each pixel of an object takes the object of its nearest sample (objects are what a user asks

@@ -74,7 +74,10 @@ Segmentation segment(const Cloud& cloud, const Config& config,
 /// boxes, centroids and colours are the samples'. About stride^2 times less work; at stride 2
 /// a VGA Kinect's samples stay closer than the 1 cm voxel up to about 2.6 m on a surface facing
 /// the camera, so far grazing surfaces (a room's walls) may come apart. Unorganized clouds and
-/// stride 1: segment() itself.
-Segmentation segment_strided(const Cloud& cloud, const Config& config, const Eigen::Vector3d& sensor_origin, int stride);
+/// stride 1: segment() itself, of the whole cloud. `max_range_m` > 0 (with a stride of 2 or more):
+/// only the samples within that range of the sensor are segmented; the others belong to no plane
+/// and no object.
+Segmentation segment_strided(const Cloud& cloud, const Config& config, const Eigen::Vector3d& sensor_origin, int stride,
+                             double max_range_m = 0);
 
 }  // namespace scenewatch::segmentation
