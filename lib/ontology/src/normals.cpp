@@ -29,6 +29,40 @@ std::uint64_t cell_key(const Eigen::Vector3i& c) {
   return part(c.x()) | (part(c.y()) << 21) | (part(c.z()) << 42);
 }
 
+/// Points of a few grid cells in float arrays (one per coordinate), so that the distances to all
+/// of them vectorise.
+class Block {
+ public:
+  void clear() {
+    x_.clear(), y_.clear(), z_.clear(), id_.clear();
+  }
+  void add(const Eigen::Vector3d& p, std::uint32_t id) {
+    x_.push_back(static_cast<float>(p.x())), y_.push_back(static_cast<float>(p.y())), z_.push_back(static_cast<float>(p.z()));
+    id_.push_back(id);
+  }
+  /// Squared distances from q to the block's points, for within().
+  void distances(const Eigen::Vector3d& q) {
+    const float qx = static_cast<float>(q.x()), qy = static_cast<float>(q.y()), qz = static_cast<float>(q.z());
+    const std::size_t m = x_.size();
+    d2_.resize(m);
+    for (std::size_t j = 0; j < m; ++j) {
+      const float dx = x_[j] - qx, dy = y_[j] - qy, dz = z_[j] - qz;
+      d2_[j] = dx * dx + dy * dy + dz * dz;
+    }
+  }
+  /// The block's points within sqrt(max_d2) of the last distances()' point, as (squared distance,
+  /// id), into out (cleared).
+  void within(float max_d2, std::vector<std::pair<float, std::uint32_t>>& out) const {
+    out.clear();
+    for (std::size_t j = 0; j < d2_.size(); ++j)
+      if (d2_[j] <= max_d2) out.emplace_back(d2_[j], id_[j]);
+  }
+
+ private:
+  std::vector<float> x_, y_, z_, d2_;
+  std::vector<std::uint32_t> id_;
+};
+
 /// The 90th percentile over a sample of up to 32 points of the distance to their k-th nearest
 /// neighbour (brute force: 32 x n distances): a cell that wide holds the k nearest of 9 in 10
 /// points within the 27 cells around them.
@@ -78,10 +112,11 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
     s = e;
   }
 
-  std::vector<std::pair<double, std::uint32_t>> candidates;
-  std::vector<std::uint32_t> block;  // the points of the 27 cells around one cell
+  // Squared distances in float: the points are the cloud's floats, so differences of neighbours
+  // are exact and only exact ties could order differently; the covariance stays in double.
+  std::vector<std::pair<float, std::uint32_t>> candidates;
   candidates.reserve(512);
-  block.reserve(512);
+  Block block;  // the points of the 27 cells around one cell
   const std::size_t want = std::min<std::size_t>(n, static_cast<std::size_t>(k));  // the point and k - 1 others, as PCL counts
   // Finds the k nearest of point i into candidates[0, want) by rings of cells around its cell:
   // after ring r every point within r cells' width is a candidate, so the k nearest are exact once
@@ -96,11 +131,11 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
             const auto found = cells.find(cell_key(cell_of[i] + Eigen::Vector3i(dx, dy, dz)));
             if (found == cells.end()) continue;
             for (std::uint32_t s = found->second.first; s < found->second.second; ++s)
-              candidates.emplace_back((p[order[s]] - p[i]).squaredNorm(), order[s]);
+              candidates.emplace_back(static_cast<float>((p[order[s]] - p[i]).squaredNorm()), order[s]);
           }
       if (ring == kMaxRings) {
         candidates.clear();
-        for (std::uint32_t j = 0; j < n; ++j) candidates.emplace_back((p[j] - p[i]).squaredNorm(), j);
+        for (std::uint32_t j = 0; j < n; ++j) candidates.emplace_back(static_cast<float>((p[j] - p[i]).squaredNorm()), j);
       }
       if (candidates.size() < want) continue;
       std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(want - 1), candidates.end());
@@ -119,7 +154,7 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
         for (int dz = -1; dz <= 1; ++dz) {
           const auto found = cells.find(cell_key(cell_of[first] + Eigen::Vector3i(dx, dy, dz)));
           if (found == cells.end()) continue;
-          for (std::uint32_t s = found->second.first; s < found->second.second; ++s) block.push_back(order[s]);
+          for (std::uint32_t s = found->second.first; s < found->second.second; ++s) block.add(p[order[s]], order[s]);
         }
     for (std::uint32_t s = range.first; s < range.second; ++s) {
       const std::size_t i = order[s];
@@ -128,11 +163,11 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
       // when there are k of them, the k nearest of those are exact; else the rings decide.
       const Eigen::Vector3d offset = p[i] / cell - cell_of[i].cast<double>();  // in [0, 1) per axis
       const double reach = cell * (1.0 + std::min(offset.minCoeff(), 1.0 - offset.maxCoeff()));
-      candidates.clear();
-      for (const std::uint32_t j : block) {
-        const double d2 = (p[j] - p[i]).squaredNorm();
-        if (d2 <= reach * reach) candidates.emplace_back(d2, j);
-      }
+      // The ball of one cell's width lies in the block too and, the cell being the typical k-th
+      // neighbour distance, usually holds k points: then the selection sorts only its points.
+      block.distances(p[i]);
+      block.within(static_cast<float>(cell * cell), candidates);
+      if (candidates.size() < want) block.within(static_cast<float>(reach * reach), candidates);
       if (candidates.size() >= want) {
         std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(want - 1), candidates.end());
       } else {
