@@ -5,6 +5,7 @@
 #include "normals.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -27,6 +28,40 @@ std::uint64_t cell_key(const Eigen::Vector3i& c) {
   constexpr std::int64_t kOffset = 1 << 20;
   const auto part = [](int v) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(v) + kOffset) & 0x1fffff; };
   return part(c.x()) | (part(c.y()) << 21) | (part(c.z()) << 42);
+}
+
+using Candidate = std::pair<float, std::uint32_t>;  // (squared distance, point)
+
+/// Moves the `want` nearest of `c` (all with squared distance <= max_d2) to its front, in any
+/// order: a radix select, as std::nth_element's unpredictable branches were the normals' largest
+/// cost. Bins of equal squared distance hold about equally many points of a surface patch; one
+/// pass counts them, a branchless pass moves the bins before the want-th point's bin to the front,
+/// and only that bin's few points are ordered.
+void select_nearest(std::vector<Candidate>& c, std::size_t want, float max_d2, std::vector<Candidate>& scratch) {
+  constexpr int kBins = 16;
+  const float scale = max_d2 > 0 ? kBins / max_d2 : 0.0f;
+  const auto bin = [&](float d2) { return std::min(kBins - 1, static_cast<int>(d2 * scale)); };
+  std::array<std::uint32_t, kBins> counts{};
+  for (const Candidate& x : c) ++counts[static_cast<std::size_t>(bin(x.first))];
+  int last = 0;  // the bin of the want-th nearest
+  std::size_t before = 0;
+  while (before + counts[static_cast<std::size_t>(last)] < want) before += counts[static_cast<std::size_t>(last++)];
+  // scratch: the nearer bins' points in [0, before), the want-th's bin's from before + 1; each
+  // write lands in its region or, when the point belongs to the other one, in the slot after it.
+  const std::size_t in_bin = counts[static_cast<std::size_t>(last)];
+  scratch.resize(before + in_bin + 2);
+  std::size_t near = 0, same = before + 1;
+  for (const Candidate& x : c) {
+    const int b = bin(x.first);
+    scratch[near] = x;
+    near += b < last ? 1 : 0;
+    scratch[same] = x;
+    same += b == last ? 1 : 0;
+  }
+  const auto first = scratch.begin() + static_cast<std::ptrdiff_t>(before + 1);
+  std::nth_element(first, first + static_cast<std::ptrdiff_t>(want - 1 - before), first + static_cast<std::ptrdiff_t>(in_bin));
+  std::copy(scratch.begin(), scratch.begin() + static_cast<std::ptrdiff_t>(before), c.begin());
+  std::copy(first, first + static_cast<std::ptrdiff_t>(want - before), c.begin() + static_cast<std::ptrdiff_t>(before));
 }
 
 /// Points of a few grid cells in float arrays (one per coordinate), so that the distances to all
@@ -52,7 +87,7 @@ class Block {
   }
   /// The block's points within sqrt(max_d2) of the last distances()' point, as (squared distance,
   /// id), into out (cleared).
-  void within(float max_d2, std::vector<std::pair<float, std::uint32_t>>& out) const {
+  void within(float max_d2, std::vector<Candidate>& out) const {
     out.clear();
     for (std::size_t j = 0; j < d2_.size(); ++j)
       if (d2_[j] <= max_d2) out.emplace_back(d2_[j], id_[j]);
@@ -114,7 +149,7 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
 
   // Squared distances in float: the points are the cloud's floats, so differences of neighbours
   // are exact and only exact ties could order differently; the covariance stays in double.
-  std::vector<std::pair<float, std::uint32_t>> candidates;
+  std::vector<Candidate> candidates, scratch;
   candidates.reserve(512);
   Block block;  // the points of the 27 cells around one cell
   const std::size_t want = std::min<std::size_t>(n, static_cast<std::size_t>(k));  // the point and k - 1 others, as PCL counts
@@ -137,10 +172,15 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
         candidates.clear();
         for (std::uint32_t j = 0; j < n; ++j) candidates.emplace_back(static_cast<float>((p[j] - p[i]).squaredNorm()), j);
       }
-      if (candidates.size() < want) continue;
-      std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(want - 1), candidates.end());
-      const double reach = ring * cell;
-      if (candidates[want - 1].first <= reach * reach || ring >= kMaxRings) return;
+      // Only the candidates within the rings' reach can be the k nearest found so far: selecting
+      // among those (a few dozen of several hundred at ring 2) leaves the others for a wider ring.
+      const auto reach2 = static_cast<float>(ring * cell * ring * cell);
+      const auto end = ring >= kMaxRings ? candidates.end()
+                                         : std::partition(candidates.begin(), candidates.end(),
+                                                          [&](const auto& c) { return c.first <= reach2; });
+      if (static_cast<std::size_t>(end - candidates.begin()) < want) continue;
+      std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(want - 1), end);
+      return;
     }
   };
   // Cell by cell: the 27 cells around a cell are looked up once for all of its points; a point
@@ -166,10 +206,11 @@ std::vector<Eigen::Vector3d> estimate_normals(const Cloud& cloud, const std::vec
       // The ball of one cell's width lies in the block too and, the cell being the typical k-th
       // neighbour distance, usually holds k points: then the selection sorts only its points.
       block.distances(p[i]);
-      block.within(static_cast<float>(cell * cell), candidates);
-      if (candidates.size() < want) block.within(static_cast<float>(reach * reach), candidates);
+      auto max_d2 = static_cast<float>(cell * cell);
+      block.within(max_d2, candidates);
+      if (candidates.size() < want) block.within(max_d2 = static_cast<float>(reach * reach), candidates);
       if (candidates.size() >= want) {
-        std::nth_element(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(want - 1), candidates.end());
+        select_nearest(candidates, want, max_d2, scratch);
       } else {
         search_rings(i);
       }
