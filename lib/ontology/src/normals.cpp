@@ -88,9 +88,14 @@ class Block {
   /// The block's points within sqrt(max_d2) of the last distances()' point, as (squared distance,
   /// id), into out (cleared).
   void within(float max_d2, std::vector<Candidate>& out) const {
-    out.clear();
-    for (std::size_t j = 0; j < d2_.size(); ++j)
-      if (d2_[j] <= max_d2) out.emplace_back(d2_[j], id_[j]);
+    // Branchless: every point is written, the count moves past those within reach.
+    out.resize(d2_.size() + 1);
+    std::size_t count = 0;
+    for (std::size_t j = 0; j < d2_.size(); ++j) {
+      out[count] = Candidate(d2_[j], id_[j]);
+      count += d2_[j] <= max_d2 ? 1 : 0;
+    }
+    out.resize(count);
   }
 
  private:
