@@ -105,16 +105,33 @@ class Block {
 
 /// The 90th percentile over a sample of up to 32 points of the distance to their k-th nearest
 /// neighbour (brute force: 32 x n distances): a cell that wide holds the k nearest of 9 in 10
-/// points within the 27 cells around them.
+/// points within the 27 cells around them. Only the distances within three times the largest such
+/// distance so far are selected from (the k nearest are among them when there are k), the others
+/// only when there are fewer; float distances, as the cell sets only the search's speed.
 double typical_kth_distance(const std::vector<Eigen::Vector3d>& p, int k) {
   const std::size_t n = p.size();
   const std::size_t step = std::max<std::size_t>(1, n / 32);
-  std::vector<double> d2(n), kth;
+  std::vector<Eigen::Vector3f> q(n);
+  for (std::size_t j = 0; j < n; ++j) q[j] = p[j].cast<float>();
+  std::vector<float> d2(n);
+  std::vector<double> kth;
+  float bound2 = std::numeric_limits<float>::infinity();
+  const auto want = static_cast<std::size_t>(k) + 1;  // the point itself is its own nearest
   for (std::size_t i = 0; i < n; i += step) {
-    for (std::size_t j = 0; j < n; ++j) d2[j] = (p[j] - p[i]).squaredNorm();
-    // Index k: the point itself is the nearest (0), its k-th neighbour the (k+1)-th smallest.
-    std::nth_element(d2.begin(), d2.begin() + k, d2.end());
-    kth.push_back(std::sqrt(d2[static_cast<std::size_t>(k)]));
+    std::size_t count = 0;
+    for (std::size_t j = 0; j < n; ++j) {  // branchless: each written, the count moved past the near
+      const float d = (q[j] - q[i]).squaredNorm();
+      d2[count] = d;
+      count += d <= bound2 ? 1 : 0;
+    }
+    if (count < want) {
+      for (std::size_t j = 0; j < n; ++j) d2[j] = (q[j] - q[i]).squaredNorm();
+      count = n;
+    }
+    std::nth_element(d2.begin(), d2.begin() + k, d2.begin() + static_cast<std::ptrdiff_t>(count));
+    const float kth2 = d2[static_cast<std::size_t>(k)];
+    kth.push_back(std::sqrt(static_cast<double>(kth2)));
+    bound2 = kth.size() == 1 ? 9 * kth2 : std::max(bound2, 9 * kth2);
   }
   const std::size_t at = kth.size() * 9 / 10;
   std::nth_element(kth.begin(), kth.begin() + static_cast<std::ptrdiff_t>(at), kth.end());
