@@ -1,5 +1,6 @@
 // Primitive fitting per object: scenewatch's fit_object (grid k-NN normals, CGAL Efficient RANSAC
-// over four shapes, cylinder refinement), the same with its former kd-tree normals (PCL's
+// over four shapes, cylinder refinement), the same without cone detection (a candidate default: the
+// classes never use a cone but as a nearly straight cylinder), the same with its former kd-tree normals (PCL's
 // NormalEstimation), and PCL's cylinder RANSAC (SACSegmentationFromNormals, SACMODEL_CYLINDER, with
 // kd-tree normals) on the same clusters, in the same run: the
 // objects of the segmented YCB frames and of a simulated frame with a can and a cup. Also the time
@@ -115,18 +116,21 @@ int run_fit(const Options& o) {
               o.repetitions);
   std::printf("(ours: grid normals; kd: ours with the former kd-tree normals; nrm, det, ref: our normals', shape detection's\n"
               " and refinement's share; kd nrm: the kd-tree normals'; cpu: ours in this thread's CPU time; 6k cpu: the same\n"
-              " with the former 6000-point subsample and no depth-edge margin, and its radius)\n");
-  std::printf("%-24s %6s %7s %7s %7s %6s %6s %6s %6s %6s %6s %6s %9s %9s %9s %9s %9s %11s %-8s\n", "scene/object", "points", "ours ms",
-              "kd ms", "pcl ms", "nrm", "det", "ref", "kd nrm", "cpu", "6k cpu", "ratio", "best", "ours r mm", "6k r mm", "kd r mm",
+              " with the former 6000-point subsample and no depth-edge margin, and its radius; no-cone cpu: ours without\n"
+              " cone detection)\n");
+  std::printf("%-24s %6s %7s %7s %7s %6s %6s %6s %6s %6s %6s %8s %6s %9s %9s %9s %9s %9s %11s %-8s\n", "scene/object", "points", "ours ms",
+              "kd ms", "pcl ms", "nrm", "det", "ref", "kd nrm", "cpu", "6k cpu", "no-cone", "ratio", "best", "ours r mm", "6k r mm", "kd r mm",
               "pcl r mm", "describe ms", "class");
   std::vector<double> ratios, ours_all, kd_all, pcl_all, describe_all, normals_all, kd_normals_all, radius_diffs, cpu_all,
-      former_cpu_all;
+      former_cpu_all, no_cone_cpu_all, no_cone_radius_diffs;
   const ontology::FitConfig config;
   ontology::FitConfig kd_config;
   kd_config.normal_search = ontology::NormalSearch::kKdTree;
   ontology::FitConfig former;
   former.max_points = 6000;
   former.edge_margin_deg = 0;
+  ontology::FitConfig no_cones;
+  no_cones.detect_cone = false;
   auto classes = ontology::load_classes_file(std::filesystem::path(SCENEWATCH_SOURCE_DIR) / "config/ontology.yaml");
   if (!classes) {
     std::fprintf(stderr, "%s\n", classes.error().message.c_str());
@@ -142,9 +146,9 @@ int run_fit(const Options& o) {
       for (const auto& plane : seg.planes)
         if (plane.id == object.plane_id) up = plane.normal;
       const std::vector<int> same = subsample(cloud, object.indices, config.max_points);
-      std::vector<double> ours, kd, theirs, described, normals, detection, refinement, kd_normals, cpu, former_cpu;
+      std::vector<double> ours, kd, theirs, described, normals, detection, refinement, kd_normals, cpu, former_cpu, no_cone_cpu;
       Result<ontology::ObjectFit> fit = invalid_argument("not run"), kd_fit = invalid_argument("not run");
-      Result<ontology::ObjectFit> former_fit = invalid_argument("not run");
+      Result<ontology::ObjectFit> former_fit = invalid_argument("not run"), no_cone_fit = invalid_argument("not run");
       Result<ontology::ObjectDescription> description = invalid_argument("not run");
       double pcl_radius = 0;
       for (int r = 0; r < o.repetitions; ++r) {
@@ -152,6 +156,7 @@ int run_fit(const Options& o) {
         kd.push_back(time_ms([&] { kd_fit = ontology::fit_object(cloud, object.indices, kd_config, up); }));
         cpu.push_back(cpu_ms([&] { fit = ontology::fit_object(cloud, object.indices, config, up); }));
         former_cpu.push_back(cpu_ms([&] { former_fit = ontology::fit_object(cloud, object.indices, former, up); }));
+        no_cone_cpu.push_back(cpu_ms([&] { no_cone_fit = ontology::fit_object(cloud, object.indices, no_cones, up); }));
         theirs.push_back(time_ms([&] { pcl_radius = pcl_cylinder_radius(cloud, same); }));
         described.push_back(time_ms([&] { description = ontology::describe(cloud, object.indices, up, *classes); }));
         if (fit) {
@@ -161,7 +166,7 @@ int run_fit(const Options& o) {
         }
         if (kd_fit) kd_normals.push_back(kd_fit->normals_ms);
       }
-      if (!fit || !kd_fit || !former_fit) continue;
+      if (!fit || !kd_fit || !former_fit || !no_cone_fit) continue;
       const double a = median(ours), akd = median(kd), b = median(theirs);
       ratios.push_back(a / b);
       ours_all.push_back(a);
@@ -175,12 +180,14 @@ int run_fit(const Options& o) {
       const double r_former = former_fit->cylinder ? former_fit->cylinder->radius_m * 1000 : 0.0;
       cpu_all.push_back(median(cpu));
       former_cpu_all.push_back(median(former_cpu));
+      no_cone_cpu_all.push_back(median(no_cone_cpu));
+      if (fit->cylinder && no_cone_fit->cylinder) no_cone_radius_diffs.push_back(std::abs(r_ours - no_cone_fit->cylinder->radius_m * 1000));
       if (fit->cylinder && kd_fit->cylinder) radius_diffs.push_back(std::abs(r_ours - r_kd));
       const char* best = fit->best >= 0 ? ontology::to_string(fit->shapes[static_cast<std::size_t>(fit->best)].kind) : "-";
       const std::string name = scene.name + " #" + std::to_string(k);
-      std::printf("%-24s %6zu %7.1f %7.1f %7.1f %6.1f %6.1f %6.1f %6.1f %6.1f %6.1f %6.2f %9s %9.1f %9.1f %9.1f %9.1f %11.1f %-8s\n",
+      std::printf("%-24s %6zu %7.1f %7.1f %7.1f %6.1f %6.1f %6.1f %6.1f %6.1f %6.1f %8.1f %6.2f %9s %9.1f %9.1f %9.1f %9.1f %11.1f %-8s\n",
                   name.c_str(), same.size(), a, akd, b, median(normals), median(detection), median(refinement), median(kd_normals),
-                  median(cpu), median(former_cpu), a / b, best, r_ours, r_former, r_kd, pcl_radius * 1000, median(described),
+                  median(cpu), median(former_cpu), median(no_cone_cpu), a / b, best, r_ours, r_former, r_kd, pcl_radius * 1000, median(described),
                   description ? description->class_name.c_str() : "error");
     }
   }
@@ -188,8 +195,14 @@ int run_fit(const Options& o) {
               "median ratio ours/PCL %.2f; median describe %.1f ms\n",
               ratios.size(), median(ours_all), median(normals_all), median(kd_all), median(kd_normals_all), median(pcl_all),
               median(ratios), median(describe_all));
-  std::printf("CPU time: median ours %.1f ms, with the former 6000-point subsample and no edge margin %.1f ms\n", median(cpu_all),
-              median(former_cpu_all));
+  std::printf("CPU time: median ours %.1f ms, with the former 6000-point subsample and no edge margin %.1f ms, without cones %.1f ms\n",
+              median(cpu_all), median(former_cpu_all), median(no_cone_cpu_all));
+  std::sort(no_cone_radius_diffs.begin(), no_cone_radius_diffs.end());
+  if (!no_cone_radius_diffs.empty())
+    std::printf("refined cylinder radius, with vs without cones, |difference| over %zu objects: median %.2f mm, above 0.1 mm on %td "
+                "(max %.2f mm)\n", no_cone_radius_diffs.size(), median(no_cone_radius_diffs),
+                no_cone_radius_diffs.end() - std::upper_bound(no_cone_radius_diffs.begin(), no_cone_radius_diffs.end(), 0.1),
+                no_cone_radius_diffs.back());
   std::sort(radius_diffs.begin(), radius_diffs.end());
   if (!radius_diffs.empty())
     std::printf("refined cylinder radius, grid vs kd-tree normals, |difference| over %zu objects: median %.2f mm, max %.2f mm\n",

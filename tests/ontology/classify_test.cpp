@@ -324,6 +324,9 @@ namespace {
 // the table's normal (the segmentation's largest plane) as up. A survey printed for the README:
 // the dataset has no per-object category, only the scenes' (learn0-16 boxes, learn17-24 stacked
 // boxes, learn25-32 occluded objects, learn33-44 cylindric objects). Classes are not tuned to it.
+// Floors at what was measured: no object of the box scenes is a can or a cup, and 9 of the 38
+// objects of the cylindric scenes are (4 cans, 5 cups; most others are tins of r 90-100 mm, wider
+// than a can, or lying, and learn38's two mugs are taken for cans: README, "Primitive fitting").
 TEST(ClassifyMosdSurvey, LabelledObjects) {
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
   const ClassLibrary library = shipped_classes();
@@ -360,6 +363,9 @@ TEST(ClassifyMosdSurvey, LabelledObjects) {
     for (const auto& [name, count] : classes) std::printf(" %s %d", name.c_str(), count);
     std::printf("\n");
   }
+  const auto round = [&](const std::string& category) { return counts[category]["can"] + counts[category]["cup"]; };
+  EXPECT_EQ(round("boxes"), 0) << "a box taken for a can or a cup";
+  EXPECT_GE(round("cylindric"), 9) << "fewer cans and cups among the cylindric scenes' objects than measured";
 }
 
 }  // namespace

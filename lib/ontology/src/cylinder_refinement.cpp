@@ -60,6 +60,10 @@ void recenter(const std::vector<Eigen::Vector3d>& points, const std::vector<int>
   s.c += (mean - s.c).dot(s.a) * s.a;
 }
 
+// At most 5 parameters: fixed-capacity Eigen types, no allocation per point.
+using Matrix5 = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 5, 5>;
+using Vector5 = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 5, 1>;
+
 // Levenberg-Marquardt on the Huber-weighted radial residuals (IRLS weights per iteration).
 // Parameters: (alpha, beta) tilt the axis towards u and v, (tx, ty) move it along u and v, dr.
 int levenberg_marquardt(const std::vector<Eigen::Vector3d>& points, const std::vector<int>& band, bool fix_axis,
@@ -71,8 +75,8 @@ int levenberg_marquardt(const std::vector<Eigen::Vector3d>& points, const std::v
   for (; iterations < 50; ++iterations) {
     Eigen::Vector3d u, v;
     basis(s.a, u, v);
-    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(n, n);
-    Eigen::VectorXd g = Eigen::VectorXd::Zero(n);
+    Matrix5 H = Matrix5::Zero(n, n);
+    Vector5 g = Vector5::Zero(n);
     for (const int i : band) {
       const Eigen::Vector3d d = points[static_cast<std::size_t>(i)] - s.c;
       const double along = d.dot(s.a);
@@ -82,7 +86,7 @@ int levenberg_marquardt(const std::vector<Eigen::Vector3d>& points, const std::v
       const Eigen::Vector3d m = perp / dist;
       const double res = dist - s.r;
       // d dist / d alpha = m . d perp / d alpha = -(d.a)(m.u), as m is orthogonal to a.
-      Eigen::VectorXd J(n);
+      Vector5 J(n);
       if (fix_axis) J << -m.dot(u), -m.dot(v), -1.0;
       else J << -along * m.dot(u), -along * m.dot(v), -m.dot(u), -m.dot(v), -1.0;
       const double w = huber_weight(res, h);
@@ -90,9 +94,9 @@ int levenberg_marquardt(const std::vector<Eigen::Vector3d>& points, const std::v
       g.noalias() += w * res * J;
     }
     bool accepted = false;
-    Eigen::VectorXd delta;
+    Vector5 delta;
     for (int attempt = 0; attempt < 10 && !accepted; ++attempt) {
-      Eigen::MatrixXd damped = H;
+      Matrix5 damped = H;
       damped.diagonal() += lambda * H.diagonal().cwiseMax(1e-12);
       delta = damped.ldlt().solve(-g);
       if (!delta.allFinite()) break;
