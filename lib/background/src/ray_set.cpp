@@ -25,6 +25,19 @@ void RaySet::reset(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi) {
   }
 }
 
+void RaySet::merge(const RaySet& other) {
+  // The same bounds give the same layout (a bitmap of the same size, or hash sets).
+  if (use_bitmap_) {
+    for (std::size_t w = 0; w < free_bits_.size() && w < other.free_bits_.size(); ++w) {
+      free_bits_[w] |= other.free_bits_[w];
+      end_bits_[w] |= other.end_bits_[w];
+    }
+    return;
+  }
+  free_set_.insert(other.free_set_.begin(), other.free_set_.end());
+  end_set_.insert(other.end_set_.begin(), other.end_set_.end());
+}
+
 void RaySet::clear() {
   free_set_.clear();
   end_set_.clear();

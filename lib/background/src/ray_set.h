@@ -29,6 +29,8 @@ class RaySet {
   template <typename F>
   void for_each(F&& f) const;
   void clear();
+  /// Adds every key of `other`, which was reset() with the same bounds.
+  void merge(const RaySet& other);
 
  private:
   using Bits = std::vector<std::uint64_t>;
