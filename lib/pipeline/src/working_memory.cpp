@@ -555,6 +555,7 @@ void WorkingMemory::reset() {
   impl_->fusion.reset();
   impl_->foreground.reset();
   impl_->planes.clear();
+  impl_->last_camera = Pose::Identity();
   impl_->frames = impl_->points = 0;
   impl_->total_ms = impl_->last_ms = 0;
   impl_->last_stamp_s = 0.0;
