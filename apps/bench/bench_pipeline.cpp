@@ -182,8 +182,13 @@ void stream(const Sequence& s, const std::filesystem::path& model_dir, std::size
     std::printf("   over TCP: an ingest failed\n");
     return;
   }
-  std::printf("   over TCP into scenewatchd, %s: %.1f frames/s sustained, %zu events\n",
-              window == 1 ? "frame after reply        " : "two frames in flight     ", 1000.0 * s.frames.size() / wall, events);
+  proto::Request stats;
+  stats.mutable_stats();
+  auto reply = client->call(stats, 30);
+  const double process_ms = reply && reply->has_stats() ? reply->stats().mean_frame_ms() : 0.0;
+  std::printf("   over TCP into scenewatchd, %s: %.1f frames/s sustained, %zu events (the daemon's process() %.1f ms mean)\n",
+              window == 1 ? "frame after reply        " : "two frames in flight     ", 1000.0 * s.frames.size() / wall, events,
+              process_ms);
 }
 
 void over_tcp(const Sequence& s) {
