@@ -60,7 +60,9 @@ int main(int argc, char** argv) {
   ingest->footer(
       "Sequence folders: the 7-Scenes layout (frame-NNNNNN.color.png|.jpg, .depth.png, .pose.txt,\n"
       "camera-intrinsics.txt) or the TUM RGB-D layout (rgb.txt, depth.txt, groundtruth.txt), told apart by\n"
-      "their files. Depth in mm (TUM: 1/5000 m) unless depth-scale.txt or --depth-scale says otherwise.");
+      "their files. Depth in mm (TUM: 1/5000 m) unless depth-scale.txt or --depth-scale says otherwise.\n"
+      "A sequence's frames go two at a time: the next frame is read and sent while the daemon processes the\n"
+      "one before it; every frame is processed, in order, and the answers are printed in that order.");
   ingest->add_option("paths", ingest_paths, "cloud files and/or sequence folders")->required();
   ingest->add_flag("--server-side", server_side,
                    "let the daemon read the files itself (absolute paths under its data roots)");
