@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <ctime>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -479,6 +480,54 @@ TEST(HandDetector, RememberedPlanesGiveTheSameHandsOnHrt1) {
     std::printf("%s: hand proper's pixels, remembered vs searched planes: IoU %.4f over %zu frames\n", name.c_str(), iou, frames);
     EXPECT_GT(iou, 0.95);
   }
+}
+
+// A hand-held camera (7-Scenes redkitchen, 50 posed frames): the remembered planes follow the
+// camera's motion (HandMemory::camera_moved), so they are searched for less often, with no more
+// false agents (there is no person here: skin-coloured wood, which the pipeline's remembered-
+// surface check drops later) than searching in every frame.
+TEST(HandDetector, RememberedPlanesFollowAMovingCamera) {
+  SCENEWATCH_REQUIRE_DATA("redkitchen");
+  auto seq = io::open_sequence(test::data_dir() / "redkitchen");
+  ASSERT_TRUE(seq.ok());
+  HandMemory moved, fixed;
+  std::optional<Pose> before;
+  std::size_t same = 0, both = 0, same_fixed = 0, both_fixed = 0, agents_searched = 0, agents_moved = 0, agents_fixed = 0;
+  for (std::size_t f = 0; f < seq->frames.size(); ++f) {
+    auto frame = io::load_sequence_frame(*seq, f);
+    ASSERT_TRUE(frame.ok());
+    ASSERT_TRUE(frame->T_world_camera.has_value());
+    if (before) moved.camera_moved((frame->T_world_camera->inverse() * *before).cast<float>());
+    before = frame->T_world_camera;
+    const HandDetection searched = detect_hands(*frame->cloud, HandConfig{});
+    const HandDetection remembered = detect_hands(*frame->cloud, HandConfig{}, &moved);
+    const HandDetection unmoved = detect_hands(*frame->cloud, HandConfig{}, &fixed);
+    for (std::size_t i = 0; i < searched.labels.size(); ++i) {
+      const bool a = searched.labels[i] != AgentLabel::kNone, b = remembered.labels[i] != AgentLabel::kNone;
+      const bool c = unmoved.labels[i] != AgentLabel::kNone;
+      same += a && b;
+      both += a || b;
+      same_fixed += a && c;
+      both_fixed += a || c;
+      agents_searched += a;
+      agents_moved += b;
+      agents_fixed += c;
+    }
+  }
+  const double iou = both ? static_cast<double>(same) / both : 1.0;
+  std::printf("redkitchen: planes in the camera's frame, against searching every frame: IoU %.4f; agent pixels "
+              "(all false here) searched %zu, planes following %zu, planes in the camera's frame %zu\n",
+              both_fixed ? static_cast<double>(same_fixed) / both_fixed : 1.0, agents_searched, agents_moved, agents_fixed);
+  std::printf("redkitchen: plane searches over %zu frames: %zu with the planes following the camera, %zu without; "
+              "agents' pixels against searching every frame: IoU %.4f (%zu pixels)\n",
+              seq->frames.size(), moved.plane_searches(), fixed.plane_searches(), iou, both);
+  // Measured: 25 searches against 58 (tables and walls together); the false agents' pixels
+  // 1.24 M against 1.50 M for searching every frame and 1.12 M for planes kept in the camera's
+  // frame. RANSAC itself does not find the same planes twice here (the camera-frame memory agrees
+  // with searching every frame at IoU 0.69, the following one at 0.62), so the pixels are not
+  // compared one by one.
+  EXPECT_LE(moved.plane_searches(), 30u);
+  EXPECT_LE(agents_moved, agents_searched) << "no more false agents than searching every frame";
 }
 
 }  // namespace

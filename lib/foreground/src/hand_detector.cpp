@@ -111,6 +111,18 @@ HandMemory::HandMemory(HandMemory&&) noexcept = default;
 HandMemory& HandMemory::operator=(HandMemory&&) noexcept = default;
 void HandMemory::reset() { *planes_ = Planes{}; }
 
+std::size_t HandMemory::plane_searches() const { return planes_->tables.searches + planes_->walls.searches; }
+
+void HandMemory::camera_moved(const Eigen::Isometry3f& T_now_prev) {
+  // n . p + d = 0 for p in the previous frame; p = R^T (q - t) for q in the new one.
+  for (PlaneMemory* memory : {&planes_->tables, &planes_->walls}) {
+    for (SupportPlane& plane : memory->planes) {
+      plane.normal = T_now_prev.linear() * plane.normal;
+      plane.d -= plane.normal.dot(T_now_prev.translation());
+    }
+  }
+}
+
 HandDetection detect_hands(const Cloud& organized, const HandConfig& config) {
   return detect_hands(organized, config, nullptr);
 }

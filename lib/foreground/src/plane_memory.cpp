@@ -59,6 +59,7 @@ std::vector<SupportPlane> find_support_planes(const std::vector<Eigen::Vector3f>
   std::vector<SupportPlane> planes = find_support_planes(points, valid, width, height, config, on_plane);
   memory->planes = planes;
   memory->frames_since_search = 0;
+  ++memory->searches;
   return planes;
 }
 

@@ -14,7 +14,8 @@ namespace scenewatch::foreground {
 struct PlaneMemory {
   std::vector<SupportPlane> planes;  ///< as last searched for, each with its patch points then
   int frames_since_search = -1;      ///< -1: nothing remembered
-  void clear() { *this = PlaneMemory{}; }
+  std::size_t searches = 0;          ///< RANSAC searches made (the frames whose planes did not hold)
+  void clear() { *this = PlaneMemory{}; }  // the search count too
 };
 
 /// find_support_planes with a memory: when every remembered plane still has large patches of at

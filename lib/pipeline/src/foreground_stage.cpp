@@ -105,6 +105,13 @@ Frame ForegroundStage::prepare(const Frame& frame, std::uint64_t frame_index, co
 
   const auto t_hands = Clock::now();
   if (config_.hands.enabled && frame.has_color && frame.cloud->height > 1) {
+    // A moving camera: the remembered planes move with it (a hand-held room sequence otherwise
+    // searched its planes again in every frame).
+    if (frame.T_world_camera && last_pose_) {
+      const Pose T_now_prev = frame.T_world_camera->inverse() * *last_pose_;
+      if (!T_now_prev.matrix().isIdentity(1e-9)) hand_memory_.camera_moved(T_now_prev.cast<float>());
+    }
+    last_pose_ = frame.T_world_camera;
     detection_ = foreground::detect_hands(*frame.cloud, config_.hands, &hand_memory_);
     drop_static_hands(*frame.cloud, T, occupied);
   }
@@ -151,6 +158,7 @@ foreground::ForegroundUpdate ForegroundStage::update(const std::vector<ObjectClu
 void ForegroundStage::reset() {
   tracker_.reset();
   hand_memory_.reset();
+  last_pose_.reset();
   recent_hands_.clear();
   hands_ = HandsSeen{};
   cloud_.reset();

@@ -5,6 +5,7 @@
 // map); after the segmentation, contacts and promotion.
 #include <cstdint>
 #include <deque>
+#include <optional>
 #include <functional>
 #include <vector>
 
@@ -38,6 +39,7 @@ class ForegroundStage {
   foreground::ForegroundConfig config_;
   foreground::ForegroundTracker tracker_;
   foreground::HandMemory hand_memory_;  // the support planes, from frame to frame
+  std::optional<Pose> last_pose_;        // the camera of the frame before, for the planes to follow
   // This frame's, between prepare() and update().
   foreground::HandDetection detection_;
   foreground::FrameView view_;

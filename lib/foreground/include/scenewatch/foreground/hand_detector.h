@@ -87,8 +87,14 @@ class HandMemory {
   ~HandMemory();
   HandMemory(HandMemory&&) noexcept;
   HandMemory& operator=(HandMemory&&) noexcept;
-  /// Forgets the planes (a new stream, or the camera moved).
+  /// Forgets the planes (a new stream).
   void reset();
+  /// The camera moved by `T_now_prev` (a point in the previous frame's camera coordinates to the
+  /// new one's): the remembered planes are moved with it, to be checked on the next frame as
+  /// usual (a plane that no longer holds is searched for again).
+  void camera_moved(const Eigen::Isometry3f& T_now_prev);
+  /// How many times the planes were searched for (RANSAC) since the memory was made or reset.
+  std::size_t plane_searches() const;
   struct Planes;  ///< private to the detector
   Planes& planes() { return *planes_; }
 
