@@ -76,7 +76,6 @@ CloudPtr thinned(const Cloud& in, double voxel, std::size_t max_points) {
   return out;
 }
 
-// A cluster's points (world frame).
 // The world box around a cluster's oriented box (clusters come in the world frame).
 Aabb world_box(const ObjectCluster& c) {
   const Eigen::Matrix3d R = c.box.rotation.toRotationMatrix();
@@ -84,6 +83,7 @@ Aabb world_box(const ObjectCluster& c) {
   return {c.box.center - half, c.box.center + half};
 }
 
+// A cluster's points (world frame).
 std::vector<Eigen::Vector3d> world_points(const FrameView& f, const ObjectCluster& c) {
   std::vector<Eigen::Vector3d> out;
   out.reserve(c.indices.size());

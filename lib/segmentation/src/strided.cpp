@@ -56,13 +56,13 @@ std::vector<std::vector<int>> upsample(const Cloud& cloud, const std::vector<int
     const int sv = v / stride;
     for (int su = 0; su < sw; ++su) {
       if (!labelled_block[static_cast<std::size_t>(sv) * sw + su]) continue;
+      const std::array<int, 4> around{corner(su, sv, 0), corner(su, sv, 1), corner(su, sv, 2), corner(su, sv, 3)};
       for (int u = su * stride; u < std::min(w, (su + 1) * stride); ++u) {
         const PointT& p = cloud.points[static_cast<std::size_t>(v) * w + u];
         if (!is_valid(p)) continue;
         float best = std::numeric_limits<float>::infinity();
         int label = -1;
-        for (int k = 0; k < 4; ++k) {
-          const int s = corner(su, sv, k);
+        for (int s : around) {
           if (s < 0) continue;
           const PointT& q = cloud.points[static_cast<std::size_t>(s / sw * stride) * w + (s % sw) * stride];
           if (!is_valid(q)) continue;
