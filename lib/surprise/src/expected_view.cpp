@@ -18,18 +18,18 @@ Status validate(const ExpectedViewConfig& c) {
 
 namespace {
 
-// Fills runs of missing depth along one line (stride apart) no longer than max_gap whose two ends
+// Fills runs of missing depth along one row no longer than max_gap whose two ends
 // agree within tolerance, by linear interpolation: the holes glass and grazing angles leave in
 // every keyframe's depth, which would otherwise leave the surface behind them without samples.
-void fill_line(float* d, int n, std::ptrdiff_t stride, int max_gap, float rel) {
+void fill_line(float* d, int n, int max_gap, float rel) {
   int last = -1;
   for (int i = 0; i < n; ++i) {
-    const float z = d[i * stride];
+    const float z = d[i];
     if (z <= 0.0f) continue;
     if (last >= 0 && i - last > 1 && i - last - 1 <= max_gap) {
-      const float z0 = d[last * stride];
+      const float z0 = d[last];
       if (std::abs(z - z0) <= rel * std::min(z, z0)) {
-        for (int k = last + 1; k < i; ++k) d[k * stride] = z0 + (z - z0) * static_cast<float>(k - last) / static_cast<float>(i - last);
+        for (int k = last + 1; k < i; ++k) d[k] = z0 + (z - z0) * static_cast<float>(k - last) / static_cast<float>(i - last);
       }
     }
     last = i;
@@ -41,8 +41,27 @@ void fill_depth_holes(std::vector<float>* depth, int w, int h, const ExpectedVie
   if (max_gap <= 0) return;
   const float rel = static_cast<float>(config.fill_holes_max_jump);
   std::vector<float> horizontal = *depth;
-  for (int v = 0; v < h; ++v) fill_line(horizontal.data() + static_cast<std::size_t>(v) * w, w, 1, max_gap, rel);
-  for (int u = 0; u < w; ++u) fill_line(depth->data() + u, h, w, max_gap, rel);
+  for (int v = 0; v < h; ++v) fill_line(horizontal.data() + static_cast<std::size_t>(v) * w, w, max_gap, rel);
+  // The columns row by row (a column at a time would read a new cache line at every pixel):
+  // each column remembers its last row with depth, and a gap is filled when it closes.
+  float* d = depth->data();
+  std::vector<int> last(static_cast<std::size_t>(w), -1);
+  for (int v = 0; v < h; ++v) {
+    const float* row = d + static_cast<std::size_t>(v) * w;
+    for (int u = 0; u < w; ++u) {
+      const float z = row[u];
+      if (z <= 0.0f) continue;
+      const int l = last[static_cast<std::size_t>(u)];
+      if (l >= 0 && v - l > 1 && v - l - 1 <= max_gap) {
+        const float z0 = d[static_cast<std::size_t>(l) * w + u];
+        if (std::abs(z - z0) <= rel * std::min(z, z0)) {
+          for (int k = l + 1; k < v; ++k)
+            d[static_cast<std::size_t>(k) * w + u] = z0 + (z - z0) * static_cast<float>(k - l) / static_cast<float>(v - l);
+        }
+      }
+      last[static_cast<std::size_t>(u)] = v;
+    }
+  }
   // A pixel filled both ways takes the nearer surface; filled one way, that one.
   for (std::size_t i = 0; i < depth->size(); ++i) {
     const float a = horizontal[i], b = (*depth)[i];
@@ -110,23 +129,29 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
   view.reference_views = refs.size();
 
   const float tol_m = static_cast<float>(config.depth_tolerance_m), tol_rel = static_cast<float>(config.depth_tolerance_rel);
-  // One colour sample of camera point p from one reference, in opponent signals; false when the
-  // reference does not see p (outside, behind, or occluded there).
-  const auto sample_ref = [&](const Ref& ref, const Eigen::Vector3f& p, float opp[kChannels]) {
-    const Eigen::Vector3f q = ref.A * p + ref.b;
-    if (q.z() <= 0.05f) return false;
-    const float iz = 1.0f / q.z();
-    const float ur = q.x() * iz, vr = q.y() * iz;
-    if (!(ur >= 0.0f && vr >= 0.0f && ur < ref.umax && vr < ref.vmax)) return false;
+  // Where a camera point falls in a reference: pixel coordinates and depth there; z = 0 when
+  // outside its image or behind it.
+  struct Projection {
+    float u, v, z;
+  };
+  // The keyframe's pixel a projection's depth test reads, and the first of the four its colour does.
+  const auto depth_pixel = [](const Ref& ref, const Projection& q) {
+    return static_cast<std::size_t>(static_cast<int>(q.v + 0.5f)) * ref.width + static_cast<std::size_t>(q.u + 0.5f);
+  };
+  const auto colour_pixel = [](const Ref& ref, const Projection& q) {
+    return static_cast<std::size_t>(static_cast<int>(q.v)) * ref.width + static_cast<std::size_t>(q.u);
+  };
+  // One colour sample of a projection (z > 0) in opponent signals; false when the reference does
+  // not see the point (occluded there).
+  const auto sample_projection = [&](const Ref& ref, const Projection& q, float opp[kChannels]) {
     // Unoccluded: the keyframe's own depth at that pixel agrees with the point's depth in it.
     // Where the keyframe has no depth (glass, grazing surfaces) nothing refutes the sample.
-    const int ui = static_cast<int>(ur + 0.5f), vi = static_cast<int>(vr + 0.5f);
-    const std::uint16_t mm = ref.depth[static_cast<std::size_t>(vi) * ref.width + ui];
-    if (mm != 0 && mm != 65535 && std::abs(mm * 0.001f - q.z()) > tol_m + tol_rel * q.z()) return false;
+    const std::uint16_t mm = ref.depth[depth_pixel(ref, q)];
+    if (mm != 0 && mm != 65535 && std::abs(mm * 0.001f - q.z) > tol_m + tol_rel * q.z) return false;
     // Bilinear colour in 8-bit fixed-point weights: one conversion per channel, not four.
-    const int u0 = static_cast<int>(ur), v0 = static_cast<int>(vr);
-    const int wu = static_cast<int>((ur - u0) * 256.0f), wv = static_cast<int>((vr - v0) * 256.0f);
-    const std::uint8_t* p00 = ref.rgb + 3 * (static_cast<std::size_t>(v0) * ref.width + u0);
+    const int u0 = static_cast<int>(q.u), v0 = static_cast<int>(q.v);
+    const int wu = static_cast<int>((q.u - u0) * 256.0f), wv = static_cast<int>((q.v - v0) * 256.0f);
+    const std::uint8_t* p00 = ref.rgb + 3 * colour_pixel(ref, q);
     const std::uint8_t* p10 = p00 + 3;
     const std::uint8_t* p01 = p00 + 3 * static_cast<std::size_t>(ref.width);
     const std::uint8_t* p11 = p01 + 3;
@@ -140,9 +165,10 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
     opp[kBlueYellow] = B - 0.5f * (R + G);
     return true;
   };
-  const auto camera_point = [&](std::size_t i, int u, int v) {
+  const auto camera_point = [&](std::size_t i) {
     const float z = view.depth_m[i];
-    return Eigen::Vector3f(xn[static_cast<std::size_t>(u)] * z, yn[static_cast<std::size_t>(v)] * z, z);
+    const std::size_t u = i % static_cast<std::size_t>(K.width), v = i / static_cast<std::size_t>(K.width);
+    return Eigen::Vector3f(xn[u] * z, yn[v] * z, z);
   };
   const auto store = [&](std::size_t i, int n, const float* sum, const float* sumsq) {
     view.count[i] = static_cast<std::uint8_t>(n);
@@ -154,46 +180,49 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
       view.ssd[c][i] = std::max(0.0f, sumsq[c] - sum[c] * mean);
     }
   };
-  const auto sample_pixel = [&](std::size_t i, int u, int v) {
-    const Eigen::Vector3f p = camera_point(i, u, v);
-    float sum[kChannels] = {0, 0, 0}, sumsq[kChannels] = {0, 0, 0}, opp[kChannels];
-    int n = 0;
-    for (const Ref& ref : refs) {
-      if (!sample_ref(ref, p, opp)) continue;
-      for (int c = 0; c < kChannels; ++c) {
-        sum[c] += opp[c];
-        sumsq[c] += opp[c] * opp[c];
-      }
-      ++n;
+  // Samples the given pixels (each with an expected surface) one reference at a time: each
+  // reference's images are then read in order, which the caches follow; pixel by pixel, seven
+  // images read at once miss the cache on most reads. A reference's reads are projected first,
+  // then fetched a few pixels ahead of their use: seven keyframes' images (10 MB at VGA) do not
+  // stay in the cache from frame to frame, and waiting for each read in turn cost most of the time.
+  const auto sample_pixels = [&](const std::vector<std::uint32_t>& pixels) {
+    const std::size_t np = pixels.size();
+    std::vector<float> px(np), py(np), pz(np);  // the camera points, one array per coordinate
+    for (std::size_t g = 0; g < np; ++g) {
+      const Eigen::Vector3f p = camera_point(pixels[g]);
+      px[g] = p.x();
+      py[g] = p.y();
+      pz[g] = p.z();
     }
-    store(i, n, sum, sumsq);
-  };
-
-  // Samples on a grid of `step` pixels, one reference at a time (each reference's images are
-  // then read in order, which the caches and prefetchers follow; pixel by pixel, seven images
-  // read at once miss the cache on most reads). The pixels between take their grid anchor's
-  // statistics when they lie on the same surface (depths agree), else they are sampled themselves.
-  const int step = std::max(1, static_cast<int>(std::lround(config.sample_step_px * K.width / 640.0)));
-  const int w = K.width, h = K.height;
-  {
-    std::vector<std::uint32_t> grid;  // pixels of the grid with an expected surface
-    for (int v = 0; v < h; v += step) {
-      for (int u = 0; u < w; u += step) {
-        const std::size_t i = static_cast<std::size_t>(v) * w + u;
-        if (view.depth_m[i] > 0.0f) grid.push_back(static_cast<std::uint32_t>(i));
-      }
-    }
-    std::vector<Eigen::Vector3f> points(grid.size());
-    for (std::size_t g = 0; g < grid.size(); ++g) {
-      const int u = static_cast<int>(grid[g] % static_cast<std::uint32_t>(w)), v = static_cast<int>(grid[g] / static_cast<std::uint32_t>(w));
-      points[g] = camera_point(grid[g], u, v);
-    }
-    std::vector<float> acc(grid.size() * 2 * kChannels, 0.0f);  // per grid pixel: sums then sums of squares
-    std::vector<std::uint8_t> n(grid.size(), 0);
+    std::vector<float> acc(np * 2 * kChannels, 0.0f);  // per pixel: sums then sums of squares
+    std::vector<std::uint8_t> n(np, 0);
+    std::vector<Projection> projections(np);
+    constexpr std::size_t kAhead = 64;
     float opp[kChannels];
     for (const Ref& ref : refs) {
-      for (std::size_t g = 0; g < grid.size(); ++g) {
-        if (!sample_ref(ref, points[g], opp)) continue;
+      // Straight-line arithmetic on arrays, which the compiler runs four points at a time.
+      const float a00 = ref.A(0, 0), a01 = ref.A(0, 1), a02 = ref.A(0, 2), b0 = ref.b.x();
+      const float a10 = ref.A(1, 0), a11 = ref.A(1, 1), a12 = ref.A(1, 2), b1 = ref.b.y();
+      const float a20 = ref.A(2, 0), a21 = ref.A(2, 1), a22 = ref.A(2, 2), b2 = ref.b.z();
+      for (std::size_t g = 0; g < np; ++g) {
+        const float x = px[g], y = py[g], z = pz[g];
+        const float qx = a00 * x + a01 * y + a02 * z + b0;
+        const float qy = a10 * x + a11 * y + a12 * z + b1;
+        const float qz = a20 * x + a21 * y + a22 * z + b2;
+        const float iz = 1.0f / qz;
+        const float ur = qx * iz, vr = qy * iz;
+        const bool seen = qz > 0.05f && ur >= 0.0f && vr >= 0.0f && ur < ref.umax && vr < ref.vmax;
+        projections[g] = Projection{seen ? ur : 0.0f, seen ? vr : 0.0f, seen ? qz : 0.0f};
+      }
+      for (std::size_t g = 0; g < np; ++g) {
+        if (g + kAhead < np && projections[g + kAhead].z > 0.0f) {
+          const Projection& ahead = projections[g + kAhead];
+          const std::uint8_t* c = ref.rgb + 3 * colour_pixel(ref, ahead);
+          __builtin_prefetch(ref.depth + depth_pixel(ref, ahead));
+          __builtin_prefetch(c);
+          __builtin_prefetch(c + 3 * static_cast<std::size_t>(ref.width));
+        }
+        if (projections[g].z <= 0.0f || !sample_projection(ref, projections[g], opp)) continue;
         float* a = &acc[g * 2 * kChannels];
         for (int c = 0; c < kChannels; ++c) {
           a[c] += opp[c];
@@ -202,9 +231,23 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
         ++n[g];
       }
     }
-    for (std::size_t g = 0; g < grid.size(); ++g) store(grid[g], n[g], &acc[g * 2 * kChannels], &acc[g * 2 * kChannels + kChannels]);
+    for (std::size_t g = 0; g < np; ++g) store(pixels[g], n[g], &acc[g * 2 * kChannels], &acc[g * 2 * kChannels + kChannels]);
+  };
+
+  // Samples on a grid of `step` pixels. The pixels between take their grid anchor's statistics
+  // when they lie on the same surface (depths agree), else they are sampled themselves.
+  const int step = std::max(1, static_cast<int>(std::lround(config.sample_step_px * K.width / 640.0)));
+  const int w = K.width, h = K.height;
+  std::vector<std::uint32_t> pixels;
+  for (int v = 0; v < h; v += step) {
+    for (int u = 0; u < w; u += step) {
+      const std::size_t i = static_cast<std::size_t>(v) * w + u;
+      if (view.depth_m[i] > 0.0f) pixels.push_back(static_cast<std::uint32_t>(i));
+    }
   }
+  sample_pixels(pixels);
   if (step > 1) {
+    pixels.clear();
     for (int v = 0; v < h; ++v) {
       const int va = v - v % step;
       for (int u = 0; u < w; ++u) {
@@ -221,10 +264,11 @@ ExpectedView sample_expected_view(const background::DepthMap& depth,
             view.ssd[c][i] = view.ssd[c][a];
           }
         } else {
-          sample_pixel(i, u, v);
+          pixels.push_back(static_cast<std::uint32_t>(i));
         }
       }
     }
+    sample_pixels(pixels);
   }
   return view;
 }
