@@ -249,6 +249,12 @@ ObjectCluster make_object(const Cloud& cloud, std::vector<int> indices, int plan
   obj.point_count = indices.size();
   obj.centroid = sum / n;
   obj.mean_rgb = (rgb / n).cast<float>();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  for (int i : indices) {
+    const Eigen::Vector3d d = Eigen::Vector3d(cloud[i].r, cloud[i].g, cloud[i].b) - rgb / n;
+    covariance += d * d.transpose();
+  }
+  obj.rgb_covariance = (covariance / n).cast<float>();
   obj.box = box_on_plane(cloud, indices, up);
   obj.indices = std::move(indices);
   return obj;

@@ -445,6 +445,7 @@ struct RequestHandler::Impl {
       if (d) surface.points_world = std::move(d->completed_points);
       surface.spacing_m = dc.completion_spacing_m;
       surface.rgb = object.cluster.mean_rgb;
+      surface.rgb_covariance = object.cluster.rgb_covariance;
       memory.set_known_surface(id, object.cluster.centroid, std::move(surface));
     }
     *out = *cached.info;

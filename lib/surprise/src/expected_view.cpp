@@ -298,6 +298,13 @@ std::size_t splat_surface(ExpectedView& view, const KnownSurface& surface, doubl
   to_opponent(static_cast<std::uint8_t>(std::clamp(surface.rgb.x(), 0.0f, 255.0f)),
               static_cast<std::uint8_t>(std::clamp(surface.rgb.y(), 0.0f, 255.0f)),
               static_cast<std::uint8_t>(std::clamp(surface.rgb.z(), 0.0f, 255.0f)), opponent);
+  // Each opponent signal is a linear map of RGB (to_opponent), so its variance is m' C m.
+  Eigen::Matrix3f to_opp;
+  to_opp << 1.0f / 3, 1.0f / 3, 1.0f / 3, 1, -1, 0, -0.5f, -0.5f, 1;
+  to_opp /= 255.0f;
+  const Eigen::Matrix3f opp_covariance = to_opp * surface.rgb_covariance * to_opp.transpose();
+  float ssd[kChannels];
+  for (int c = 0; c < kChannels; ++c) ssd[c] = kMaxSamples * std::max(0.0f, opp_covariance(c, c));
   // The splat's depth first (nearest point per pixel), then what it changes.
   std::vector<float> splat(view.pixel_count(), 0.0f);
   for (const Eigen::Vector3d& p_world : surface.points_world) {
@@ -319,10 +326,10 @@ std::size_t splat_surface(ExpectedView& view, const KnownSurface& surface, doubl
     const float expected = view.depth_m[i];
     if (expected > 0.0f && z >= expected - static_cast<float>(tolerance_m)) continue;
     view.depth_m[i] = z;
-    view.count[i] = 1;
+    view.count[i] = kMaxSamples;
     for (int c = 0; c < kChannels; ++c) {
       view.mean[static_cast<std::size_t>(c)][i] = opponent[c];
-      view.ssd[static_cast<std::size_t>(c)][i] = 0.0f;
+      view.ssd[static_cast<std::size_t>(c)][i] = ssd[c];
     }
     ++changed;
   }

@@ -40,6 +40,9 @@ struct ObjectCluster {
   std::size_t point_count = 0;
   std::vector<int> indices;           ///< indices in the input cloud
   Eigen::Vector3f mean_rgb = Eigen::Vector3f::Zero();  ///< 0..255
+  /// The points' colour covariance (0..255 units squared): how much the object's colours vary,
+  /// which the expected view assumes for a side of the object it has not seen.
+  Eigen::Matrix3f rgb_covariance = Eigen::Matrix3f::Zero();
 };
 
 /// One episode of a person handling a foreground object, from the first touch to the release.

@@ -62,12 +62,16 @@ struct KnownSurface {
   std::vector<Eigen::Vector3d> points_world;
   double spacing_m = 0.004;                       ///< between neighbouring points
   Eigen::Vector3f rgb = Eigen::Vector3f::Zero();  ///< 0..255, the object's mean colour
+  /// The covariance of the object's colours (0..255 units squared; zero: one colour).
+  Eigen::Matrix3f rgb_covariance = Eigen::Matrix3f::Zero();
 };
 
 /// Splats `surface` into `view` as a z-buffer: each point covers the pixels of a square of
 /// spacing_m at its depth; where it is nearer than the expected depth by more than tolerance_m, or
-/// the mesh has no surface there, it becomes the expected depth, and its colour the pixel's only
-/// sample (the mesh's samples there belong to a surface it now hides). Returns the pixels changed.
+/// the mesh has no surface there, it becomes the expected depth, and the object's colours the
+/// pixel's samples (the mesh's samples there belong to a surface it now hides): their mean, and
+/// their spread as if every reference view had seen it. An unseen side is predicted to look like
+/// the seen one: a striped can's white and red both belong to it. Returns the pixels changed.
 std::size_t splat_surface(ExpectedView& view, const KnownSurface& surface, double tolerance_m = 0.01);
 
 /// The virtual image: the mean colour per pixel (the seed's Fig. 4.4 right); black where no sample.
