@@ -326,7 +326,8 @@ namespace {
 // boxes, learn25-32 occluded objects, learn33-44 cylindric objects). Classes are not tuned to it.
 // Floors at what was measured: no object of the box scenes is a can or a cup, and 9 of the 38
 // objects of the cylindric scenes are (4 cans, 5 cups; most others are tins of r 90-100 mm, wider
-// than a can, or lying, and learn38's two mugs are taken for cans: README, "Primitive fitting").
+// than a can, or lying; learn38's two mugs stand upside down, their closed bases up, and are cans
+// for this view: ClassifyMosdMugs below, README "Primitive fitting").
 TEST(ClassifyMosdSurvey, LabelledObjects) {
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
   const ClassLibrary library = shipped_classes();
@@ -366,6 +367,81 @@ TEST(ClassifyMosdSurvey, LabelledObjects) {
   const auto round = [&](const std::string& category) { return counts[category]["can"] + counts[category]["cup"]; };
   EXPECT_EQ(round("boxes"), 0) << "a box taken for a can or a cup";
   EXPECT_GE(round("cylindric"), 9) << "fewer cans and cups among the cylindric scenes' objects than measured";
+}
+
+/// One labelled object of an mOSD scene (label / 10 == id): its valid pixels, and the pairs of
+/// vertically neighbouring pixels on it whose ranges differ by more than 2 cm (the segmentation's
+/// gap between two surfaces). The near rim of an open vessel seen from above hides its inside
+/// beyond a jump like this all along the rim; a closed top shows none.
+struct MosdObject {
+  std::vector<int> indices;
+  int range_jumps = 0;
+};
+
+MosdObject mosd_object(const Cloud& cloud, const std::vector<std::uint32_t>& labels, std::uint32_t id) {
+  MosdObject out;
+  const std::size_t width = cloud.width;
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    if (labels[i] / 10 != id || !is_valid(cloud.points[i])) continue;
+    out.indices.push_back(static_cast<int>(i));
+    const std::size_t below = i + width;
+    if (below >= labels.size() || labels[below] / 10 != id || !is_valid(cloud.points[below])) continue;
+    const float jump = cloud.points[i].getVector3fMap().norm() - cloud.points[below].getVector3fMap().norm();
+    if (std::abs(jump) > 0.02f) ++out.range_jumps;
+  }
+  return out;
+}
+
+// The same two white mugs, open side up in learn39 (objects 3 and 4) and upside down in learn38
+// (objects 2 and 3: the colour image shows their closed bases with the foot ring). Seen from
+// 40-53 degrees above, an open mug of r 40 mm shows its far inside wall 2 r tan(elevation), from
+// 65 mm down to its bottom, beyond its near rim: a jump of several centimetres along the rim, whose
+// 80 mm span 50-65 columns at 0.65-0.8 m (measured: 45 and 51 pixel pairs; at least 20 asserted,
+// well under the rim's width). The upside-down mugs' tops fall smoothly in range from the far edge
+// to the near one (657 -> 620 mm and 826 -> 774 mm down their centre columns; 0 and 1 jumps, at
+// most 3 asserted, stray silhouette pixels): no inside to see. The open-top test must agree.
+TEST(ClassifyMosdMugs, OpenSideUpIsACupUpsideDownIsNot) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn38.pcd");
+  const ClassLibrary library = shipped_classes();
+  struct Mug {
+    int scene;
+    std::uint32_t id;
+    bool open_side_up;
+  };
+  for (const Mug& mug : {Mug{39, 3, true}, Mug{39, 4, true}, Mug{38, 2, false}, Mug{38, 3, false}}) {
+    const std::string name = "learn" + std::to_string(mug.scene) + " object " + std::to_string(mug.id);
+    SCOPED_TRACE(name);
+    const auto path = test::data_dir() / "mosd/learn" / ("learn" + std::to_string(mug.scene) + ".pcd");
+    auto file = io::read_cloud(path);
+    auto labels = io::read_pcd_labels(path);
+    ASSERT_TRUE(file.ok() && labels.ok()) << path;
+    const Cloud& cloud = *file->cloud;
+    // Up as in the survey: the normal of the largest plane, the table.
+    const segmentation::Segmentation scene = segmentation::segment(cloud, segmentation::Config{});
+    Eigen::Vector3d up(0, -1, 0);
+    double area = 0;
+    for (const auto& plane : scene.planes)
+      if (plane.area_m2 > area) up = plane.normal, area = plane.area_m2;
+    const MosdObject object = mosd_object(cloud, *labels, mug.id);
+    ASSERT_GT(object.indices.size(), 3000u);
+    auto d = describe(cloud, object.indices, up, library);
+    ASSERT_TRUE(d.ok()) << d.error().message;
+    print(name + " (" + std::to_string(object.range_jumps) + " range jumps)", *d);
+    ASSERT_TRUE(d->primitive);
+    if (mug.open_side_up) {
+      EXPECT_GE(object.range_jumps, 20) << "the data: an open rim hides the inside beyond it";
+      EXPECT_EQ(d->class_name, "cup");
+      EXPECT_GE(d->primitive->inner_fraction, kOpenTopMinInnerFraction);
+    } else {
+      EXPECT_LE(object.range_jumps, 3) << "the data: a closed top has no rim to hide anything";
+      EXPECT_NE(d->class_name, "cup");
+      // Closed for every vessel shape fitted (the can's cylinder, the cup's and the bowl's frustum).
+      for (const ClassMatch& m : d->candidates) {
+        const bool vessel = m.fit.shape == ClassShape::kCylinder || m.fit.shape == ClassShape::kFrustum;
+        if (m.score > 0 && vessel) EXPECT_LT(m.fit.inner_fraction, kOpenTopMinInnerFraction) << m.class_name;
+      }
+    }
+  }
 }
 
 }  // namespace
