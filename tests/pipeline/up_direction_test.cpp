@@ -15,7 +15,11 @@
 namespace scenewatch::pipeline {
 namespace {
 
-void expect_table_up_on_every_frame(const std::string& name) {
+// Also the object list: what stands on the wall (the relief of a whiteboard, posters) is not an
+// object. Measured at the end: pick_toy_1 18 objects, pick_toy_2 25-26 (41 and 60 when the wall's
+// pieces were listed; the rest are the person's arm and clothes on the table's plane, flat things
+// on the table and single sightings, as confirm_frames is 1).
+void expect_table_up_on_every_frame(const std::string& name, std::size_t max_objects) {
   std::vector<std::string> sections = pipeline_sections();
   sections.push_back("server");  // the daemon's own sections
   sections.push_back("ontology");
@@ -29,32 +33,42 @@ void expect_table_up_on_every_frame(const std::string& name) {
   WorkingMemory memory(config);
   int wall_frames = 0;
   double worst_deg = 0;
+  std::size_t on_wall = 0;  // sightings of listed objects whose support faces sideways
   for (std::size_t i = 0; i < seq->frames.size(); ++i) {
     auto frame = io::load_sequence_frame(*seq, i);
     ASSERT_TRUE(frame) << frame.error().message;
     ASSERT_TRUE(memory.process(*frame));
     const auto snapshot = memory.snapshot();
+    for (const auto& o : snapshot->objects) {
+      if (o.foreground || o.last_seen_s != frame->stamp_s) continue;
+      for (const auto& p : snapshot->planes)
+        if (p.id == o.cluster.plane_id && std::abs(p.normal.z()) < std::cos(M_PI / 4)) ++on_wall;
+    }
     if (snapshot->planes.empty()) continue;
     const double deg = std::acos(std::clamp(snapshot->up_world.z(), -1.0, 1.0)) * 180.0 / M_PI;
     worst_deg = std::max(worst_deg, deg);
     wall_frames += deg > 45 ? 1 : 0;
   }
-  std::printf("%s: up within %.1f deg of the base's z on every frame with planes; %d frames took the wall\n", name.c_str(),
-              worst_deg, wall_frames);
+  const std::size_t listed = memory.snapshot()->objects.size();
+  std::printf("%s: up within %.1f deg of the base's z on every frame with planes; %d frames took the wall; "
+              "%zu objects listed at the end, %zu sightings of objects on the wall\n",
+              name.c_str(), worst_deg, wall_frames, listed, on_wall);
+  EXPECT_EQ(on_wall, 0u);
+  EXPECT_LE(listed, max_objects);
   EXPECT_EQ(wall_frames, 0);
-  // The table's fitted normal: within 1 degree of the base's z on every frame but pick_toy_1's
-  // frame 35 (3.0 degrees).
+  // The table's fitted normal: within 0.4 degrees of the base's z on every frame of both (3.0
+  // degrees on pick_toy_1's frame 35 when it was first measured, with every pixel segmented).
   EXPECT_LT(worst_deg, 4.0);
 }
 
-TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy1) {
+TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy1AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_1");
-  expect_table_up_on_every_frame("pick_toy_1");
+  expect_table_up_on_every_frame("pick_toy_1", 20);
 }
 
-TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy2) {
+TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy2AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_2");
-  expect_table_up_on_every_frame("pick_toy_2");
+  expect_table_up_on_every_frame("pick_toy_2", 28);
 }
 
 }  // namespace

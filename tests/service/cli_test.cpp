@@ -318,7 +318,10 @@ TEST_F(CliTest, IngestLiveKeepsUpWithTheNewestFrame) {
   std::printf("--live 1000 on 50 kitchen frames: %s\n", last.c_str());
   EXPECT_EQ(summary.at("sent").get<int>(), 50);
   EXPECT_EQ(summary.at("processed").get<int>() + summary.at("skipped").get<int>(), 50);
-  EXPECT_GE(summary.at("skipped").get<int>(), 25) << "frames arrive every 1 ms, a room frame takes tens of ms";
+  // The CLI reads and decodes a kitchen frame in about 30 ms, the daemon takes 50-75 ms per frame:
+  // measured 29-30 skipped alone, 24 with the whole suite running beside it on two cores (the
+  // ratio of the two, not the daemon, sets it). Queueing every frame would skip none.
+  EXPECT_GE(summary.at("skipped").get<int>(), 18) << "frames arrive faster than a room frame is processed";
   auto stats = remote({"stats", "--json"});
   ASSERT_EQ(stats.exit_code, 0) << stats.err;
   EXPECT_EQ(parse(stats.out).at("frames_processed").get<int>(), summary.at("processed").get<int>());

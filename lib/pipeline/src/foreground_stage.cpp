@@ -7,20 +7,27 @@
 
 namespace scenewatch::pipeline {
 
-Eigen::Vector3d up_direction(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
-                             const Pose& T_world_camera) {
+std::optional<Eigen::Vector3d> level_up(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
+                                        const Pose& T_world_camera) {
   if (configured && configured->norm() > 0) return configured->normalized();
   const Eigen::Vector3d camera = T_world_camera.translation();
   const Eigen::Vector3d camera_up = -T_world_camera.linear().col(1);
   const double cos_max = std::cos(M_PI / 4);
-  const Plane* largest = nullptr;
   const Plane* upright = nullptr;
   for (const auto& p : planes) {
-    if (!largest || p.area_m2 > largest->area_m2) largest = &p;
     if (p.normal_towards(camera).dot(camera_up) >= cos_max && (!upright || p.area_m2 > upright->area_m2)) upright = &p;
   }
   if (upright) return upright->normal_towards(camera);
-  return largest ? largest->normal_towards(camera) : Eigen::Vector3d::UnitZ();
+  return std::nullopt;
+}
+
+Eigen::Vector3d up_direction(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
+                             const Pose& T_world_camera) {
+  if (const auto up = level_up(configured, planes, T_world_camera)) return *up;
+  const Plane* largest = nullptr;
+  for (const auto& p : planes)
+    if (!largest || p.area_m2 > largest->area_m2) largest = &p;
+  return largest ? largest->normal_towards(T_world_camera.translation()) : Eigen::Vector3d::UnitZ();
 }
 
 namespace {

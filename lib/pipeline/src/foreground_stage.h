@@ -65,4 +65,9 @@ class ForegroundStage {
 Eigen::Vector3d up_direction(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
                              const Pose& T_world_camera);
 
+/// The configured up, else the normal of the largest plane within 45 degrees of the camera's own
+/// up (as up_direction); none when no plane is (up_direction then falls back to the largest).
+std::optional<Eigen::Vector3d> level_up(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
+                                        const Pose& T_world_camera);
+
 }  // namespace scenewatch::pipeline

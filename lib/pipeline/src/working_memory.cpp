@@ -110,6 +110,24 @@ std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectClu
   return observations;
 }
 
+// Objects stand on tables, shelves and floors, not on walls: the clusters whose supporting plane
+// faces more than 45 degrees away from the world's up (up_direction's own bound) are a wall's
+// relief (a whiteboard, a poster, a socket), not objects to list. Their space is never seen free,
+// so the list would only grow: hrt1's pick_toy_2 ended with 60 objects, most of them pieces of
+// the wall behind the table.
+void keep_on_level_supports(std::vector<TrackerObservation>& observations, const std::vector<Plane>& planes,
+                            const Eigen::Vector3d& up, const Eigen::Vector3d& camera) {
+  const double cos_max = std::cos(M_PI / 4);
+  const auto level = [&](int plane_id) {
+    for (const auto& p : planes)
+      if (p.id == plane_id) return p.normal_towards(camera).dot(up) >= cos_max;
+    return true;  // no plane to judge by
+  };
+  observations.erase(std::remove_if(observations.begin(), observations.end(),
+                                    [&](const TrackerObservation& o) { return !level(o.cluster.plane_id); }),
+                     observations.end());
+}
+
 // The frame without the points of unconfirmed change candidates: an added candidate's own points,
 // and every pixel in the region where a removed candidate was seen through (a few pixels wider).
 // Without this the insertion would erode a removed object's voxels frame by frame, and the
@@ -283,6 +301,22 @@ struct WorkingMemory::Impl {
   // Change detection against the map as it stands before this frame, then the frame into the
   // map (without the points of unconfirmed candidates); confirmed changes are written into it at
   // once. Runs beside the segmentation and the image surprise, which do not read the map.
+  // The object list (no events: a change is reported by the change detector, once); the
+  // foreground's objects are not background objects.
+  void track_objects(const FrameResult& result, const Frame& frame, const Pose& T, const std::vector<std::size_t>& claimed,
+                     const std::optional<Eigen::Vector3d>& configured_up) {
+    std::vector<TrackerObservation> observations = tracker_observations(result.objects, *frame.cloud, T, claimed);
+      // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
+    if (const auto up = level_up(configured_up, result.planes, T)) keep_on_level_supports(observations, result.planes, *up, T.translation());
+    std::shared_lock<std::shared_mutex> read(map_mutex);
+    tracker.update(std::move(observations), frame.stamp_s, [&](const std::vector<Eigen::Vector3d>& pts) {
+      if (pts.empty()) return 0.0;
+      std::size_t n = 0;
+      for (const auto& p : pts) n += (map.freed_by_last_insert(p) || map.query(p) == background::Occupancy::kFree) ? 1 : 0;
+      return static_cast<double>(n) / pts.size();
+    });
+  }
+
   ChangeOutcome update_map(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
                            FrameResult& result) {
     ChangeOutcome changed;
@@ -438,20 +472,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   foreground::ForegroundUpdate fg = m.foreground.update(result.objects, m.tracker.objects(), result);
   result.events = m.fuse(result, changed, fg.quiet_boxes, frame.stamp_s);
 
-  // The object list (no events: a change is reported by the change detector, once); the
-  // foreground's objects are not background objects.
-  {
-    std::vector<TrackerObservation> observations = tracker_observations(result.objects, *frame.cloud, T, fg.claimed_clusters);
-    std::shared_lock<std::shared_mutex> read(m.map_mutex);
-    m.tracker.update(std::move(observations), frame.stamp_s, [&](const std::vector<Eigen::Vector3d>& pts) {
-      if (pts.empty()) return 0.0;
-      std::size_t n = 0;
-      for (const auto& p : pts) {
-        n += (m.map.freed_by_last_insert(p) || m.map.query(p) == background::Occupancy::kFree) ? 1 : 0;
-      }
-      return static_cast<double>(n) / pts.size();
-    });
-  }
+  m.track_objects(result, frame, T, fg.claimed_clusters, config_.segmentation.up);
   for (std::uint64_t id : fg.promoted) m.tracker.remove(id);
   if (!fg.vacated.empty()) {
     // A promoted object's old place is empty now: its removal is explained, not a surprise.
