@@ -92,7 +92,19 @@ struct Descent {
 };
 }  // namespace
 
-std::uint64_t morton_encode(const octomap::OcTreeKey& k) { return spread(k[0]) | (spread(k[1]) << 1) | (spread(k[2]) << 2); }
+namespace {
+// spread() of every byte: a 16-bit component is two lookups, not five shift-and-mask steps.
+struct SpreadTable {
+  std::array<std::uint64_t, 256> byte{};
+  SpreadTable() {
+    for (std::uint64_t v = 0; v < 256; ++v) byte[v] = spread(v);
+  }
+};
+const SpreadTable kSpread;
+std::uint64_t spread16(std::uint64_t v) { return kSpread.byte[v & 0xff] | (kSpread.byte[(v >> 8) & 0xff] << 24); }
+}  // namespace
+
+std::uint64_t morton_encode(const octomap::OcTreeKey& k) { return spread16(k[0]) | (spread16(k[1]) << 1) | (spread16(k[2]) << 2); }
 
 octomap::OcTreeKey morton_decode(std::uint64_t c) {
   return octomap::OcTreeKey(static_cast<octomap::key_type>(compact(c)), static_cast<octomap::key_type>(compact(c >> 1)),

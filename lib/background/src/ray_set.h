@@ -74,13 +74,24 @@ class RaySet {
 template <typename F>
 void RaySet::for_each(F&& f) const {
   if (use_bitmap_) {
+    const std::uint64_t dz = dim_[2], dy = dim_[1];
     for (std::size_t w = 0; w < free_bits_.size(); ++w) {
       std::uint64_t any = free_bits_[w] | end_bits_[w];
+      if (!any) continue;
+      // The word's first index split into x, y, z once (divisions); the bits after it step along
+      // z, wrapping into y and x.
+      const std::uint64_t first = static_cast<std::uint64_t>(w) << 6;
+      std::uint64_t z = first % dz, y = (first / dz) % dy, x = first / (dz * dy), at = first;
       while (any) {
         const int b = __builtin_ctzll(any);
         any &= any - 1;
-        const std::uint64_t i = (static_cast<std::uint64_t>(w) << 6) | b;
-        const std::uint64_t z = i % dim_[2], y = (i / dim_[2]) % dim_[1], x = i / (static_cast<std::uint64_t>(dim_[2]) * dim_[1]);
+        const std::uint64_t i = first | static_cast<std::uint64_t>(b);
+        z += i - at;
+        at = i;
+        while (z >= dz) {
+          z -= dz;
+          if (++y == dy) y = 0, ++x;
+        }
         const octomap::OcTreeKey k(static_cast<octomap::key_type>(lo_[0] + x), static_cast<octomap::key_type>(lo_[1] + y),
                                    static_cast<octomap::key_type>(lo_[2] + z));
         f(k, static_cast<bool>((end_bits_[w] >> b) & 1));
