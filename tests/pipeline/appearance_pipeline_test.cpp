@@ -94,6 +94,16 @@ TEST(AppearancePipeline, CupAddedIsOneEventWithTheSurpriseAsEvidence) {
   WorkingMemory restored(config);
   ASSERT_TRUE(restored.load(dir.path()).ok());
   EXPECT_EQ(restored.stats().keyframes, memory.stats().keyframes);
+  // The objects' colour spread too (what a completed object's unseen side is predicted with).
+  std::size_t spread = 0;
+  for (const auto& o : memory.snapshot()->objects) {
+    for (const auto& r : restored.snapshot()->objects) {
+      if (r.id != o.id) continue;
+      EXPECT_TRUE(r.cluster.rgb_covariance.isApprox(o.cluster.rgb_covariance)) << "object " << o.id;
+      spread += o.cluster.rgb_covariance.trace() > 1.0f ? 1 : 0;
+    }
+  }
+  EXPECT_GT(spread, 0u) << "the simulator's objects are shaded and textured: their colours vary";
   auto a = memory.surprise(last), b = restored.surprise(last);
   ASSERT_TRUE(a.ok() && b.ok());
   EXPECT_EQ((*a)->events.size(), (*b)->events.size());

@@ -42,6 +42,7 @@ json to_json(const TrackedObject& o) {
   const ObjectCluster& c = o.cluster;
   json j = {{"id", o.id}, {"plane_id", c.plane_id}, {"centroid", vec(c.centroid)}, {"box", to_json(c.box)},
             {"point_count", c.point_count}, {"mean_rgb", {c.mean_rgb.x(), c.mean_rgb.y(), c.mean_rgb.z()}},
+            {"rgb_covariance", std::vector<float>(c.rgb_covariance.data(), c.rgb_covariance.data() + 9)},
             {"first_seen_s", o.first_seen_s}, {"last_seen_s", o.last_seen_s}, {"observations", o.observations},
             {"supported_by", o.supported_by}};
   if (o.foreground) j["foreground"] = to_json(*o.foreground);

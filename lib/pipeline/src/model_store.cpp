@@ -95,6 +95,12 @@ Result<TrackedObject> object_from_json(const json& j) {
     o.cluster.point_count = j.at("point_count").get<std::size_t>();
     const auto& c = j.at("mean_rgb");
     o.cluster.mean_rgb = Eigen::Vector3f(c.at(0).get<float>(), c.at(1).get<float>(), c.at(2).get<float>());
+    if (j.contains("rgb_covariance")) {  // absent in models saved before it existed
+      const auto v = j.at("rgb_covariance").get<std::vector<float>>();
+      if (v.size() != 9) throw std::runtime_error("rgb_covariance: 9 numbers expected");
+      o.cluster.rgb_covariance = Eigen::Map<const Eigen::Matrix3f>(v.data());
+      if (!o.cluster.rgb_covariance.allFinite()) throw std::runtime_error("rgb_covariance: not finite");
+    }
     o.first_seen_s = j.at("first_seen_s").get<double>();
     o.last_seen_s = j.at("last_seen_s").get<double>();
     o.supported_by = j.value("supported_by", std::uint64_t{0});  // absent in models saved before it existed

@@ -298,15 +298,12 @@ struct WorkingMemory::Impl {
     return out;
   }
 
-  // Change detection against the map as it stands before this frame, then the frame into the
-  // map (without the points of unconfirmed candidates); confirmed changes are written into it at
-  // once. Runs beside the segmentation and the image surprise, which do not read the map.
   // The object list (no events: a change is reported by the change detector, once); the
   // foreground's objects are not background objects.
   void track_objects(const FrameResult& result, const Frame& frame, const Pose& T, const std::vector<std::size_t>& claimed,
                      const std::optional<Eigen::Vector3d>& configured_up) {
     std::vector<TrackerObservation> observations = tracker_observations(result.objects, *frame.cloud, T, claimed);
-      // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
+    // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
     if (const auto up = level_up(configured_up, result.planes, T)) keep_on_level_supports(observations, result.planes, *up, T.translation());
     std::shared_lock<std::shared_mutex> read(map_mutex);
     tracker.update(std::move(observations), frame.stamp_s, [&](const std::vector<Eigen::Vector3d>& pts) {
@@ -317,6 +314,9 @@ struct WorkingMemory::Impl {
     });
   }
 
+  // Change detection against the map as it stands before this frame, then the frame into the
+  // map (without the points of unconfirmed candidates); confirmed changes are written into it at
+  // once. Runs beside the segmentation and the image surprise, which do not read the map.
   ChangeOutcome update_map(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
                            FrameResult& result) {
     ChangeOutcome changed;

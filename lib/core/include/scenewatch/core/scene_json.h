@@ -3,8 +3,9 @@
 /// live view's `/api/state` (the reading side for the model store is in the pipeline).
 ///
 ///   plane:  {"id", "normal": [x,y,z], "d", "hull": [[x,y,z], ...], "area_m2", "inlier_count", "centroid"}
-///   object: {"id", "plane_id", "centroid", "box", "point_count", "mean_rgb", "first_seen_s",
-///            "last_seen_s", "observations", "supported_by", "foreground" (foreground objects only)}
+///   object: {"id", "plane_id", "centroid", "box", "point_count", "mean_rgb", "rgb_covariance" (9
+///            numbers, row by row), "first_seen_s", "last_seen_s", "observations", "supported_by",
+///            "foreground" (foreground objects only)}
 ///   box:    {"center": [x,y,z], "rotation_xyzw": [x,y,z,w], "extents": [x,y,z]}
 #include <nlohmann/json.hpp>
 
