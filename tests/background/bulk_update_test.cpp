@@ -32,6 +32,25 @@ TEST(BulkUpdate, RadixSortSorts) {
   EXPECT_EQ(v, expected);
 }
 
+// Every key of the cube [lo, hi)^3 is known in both trees or in neither, with the same log-odds;
+// returns how many are known.
+std::size_t expect_same_log_odds(const octomap::ColorOcTree& bulk, const octomap::ColorOcTree& oracle, unsigned lo,
+                                 unsigned hi) {
+  std::size_t compared = 0;
+  for (unsigned x = lo; x < hi; ++x)
+    for (unsigned y = lo; y < hi; ++y)
+      for (unsigned z = lo; z < hi; ++z) {
+        const octomap::OcTreeKey k(x, y, z);
+        const auto* a = bulk.search(k);
+        const auto* b = oracle.search(k);
+        EXPECT_EQ(a == nullptr, b == nullptr) << x << " " << y << " " << z;
+        if (a == nullptr || b == nullptr) continue;
+        EXPECT_FLOAT_EQ(a->getLogOdds(), b->getLogOdds()) << x << " " << y << " " << z;
+        ++compared;
+      }
+  return compared;
+}
+
 TEST(BulkUpdate, MatchesUpdateNodeOracle) {
   BulkColorOcTree bulk(0.05);
   octomap::ColorOcTree oracle(0.05);
@@ -68,19 +87,44 @@ TEST(BulkUpdate, MatchesUpdateNodeOracle) {
   }
   EXPECT_EQ(bulk.size(), oracle.size()) << "same nodes after pruning";
   EXPECT_EQ(bulk.getNumLeafNodes(), oracle.getNumLeafNodes());
-  std::size_t compared = 0;
-  for (unsigned x = 32756; x < 32776; ++x)
-    for (unsigned y = 32756; y < 32776; ++y)
-      for (unsigned z = 32756; z < 32776; ++z) {
-        const octomap::OcTreeKey k(x, y, z);
-        const auto* a = bulk.search(k);
-        const auto* b = oracle.search(k);
-        ASSERT_EQ(a == nullptr, b == nullptr);
-        if (a == nullptr) continue;
-        ASSERT_FLOAT_EQ(a->getLogOdds(), b->getLogOdds());
-        ++compared;
-      }
-  EXPECT_GT(compared, 1000u);
+  EXPECT_GT(expect_same_log_odds(bulk, oracle, 32756, 32776), 1000u);
+}
+
+// Whole cubes freed at once (as a room frame's rays free most 2 cm cells at 1 cm): the bulk update
+// then sets the childless node itself, where OctoMap creates or expands the leaves, updates each
+// and prunes them back. Fresh cubes, pruned cubes (clamped or not) and cubes with some hits, all
+// against the oracle node by node.
+TEST(BulkUpdate, MatchesUpdateNodeOracleWhenWholeCubesAreFreed) {
+  BulkColorOcTree bulk(0.05);
+  octomap::ColorOcTree oracle(0.05);
+  std::mt19937 rng(5);
+  const auto color = [](const octomap::OcTreeKey&, std::uint8_t rgb[3]) { rgb[0] = rgb[1] = rgb[2] = 90; };
+  std::size_t whole_cube_rounds = 0;
+  for (int round = 0; round < 30; ++round) {
+    std::map<std::uint64_t, bool> updates;  // morton -> hit
+    // An aligned 8^3 block at the map centre, whole or with holes, with or without hits.
+    const bool whole = round % 3 != 2, with_hits = round % 5 == 4;
+    whole_cube_rounds += whole && !with_hits;
+    for (unsigned x = 32768; x < 32776; ++x)
+      for (unsigned y = 32768; y < 32776; ++y)
+        for (unsigned z = 32768; z < 32776; ++z) {
+          if (!whole && rng() % 4 == 0) continue;
+          const bool hit = with_hits && rng() % 20 == 0;
+          updates[morton_encode(octomap::OcTreeKey(x, y, z))] = hit;
+        }
+    std::vector<std::uint64_t> sorted;
+    for (const auto& [m, hit] : updates) {
+      sorted.push_back((m << 1) | (hit ? 1 : 0));
+      const octomap::OcTreeKey k = morton_decode(m);
+      oracle.updateNode(k, hit, /*lazy_eval=*/false);
+      if (hit) oracle.averageNodeColor(k, 90, 90, 90);
+    }
+    bulk_update(bulk, sorted, color);
+    ASSERT_EQ(bulk.size(), oracle.size()) << "round " << round;
+  }
+  EXPECT_GE(whole_cube_rounds, 10u);
+  EXPECT_EQ(bulk.getNumLeafNodes(), oracle.getNumLeafNodes());
+  EXPECT_EQ(expect_same_log_odds(bulk, oracle, 32766, 32778), 8u * 8u * 8u);
 }
 
 }  // namespace

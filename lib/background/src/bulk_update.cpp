@@ -59,12 +59,28 @@ struct Descent {
     }
   }
 
+  // The updates [b, e) of a node at `level` (unique keys inside its cube) free every voxel of it.
+  static bool whole_cube_freed(unsigned level, const std::uint64_t* b, const std::uint64_t* e) {
+    if (level == 0 || static_cast<std::uint64_t>(e - b) != std::uint64_t{1} << (3 * (kDepth - level))) return false;
+    for (const std::uint64_t* p = b; p < e; ++p)
+      if (*p & 1) return false;
+    return true;
+  }
+
   void apply(Node* node, unsigned level, const std::uint64_t* b, const std::uint64_t* e, bool fresh) {
     if (level == kDepth) {
       leaf(node, *b);  // keys are unique: one value per leaf
       return;
     }
-    if (!fresh && !tree.nodeHasChildren(node)) {
+    const bool leaf_now = fresh || !tree.nodeHasChildren(node);
+    if (leaf_now && whole_cube_freed(level, b, e)) {
+      // Every voxel of this childless node's cube is freed. OctoMap would create (or expand into)
+      // its leaves, each from the node's value, update each by the same miss, and prune them back
+      // into this node: the node updated by one miss.
+      tree.updateNodeLogOdds(node, miss_log);
+      return;
+    }
+    if (!fresh && leaf_now) {
       // A pruned node above the finest level. OctoMap's updateNode returns early when the node
       // is already clamped in the direction of the update; otherwise it expands the node.
       const float v = node->getLogOdds();
