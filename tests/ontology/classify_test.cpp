@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <cstdlib>
 #include <sstream>
 #include <string>
@@ -320,6 +321,29 @@ TEST(ClassifyMugTest, PclStereoMugIsACup) {
 namespace scenewatch::ontology {
 namespace {
 
+// One labelled mOSD scene (../shared/data/mosd/learn/learnN.pcd): its cloud, its labels and the
+// up the survey describes its objects with, the normal of the segmentation's largest plane (the
+// table). Fails the calling test and returns nothing when the file cannot be read.
+struct MosdScene {
+  CloudConstPtr cloud;
+  std::vector<std::uint32_t> labels;
+  Eigen::Vector3d up{0, -1, 0};
+};
+
+std::optional<MosdScene> load_mosd_scene(int n) {
+  const auto path = test::data_dir() / "mosd/learn" / ("learn" + std::to_string(n) + ".pcd");
+  auto file = io::read_cloud(path);
+  auto labels = io::read_pcd_labels(path);
+  EXPECT_TRUE(file.ok() && labels.ok()) << path;
+  if (!file.ok() || !labels.ok()) return std::nullopt;
+  MosdScene scene{file->cloud, std::move(*labels)};
+  const segmentation::Segmentation segmented = segmentation::segment(*scene.cloud, segmentation::Config{});
+  double area = 0;
+  for (const auto& plane : segmented.planes)
+    if (plane.area_m2 > area) scene.up = plane.normal, area = plane.area_m2;
+  return scene;
+}
+
 // mOSD (../shared/data/mosd/learn): every labelled object of 500 points or more, described with
 // the table's normal (the segmentation's largest plane) as up. A survey printed for the README:
 // the dataset has no per-object category, only the scenes' (learn0-16 boxes, learn17-24 stacked
@@ -333,19 +357,14 @@ TEST(ClassifyMosdSurvey, LabelledObjects) {
   const ClassLibrary library = shipped_classes();
   std::map<std::string, std::map<std::string, int>> counts;  // scene category -> class -> objects
   for (int n = 0; n < 45; ++n) {
-    const auto path = test::data_dir() / "mosd/learn" / ("learn" + std::to_string(n) + ".pcd");
-    auto file = io::read_cloud(path);
-    auto labels = io::read_pcd_labels(path);
-    ASSERT_TRUE(file.ok() && labels.ok()) << path;
-    const Cloud& cloud = *file->cloud;
-    const segmentation::Segmentation scene = segmentation::segment(cloud, segmentation::Config{});
-    Eigen::Vector3d up(0, -1, 0);
-    double area = 0;
-    for (const auto& plane : scene.planes)
-      if (plane.area_m2 > area) up = plane.normal, area = plane.area_m2;
+    const auto scene = load_mosd_scene(n);
+    ASSERT_TRUE(scene);
+    const Cloud& cloud = *scene->cloud;
+    const auto& labels = scene->labels;
+    const Eigen::Vector3d& up = scene->up;
     std::map<std::uint32_t, std::vector<int>> objects;
-    for (std::size_t i = 0; i < labels->size(); ++i)
-      if ((*labels)[i] >= 20 && is_valid(cloud.points[i])) objects[(*labels)[i] / 10].push_back(static_cast<int>(i));
+    for (std::size_t i = 0; i < labels.size(); ++i)
+      if (labels[i] >= 20 && is_valid(cloud.points[i])) objects[labels[i] / 10].push_back(static_cast<int>(i));
     const std::string category = n <= 16 ? "boxes" : n <= 24 ? "stacked boxes" : n <= 32 ? "occluded" : "cylindric";
     std::printf("learn%d:", n);
     for (const auto& [id, indices] : objects) {
@@ -411,20 +430,12 @@ TEST(ClassifyMosdMugs, OpenSideUpIsACupUpsideDownIsNot) {
   for (const Mug& mug : {Mug{39, 3, true}, Mug{39, 4, true}, Mug{38, 2, false}, Mug{38, 3, false}}) {
     const std::string name = "learn" + std::to_string(mug.scene) + " object " + std::to_string(mug.id);
     SCOPED_TRACE(name);
-    const auto path = test::data_dir() / "mosd/learn" / ("learn" + std::to_string(mug.scene) + ".pcd");
-    auto file = io::read_cloud(path);
-    auto labels = io::read_pcd_labels(path);
-    ASSERT_TRUE(file.ok() && labels.ok()) << path;
-    const Cloud& cloud = *file->cloud;
-    // Up as in the survey: the normal of the largest plane, the table.
-    const segmentation::Segmentation scene = segmentation::segment(cloud, segmentation::Config{});
-    Eigen::Vector3d up(0, -1, 0);
-    double area = 0;
-    for (const auto& plane : scene.planes)
-      if (plane.area_m2 > area) up = plane.normal, area = plane.area_m2;
-    const MosdObject object = mosd_object(cloud, *labels, mug.id);
+    const auto scene = load_mosd_scene(mug.scene);  // up as in the survey
+    ASSERT_TRUE(scene);
+    const Cloud& cloud = *scene->cloud;
+    const MosdObject object = mosd_object(cloud, scene->labels, mug.id);
     ASSERT_GT(object.indices.size(), 3000u);
-    auto d = describe(cloud, object.indices, up, library);
+    auto d = describe(cloud, object.indices, scene->up, library);
     ASSERT_TRUE(d.ok()) << d.error().message;
     print(name + " (" + std::to_string(object.range_jumps) + " range jumps)", *d);
     ASSERT_TRUE(d->primitive);
