@@ -173,10 +173,14 @@ std::size_t splat_surface(ExpectedView& view, const KnownSurface& surface, doubl
   to_opponent(static_cast<std::uint8_t>(std::clamp(surface.rgb.x(), 0.0f, 255.0f)),
               static_cast<std::uint8_t>(std::clamp(surface.rgb.y(), 0.0f, 255.0f)),
               static_cast<std::uint8_t>(std::clamp(surface.rgb.z(), 0.0f, 255.0f)), opponent);
-  // Each opponent signal is a linear map of RGB (to_opponent), so its variance is m' C m.
+  // Each opponent signal is a linear map of RGB, so its variance is m' C m; the map's columns are
+  // to_opponent's answers for pure red, green and blue (per 255 units).
   Eigen::Matrix3f to_opp;
-  to_opp << 1.0f / 3, 1.0f / 3, 1.0f / 3, 1, -1, 0, -0.5f, -0.5f, 1;
-  to_opp /= 255.0f;
+  for (int k = 0; k < 3; ++k) {
+    float column[kChannels];
+    to_opponent(k == 0 ? 255 : 0, k == 1 ? 255 : 0, k == 2 ? 255 : 0, column);
+    to_opp.col(k) = Eigen::Vector3f(column[0], column[1], column[2]) / 255.0f;
+  }
   const Eigen::Matrix3f opp_covariance = to_opp * surface.rgb_covariance * to_opp.transpose();
   float ssd[kChannels];
   for (int c = 0; c < kChannels; ++c) ssd[c] = kMaxSamples * std::max(0.0f, opp_covariance(c, c));
