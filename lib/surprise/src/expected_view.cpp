@@ -20,22 +20,15 @@ Status validate(const ExpectedViewConfig& c) {
 
 namespace {
 
-// Fills runs of missing depth along one row no longer than max_gap whose two ends
-// agree within tolerance, by linear interpolation: the holes glass and grazing angles leave in
-// every keyframe's depth, which would otherwise leave the surface behind them without samples.
-void fill_line(float* d, int n, int max_gap, float rel) {
-  int last = -1;
-  for (int i = 0; i < n; ++i) {
-    const float z = d[i];
-    if (z <= 0.0f) continue;
-    if (last >= 0 && i - last > 1 && i - last - 1 <= max_gap) {
-      const float z0 = d[last];
-      if (std::abs(z - z0) <= rel * std::min(z, z0)) {
-        for (int k = last + 1; k < i; ++k) d[k] = z0 + (z - z0) * static_cast<float>(k - last) / static_cast<float>(i - last);
-      }
-    }
-    last = i;
-  }
+// Fills the gap between the depths d[0] and d[n * stride], n steps apart along a line of
+// `stride`-apart values, when it is no longer than max_gap and its two ends agree within
+// tolerance, by linear interpolation: the holes glass and grazing angles leave in every keyframe's
+// depth, which would otherwise leave the surface behind them without samples.
+void fill_gap(float* d, std::ptrdiff_t stride, int n, int max_gap, float rel) {
+  if (n <= 1 || n - 1 > max_gap) return;
+  const float z0 = d[0], z = d[n * stride];
+  if (std::abs(z - z0) > rel * std::min(z, z0)) return;
+  for (int k = 1; k < n; ++k) d[k * stride] = z0 + (z - z0) * static_cast<float>(k) / static_cast<float>(n);
 }
 
 void fill_depth_holes(std::vector<float>* depth, int w, int h, const ExpectedViewConfig& config) {
@@ -43,7 +36,15 @@ void fill_depth_holes(std::vector<float>* depth, int w, int h, const ExpectedVie
   if (max_gap <= 0) return;
   const float rel = static_cast<float>(config.fill_holes_max_jump);
   std::vector<float> horizontal = *depth;
-  for (int v = 0; v < h; ++v) fill_line(horizontal.data() + static_cast<std::size_t>(v) * w, w, max_gap, rel);
+  for (int v = 0; v < h; ++v) {
+    float* row = horizontal.data() + static_cast<std::size_t>(v) * w;
+    int last = -1;
+    for (int u = 0; u < w; ++u) {
+      if (row[u] <= 0.0f) continue;
+      if (last >= 0) fill_gap(row + last, 1, u - last, max_gap, rel);
+      last = u;
+    }
+  }
   // The columns row by row (a column at a time would read a new cache line at every pixel):
   // each column remembers its last row with depth, and a gap is filled when it closes.
   float* d = depth->data();
@@ -51,16 +52,9 @@ void fill_depth_holes(std::vector<float>* depth, int w, int h, const ExpectedVie
   for (int v = 0; v < h; ++v) {
     const float* row = d + static_cast<std::size_t>(v) * w;
     for (int u = 0; u < w; ++u) {
-      const float z = row[u];
-      if (z <= 0.0f) continue;
+      if (row[u] <= 0.0f) continue;
       const int l = last[static_cast<std::size_t>(u)];
-      if (l >= 0 && v - l > 1 && v - l - 1 <= max_gap) {
-        const float z0 = d[static_cast<std::size_t>(l) * w + u];
-        if (std::abs(z - z0) <= rel * std::min(z, z0)) {
-          for (int k = l + 1; k < v; ++k)
-            d[static_cast<std::size_t>(k) * w + u] = z0 + (z - z0) * static_cast<float>(k - l) / static_cast<float>(v - l);
-        }
-      }
+      if (l >= 0) fill_gap(d + static_cast<std::size_t>(l) * w + u, w, v - l, max_gap, rel);
       last[static_cast<std::size_t>(u)] = v;
     }
   }
