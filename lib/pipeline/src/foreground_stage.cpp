@@ -7,15 +7,18 @@
 
 namespace scenewatch::pipeline {
 
+bool faces_within_45_degrees(const Plane& plane, const Eigen::Vector3d& camera, const Eigen::Vector3d& direction) {
+  return plane.normal_towards(camera).dot(direction) >= std::cos(M_PI / 4);
+}
+
 std::optional<Eigen::Vector3d> level_up(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
                                         const Pose& T_world_camera) {
   if (configured && configured->norm() > 0) return configured->normalized();
   const Eigen::Vector3d camera = T_world_camera.translation();
   const Eigen::Vector3d camera_up = -T_world_camera.linear().col(1);
-  const double cos_max = std::cos(M_PI / 4);
   const Plane* upright = nullptr;
   for (const auto& p : planes) {
-    if (p.normal_towards(camera).dot(camera_up) >= cos_max && (!upright || p.area_m2 > upright->area_m2)) upright = &p;
+    if (faces_within_45_degrees(p, camera, camera_up) && (!upright || p.area_m2 > upright->area_m2)) upright = &p;
   }
   if (upright) return upright->normal_towards(camera);
   return std::nullopt;

@@ -65,6 +65,10 @@ class ForegroundStage {
 Eigen::Vector3d up_direction(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,
                              const Pose& T_world_camera);
 
+/// A plane whose side facing the camera faces within 45 degrees of `direction`: level, when
+/// `direction` is up (what objects stand on and up_direction chooses from).
+bool faces_within_45_degrees(const Plane& plane, const Eigen::Vector3d& camera, const Eigen::Vector3d& direction);
+
 /// The configured up, else the normal of the largest plane within 45 degrees of the camera's own
 /// up (as up_direction); none when no plane is (up_direction then falls back to the largest).
 std::optional<Eigen::Vector3d> level_up(const std::optional<Eigen::Vector3d>& configured, const std::vector<Plane>& planes,

@@ -117,10 +117,9 @@ std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectClu
 // the wall behind the table.
 void keep_on_level_supports(std::vector<TrackerObservation>& observations, const std::vector<Plane>& planes,
                             const Eigen::Vector3d& up, const Eigen::Vector3d& camera) {
-  const double cos_max = std::cos(M_PI / 4);
   const auto level = [&](int plane_id) {
     for (const auto& p : planes)
-      if (p.id == plane_id) return p.normal_towards(camera).dot(up) >= cos_max;
+      if (p.id == plane_id) return faces_within_45_degrees(p, camera, up);
     return true;  // no plane to judge by
   };
   observations.erase(std::remove_if(observations.begin(), observations.end(),
