@@ -2,22 +2,20 @@
 //
 // Fast insertion follows OctoMap's own discretized update (OccupancyOcTreeBase::computeDiscreteUpdate):
 // endpoints are first reduced to one per voxel, rays are cast from the sensor to the voxel centres,
-// and cells both hit and passed through count as hit. The key sets live in robin-hood hash sets;
-// the updates are radix-sorted by Morton code and applied in one ordered descent of the tree
+// and cells both hit and passed through count as hit (frame_trace.h). The voxels live in blocks
+// of 8x8x8 bits (ray_set.h), which are applied in Morton order in one descent of the tree
 // (bulk_update.h), which also refreshes inner nodes along the touched paths only.
 #include <octomap/ColorOcTree.h>
 #include <octomap/OcTree.h>
-#include <tsl/robin_map.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <fstream>
-#include <future>
 #include <system_error>
 
 #include "bulk_update.h"
-#include "ray_set.h"
+#include "frame_trace.h"
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/core/files.h"
 #include "scenewatch/core/hash.h"
@@ -28,24 +26,6 @@ namespace fs = std::filesystem;
 namespace {
 
 using octomap::OcTreeKey;
-
-std::uint64_t pack(const OcTreeKey& k) {
-  return (static_cast<std::uint64_t>(k[0]) << 32) | (static_cast<std::uint64_t>(k[1]) << 16) | k[2];
-}
-OcTreeKey unpack(std::uint64_t v) {
-  return OcTreeKey(static_cast<octomap::key_type>(v >> 32), static_cast<octomap::key_type>((v >> 16) & 0xffff),
-                   static_cast<octomap::key_type>(v & 0xffff));
-}
-
-
-// Frames with at least this many endpoint voxels cast their rays on two threads (a VGA room
-// frame has 30000-60000 at 2 cm; a 320x240 tabletop frame a few thousand, not worth a thread).
-constexpr std::size_t kParallelRayEndpoints = 20000;
-
-struct ColorSum {
-  std::uint32_t r = 0, g = 0, b = 0, n = 0;
-};
-
 
 // ColorOcTree::updateInnerOccupancy() dereferences the root without checking it (OctoMap 1.9.7):
 // on an empty tree it crashes.
@@ -66,10 +46,8 @@ struct OccupancyMap::Impl {
   BulkColorOcTree tree;
   // The last insert's endpoints (with their colour) and ray voxels, kept for
   // freed_by_last_insert(); scratch buffers reused between frames.
-  tsl::robin_map<std::uint64_t, ColorSum, MixHash64> endpoints;
-  RaySet rays, rays_right;
-  std::vector<std::uint64_t> clipped_ends, updates, scratch;
-  std::vector<OcTreeKey> left_ends, right_ends;
+  FrameTrace trace;
+  std::vector<std::uint64_t> order, scratch;
 };
 
 Status validate(const Config& c) {
@@ -100,238 +78,70 @@ OccupancyMap::OccupancyMap(OccupancyMap&&) noexcept = default;
 OccupancyMap& OccupancyMap::operator=(OccupancyMap&&) noexcept = default;
 
 namespace {
-// Amanatides & Woo's voxel walk as OctoMap's OcTreeBaseImpl::computeRayKeys does it, step for
-// step, with its float/double arithmetic, so that the rays match OctoMap's.
-class RayWalk {
- public:
-  RayWalk(const octomap::ColorOcTree& tree, const octomap::point3d& from, const OcTreeKey& key_from, const octomap::point3d& to)
-      : current_(key_from) {
-    octomap::point3d direction = to - from;
-    length_ = static_cast<float>(direction.norm());
-    direction /= length_;
-    const double res = tree.getResolution();
-    for (unsigned i = 0; i < 3; ++i) {
-      step_[i] = direction(i) > 0.0 ? 1 : (direction(i) < 0.0 ? -1 : 0);
-      if (step_[i] != 0) {
-        double border = tree.keyToCoord(current_[i]);
-        border += static_cast<float>(step_[i] * res * 0.5);
-        t_max_[i] = (border - from(i)) / direction(i);
-        t_delta_[i] = res / std::fabs(direction(i));
-      } else {
-        t_max_[i] = t_delta_[i] = std::numeric_limits<double>::max();
-      }
-    }
-  }
-  /// Steps into the next voxel; false once the walk has passed the far end.
-  bool next() {
-    const unsigned dim = t_max_[0] < t_max_[1] ? (t_max_[0] < t_max_[2] ? 0 : 2) : (t_max_[1] < t_max_[2] ? 1 : 2);
-    current_[dim] = static_cast<octomap::key_type>(current_[dim] + step_[dim]);
-    t_max_[dim] += t_delta_[dim];
-    return std::min(std::min(t_max_[0], t_max_[1]), t_max_[2]) <= length_;
-  }
-  const OcTreeKey& key() const { return current_; }
-
- private:
-  OcTreeKey current_;
-  float length_ = 0.0f;
-  int step_[3];
-  double t_max_[3], t_delta_[3];
-};
-
-// The voxels from the origin's voxel up to, not including, the end's voxel (OctoMap's ray).
-void cast_ray(const octomap::ColorOcTree& tree, const octomap::point3d& origin, const OcTreeKey& key_origin,
-              const octomap::point3d& end, const OcTreeKey& key_end, RaySet& rays) {
-  if (key_origin == key_end) return;
-  rays.insert_free(key_origin);
-  RayWalk walk(tree, origin, key_origin, end);
-  while (true) {
-    const bool inside = walk.next();
-    if (walk.key() == key_end || !inside) return;
-    rays.insert_free(walk.key());
-  }
-}
-
-// The same voxels walked the other way, from the end's voxel centre back to the sensor, and cut
-// short where the ray has run through `stop_after` voxels in a row that other rays of this frame
-// already freed: from there on it would mostly repeat them (neighbouring rays converge towards
-// the sensor). This is voxblox's FastTsdfIntegrator shortcut (max_consecutive_ray_collisions,
-// 2 by default there); it trades a few missed voxels inside the frustum for most of the steps.
-void cast_ray_back(const octomap::ColorOcTree& tree, const octomap::point3d& sensor, const OcTreeKey& key_sensor,
-                   const octomap::point3d& end, const OcTreeKey& key_end, int stop_after, RaySet& rays) {
-  if (key_sensor == key_end) return;
-  RayWalk walk(tree, end, key_end, sensor);
-  int repeated = 0;
-  while (walk.next()) {
-    if (rays.is_free(walk.key())) {
-      if (++repeated >= stop_after) return;
-    } else {
-      repeated = 0;
-      rays.insert_free(walk.key());
-    }
-    if (walk.key() == key_sensor) return;
-  }
-  rays.insert_free(key_sensor);
-}
-}  // namespace
-
-InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world_camera, int stride) {
-  auto& tree = impl_->tree;
-  auto& endpoints = impl_->endpoints;
-  auto& rays = impl_->rays;
-  endpoints.clear();
+// Reference: OctoMap's plain insertion, one ray per point. The key sets OctoMap computes inside
+// insertPointCloud are kept in `rays` for freed_by_last_insert().
+InsertStats insert_plain(octomap::ColorOcTree& tree, const Cloud& points_camera, const Eigen::Isometry3f& T, double max_range,
+                         RaySet& rays) {
   InsertStats stats;
-  const Eigen::Isometry3f T = T_world_camera.cast<float>();
-  const Eigen::Vector3f origin_f = T.translation();
-  const octomap::point3d origin(origin_f.x(), origin_f.y(), origin_f.z());
-  const double max_range = config_.max_range_m;
+  const octomap::point3d origin(T.translation().x(), T.translation().y(), T.translation().z());
   OcTreeKey origin_key;
   if (!tree.coordToKeyChecked(origin, origin_key)) {
     rays.reset(OcTreeKey(0, 0, 0), OcTreeKey(0, 0, 0));
     return stats;  // the sensor is outside the map's extent
   }
+  octomap::Pointcloud scan;
+  scan.reserve(points_camera.size());
+  for (const auto& p : points_camera.points) {
+    if (!is_valid(p)) continue;
+    const Eigen::Vector3f w = T * p.getVector3fMap();
+    scan.push_back(w.x(), w.y(), w.z());
+  }
+  stats.points = scan.size();
+  const double range = max_range > 0 ? max_range : -1.0;
+  octomap::KeySet free_keys, occupied_keys;
+  tree.computeUpdate(scan, origin, free_keys, occupied_keys, range);
   OcTreeKey lo = origin_key, hi = origin_key;
-  auto grow = [&](const OcTreeKey& k) {
-    for (int i = 0; i < 3; ++i) {
-      lo[i] = std::min(lo[i], k[i]);
-      hi[i] = std::max(hi[i], k[i]);
+  for (const auto* keys : {&free_keys, &occupied_keys}) {
+    for (const auto& k : *keys) {
+      for (int i = 0; i < 3; ++i) lo[i] = std::min(lo[i], k[i]), hi[i] = std::max(hi[i], k[i]);
     }
-  };
-
-  if (!config_.fast_insertion) {
-    // Reference: OctoMap's plain insertion, one ray per point.
-    octomap::Pointcloud scan;
-    scan.reserve(points_camera.size());
-    for (const auto& p : points_camera.points) {
-      if (!is_valid(p)) continue;
-      const Eigen::Vector3f w = T * p.getVector3fMap();
-      scan.push_back(w.x(), w.y(), w.z());
-    }
-    stats.points = scan.size();
-    const double range = max_range > 0 ? max_range : -1.0;
-    // The same key sets OctoMap computes inside insertPointCloud, kept for freed_by_last_insert().
-    octomap::KeySet free_keys, occupied_keys;
-    tree.computeUpdate(scan, origin, free_keys, occupied_keys, range);
-    for (const auto& k : free_keys) grow(k);
-    for (const auto& k : occupied_keys) grow(k);
-    rays.reset(lo, hi);
-    for (const auto& k : free_keys) rays.insert_free(k);
-    for (const auto& k : occupied_keys) rays.insert_end(k);
-    stats.free_updates = free_keys.size();
-    stats.occupied_updates = occupied_keys.size();
-    tree.insertPointCloud(scan, origin, range, /*lazy_eval=*/false, /*discretize=*/false);
-    for (const auto& p : points_camera.points) {
-      if (!is_valid(p)) continue;
-      const Eigen::Vector3f w = T * p.getVector3fMap();
-      tree.averageNodeColor(w.x(), w.y(), w.z(), p.r, p.g, p.b);
-    }
-    return stats;
   }
-
-  // 1. One endpoint per voxel, with the frame's mean colour in it; rays beyond max range are cut
-  //    and end in a voxel that is freed, not hit.
-  //    Neighbouring pixels mostly end in one voxel: their colours are summed in a run that goes
-  //    into the hash map once, when the voxel changes.
-  auto& clipped = impl_->clipped_ends;
-  clipped.clear();
-  OcTreeKey key;
-  std::uint64_t run_key = 0;
-  ColorSum run;
-  auto flush = [&] {
-    if (run.n == 0) return;
-    ColorSum& c = endpoints[run_key];
-    c.r += run.r;
-    c.g += run.g;
-    c.b += run.b;
-    c.n += run.n;
-    run = ColorSum{};
-  };
-  auto add = [&](const PointT& p) {
-    if (!is_valid(p)) return;
-    ++stats.points;
-    Eigen::Vector3f w = T * p.getVector3fMap();
-    const Eigen::Vector3f d = w - origin_f;
-    const float range = d.norm();
-    if (max_range > 0 && range > max_range) {
-      w = origin_f + d * static_cast<float>(max_range / range);
-      if (tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) clipped.push_back(pack(key));
-      return;
-    }
-    if (!tree.coordToKeyChecked(octomap::point3d(w.x(), w.y(), w.z()), key)) return;
-    const std::uint64_t k = pack(key);
-    if (k != run_key) {
-      flush();
-      run_key = k;
-    }
-    run.r += p.r;
-    run.g += p.g;
-    run.b += p.b;
-    ++run.n;
-  };
-  const std::size_t n = points_camera.size();
-  const bool organized = points_camera.height > 1 && points_camera.width > 0;
-  const std::size_t width = organized ? points_camera.width : std::max<std::size_t>(n, 1);
-  const std::size_t step = organized && stride > 1 ? static_cast<std::size_t>(stride) : 1;
-  for (std::size_t row = 0; row < n; row += width * step)
-    for (std::size_t i = row; i < std::min(row + width, n); i += step) add(points_camera.points[i]);
-  flush();
-  std::sort(clipped.begin(), clipped.end());
-  clipped.erase(std::unique(clipped.begin(), clipped.end()), clipped.end());
-  for (const auto& [k, c] : endpoints) grow(unpack(k));
-  for (std::uint64_t k : clipped) grow(unpack(k));
-
-  // 2. Rays from the sensor to each endpoint voxel's centre (OctoMap's discretized update). A
-  //    frame of many endpoints casts the two halves of its image (left and right of the camera's
-  //    axis) on two threads, each into a ray set of its own, then ORs them: the same split every
-  //    time, so the same map whichever thread is faster; each half's rays still converge among
-  //    themselves for the ray_stop_after shortcut.
   rays.reset(lo, hi);
-  auto cast = [&](const OcTreeKey& end, RaySet& into) {
-    into.insert_end(end);
-    if (config_.ray_stop_after > 0) cast_ray_back(tree, origin, origin_key, tree.keyToCoord(end), end, config_.ray_stop_after, into);
-    else cast_ray(tree, origin, origin_key, tree.keyToCoord(end), end, into);
-  };
-  if (endpoints.size() < kParallelRayEndpoints) {
-    for (const auto& [k, c] : endpoints) cast(unpack(k), rays);
-  } else {
-    auto& left = impl_->left_ends;
-    auto& right = impl_->right_ends;
-    left.clear();
-    right.clear();
-    const Eigen::Vector3f camera_x = T.linear().col(0);
-    for (const auto& [k, c] : endpoints) {
-      const OcTreeKey end = unpack(k);
-      const octomap::point3d p = tree.keyToCoord(end);
-      (camera_x.dot(Eigen::Vector3f(p.x(), p.y(), p.z()) - origin_f) < 0 ? left : right).push_back(end);
-    }
-    auto& rays_right = impl_->rays_right;
-    rays_right.reset(lo, hi);
-    auto other = std::async(std::launch::async, [&] {
-      for (const auto& end : right) cast(end, rays_right);
-    });
-    for (const auto& end : left) cast(end, rays);
-    other.get();
-    rays.merge(rays_right);
+  for (const auto& k : free_keys) rays.insert_free(k);
+  for (const auto& k : occupied_keys) rays.insert_end(k);
+  stats.free_updates = free_keys.size();
+  stats.occupied_updates = occupied_keys.size();
+  tree.insertPointCloud(scan, origin, range, /*lazy_eval=*/false, /*discretize=*/false);
+  for (const auto& p : points_camera.points) {
+    if (!is_valid(p)) continue;
+    const Eigen::Vector3f w = T * p.getVector3fMap();
+    tree.averageNodeColor(w.x(), w.y(), w.z(), p.r, p.g, p.b);
   }
-  for (std::uint64_t k : clipped) {
-    const OcTreeKey end = unpack(k);
-    cast_ray(tree, origin, origin_key, tree.keyToCoord(end), end, rays);
-    rays.insert_free(end);  // a cut ray frees its last voxel too: nothing was seen there
-  }
+  return stats;
+}
+}  // namespace
 
-  // 3. One sorted list of updates, (morton << 1) | hit, then one ordered descent of the tree.
-  auto& updates = impl_->updates;
-  updates.clear();
-  rays.for_each([&](const OcTreeKey& k, bool is_end) {
-    updates.push_back((morton_encode(k) << 1) | (is_end ? 1 : 0));
-    ++(is_end ? stats.occupied_updates : stats.free_updates);
-  });
-  radix_sort(updates, impl_->scratch, 49);
-  bulk_update(tree, updates, [&](const OcTreeKey& k, std::uint8_t rgb[3]) {
-    const ColorSum& c = endpoints.find(pack(k))->second;
-    rgb[0] = static_cast<std::uint8_t>(c.r / c.n);
-    rgb[1] = static_cast<std::uint8_t>(c.g / c.n);
-    rgb[2] = static_cast<std::uint8_t>(c.b / c.n);
-  });
+InsertStats OccupancyMap::insert(const Cloud& points_camera, const Pose& T_world_camera, int stride) {
+  auto& tree = impl_->tree;
+  auto& trace = impl_->trace;
+  const Eigen::Isometry3f T = T_world_camera.cast<float>();
+  if (!config_.fast_insertion) return insert_plain(tree, points_camera, T, config_.max_range_m, trace.rays());
+
+  // 1. The frame's endpoints and rays (frame_trace.h).
+  InsertStats stats;
+  TraceSettings settings;
+  settings.max_range_m = config_.max_range_m;
+  settings.ray_stop_after = config_.ray_stop_after;
+  settings.stride = stride;
+  stats.points = trace.trace(tree, points_camera, T, settings);
+  auto& rays = trace.rays();
+
+  // 2. One ordered descent of the tree, block by block in Morton order.
+  stats.free_updates = rays.count_freed();
+  stats.occupied_updates = rays.count_ends();
+  rays.morton_order(impl_->order, impl_->scratch);
+  bulk_update(tree, rays, impl_->order,
+              [&](const OcTreeKey& k, std::uint8_t rgb[3]) { trace.endpoints().mean_color_in_order(k, rgb); });
   return stats;
 }
 
@@ -348,7 +158,7 @@ Occupancy OccupancyMap::query(const Eigen::Vector3d& p) const {
 bool OccupancyMap::freed_by_last_insert(const Eigen::Vector3d& p) const {
   OcTreeKey key;
   if (!p.allFinite() || !impl_->tree.coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) return false;
-  return impl_->rays.freed(key);
+  return impl_->trace.rays().freed(key);
 }
 
 namespace {
@@ -539,16 +349,16 @@ std::size_t OccupancyMap::set_voxels(const std::vector<Eigen::Vector3d>& points,
   keys.reserve(points.size());
   OcTreeKey key;
   for (const auto& p : points) {
-    if (p.allFinite() && tree.coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) keys.push_back(pack(key));
+    if (p.allFinite() && tree.coordToKeyChecked(octomap::point3d(p.x(), p.y(), p.z()), key)) keys.push_back(pack_key(key));
   }
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   const float log_odds = state == Occupancy::kOccupied ? tree.getClampingThresMaxLog() : tree.getClampingThresMinLog();
   for (std::uint64_t k : keys) {
     if (state == Occupancy::kUnknown) {
-      tree.deleteNode(unpack(k));
+      tree.deleteNode(unpack_key(k));
     } else {
-      tree.setNodeValue(unpack(k), log_odds, /*lazy_eval=*/true);
+      tree.setNodeValue(unpack_key(k), log_odds, /*lazy_eval=*/true);
     }
   }
   if (state != Occupancy::kUnknown) refresh_inner(tree);
@@ -557,8 +367,7 @@ std::size_t OccupancyMap::set_voxels(const std::vector<Eigen::Vector3d>& points,
 
 void OccupancyMap::reset() {
   impl_->tree.clear();
-  impl_->rays.clear();
-  impl_->endpoints.clear();
+  impl_->trace.clear();
 }
 
 Status OccupancyMap::save(const fs::path& path) const {

@@ -1,48 +1,108 @@
 #include "ray_set.h"
 
 #include <algorithm>
+#include <stdexcept>
+
+#include "bulk_update.h"
 
 namespace scenewatch::background {
 
 void RaySet::reset(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi) {
-  std::uint64_t volume = 1;
+  std::size_t cells = 1;
   for (int i = 0; i < 3; ++i) {
-    lo_[i] = static_cast<octomap::key_type>(lo[i] > 0 ? lo[i] - 1 : 0);
-    const std::uint32_t top = std::min<std::uint32_t>(hi[i] + 1u, 0xffffu);
-    dim_[i] = top - lo_[i] + 1;
-    volume *= dim_[i];
+    const unsigned first = lo[i] > 0 ? lo[i] - 1u : 0u;
+    const unsigned last = std::min<unsigned>(hi[i] + 1u, 0xffffu);
+    lo_[i] = first >> kBlockLevels;
+    dim_[i] = (last >> kBlockLevels) - lo_[i] + 1;
+    cells *= dim_[i];
   }
-  use_bitmap_ = volume <= kMaxBitmapVoxels;
-  free_set_.clear();
-  end_set_.clear();
-  if (use_bitmap_) {
-    const std::size_t words = static_cast<std::size_t>((volume + 63) / 64);
-    free_bits_.assign(words, 0);
-    end_bits_.assign(words, 0);
+  use_index_ = cells <= kMaxIndexedBlocks;
+  blocks_.clear();
+  coords_.clear();
+  by_coords_.clear();
+  if (use_index_) {
+    index_.assign(cells, kNone);
   } else {
-    Bits().swap(free_bits_);
-    Bits().swap(end_bits_);
+    std::vector<std::uint32_t>().swap(index_);
   }
 }
 
-void RaySet::merge(const RaySet& other) {
-  // The same bounds give the same layout (a bitmap of the same size, or hash sets).
-  if (use_bitmap_) {
-    for (std::size_t w = 0; w < free_bits_.size() && w < other.free_bits_.size(); ++w) {
-      free_bits_[w] |= other.free_bits_[w];
-      end_bits_[w] |= other.end_bits_[w];
-    }
-    return;
+std::uint32_t RaySet::find(unsigned bx, unsigned by, unsigned bz) const {
+  if (use_index_) {
+    const std::uint32_t* c = cell(bx, by, bz);
+    return c ? *c : kNone;
   }
-  free_set_.insert(other.free_set_.begin(), other.free_set_.end());
-  end_set_.insert(other.end_set_.begin(), other.end_set_.end());
+  const auto it = by_coords_.find(pack(bx, by, bz));
+  return it == by_coords_.end() ? kNone : it->second;
+}
+
+std::uint32_t RaySet::find_or_add(unsigned bx, unsigned by, unsigned bz) {
+  std::uint32_t* slot = nullptr;
+  if (use_index_) {
+    slot = const_cast<std::uint32_t*>(cell(bx, by, bz));
+    if (slot == nullptr) return kNone;
+  } else {
+    slot = &by_coords_.try_emplace(pack(bx, by, bz), kNone).first.value();
+  }
+  if (*slot == kNone) {
+    if (blocks_.size() >= (std::size_t{1} << kNumberBits)) throw std::length_error("RaySet: more than 2^25 blocks of rays in one frame");
+    *slot = static_cast<std::uint32_t>(blocks_.size());
+    blocks_.emplace_back();
+    coords_.push_back(pack(bx, by, bz));
+  }
+  return *slot;
 }
 
 void RaySet::clear() {
-  free_set_.clear();
-  end_set_.clear();
-  std::fill(free_bits_.begin(), free_bits_.end(), 0);
-  std::fill(end_bits_.begin(), end_bits_.end(), 0);
+  if (use_index_) {
+    for (std::uint64_t c : coords_) {
+      const std::uint32_t* cellp = cell(static_cast<unsigned>(c >> 32), static_cast<unsigned>((c >> 16) & 0xffff),
+                                        static_cast<unsigned>(c & 0xffff));
+      if (cellp != nullptr) *const_cast<std::uint32_t*>(cellp) = kNone;
+    }
+  }
+  by_coords_.clear();
+  blocks_.clear();
+  coords_.clear();
+}
+
+void RaySet::merge(const RaySet& other) {
+  for (std::size_t i = 0; i < other.blocks_.size(); ++i) {
+    const std::uint64_t c = other.coords_[i];
+    const std::uint32_t b = find_or_add(static_cast<unsigned>(c >> 32), static_cast<unsigned>((c >> 16) & 0xffff),
+                                        static_cast<unsigned>(c & 0xffff));
+    if (b == kNone) continue;  // other was reset with other bounds
+    for (unsigned w = 0; w < kBlockVoxels / 64; ++w) {
+      blocks_[b].free[w] |= other.blocks_[i].free[w];
+      blocks_[b].end[w] |= other.blocks_[i].end[w];
+    }
+  }
+}
+
+void RaySet::morton_order(std::vector<std::uint64_t>& sorted, std::vector<std::uint64_t>& scratch) const {
+  sorted.resize(blocks_.size());
+  for (std::size_t i = 0; i < blocks_.size(); ++i) {
+    const std::uint64_t c = coords_[i];
+    const octomap::OcTreeKey block(static_cast<octomap::key_type>(c >> 32), static_cast<octomap::key_type>((c >> 16) & 0xffff),
+                                   static_cast<octomap::key_type>(c & 0xffff));
+    sorted[i] = (morton_encode(block) << kNumberBits) | i;
+  }
+  // Block coordinates have 16 - 3 bits per axis: the codes fit in 39 bits above the numbers.
+  radix_sort(sorted, scratch, 3 * (16 - kBlockLevels) + kNumberBits);
+}
+
+std::size_t RaySet::count_freed() const {
+  std::size_t n = 0;
+  for (const Block& b : blocks_)
+    for (unsigned w = 0; w < kBlockVoxels / 64; ++w) n += static_cast<std::size_t>(__builtin_popcountll(b.free[w] & ~b.end[w]));
+  return n;
+}
+
+std::size_t RaySet::count_ends() const {
+  std::size_t n = 0;
+  for (const Block& b : blocks_)
+    for (unsigned w = 0; w < kBlockVoxels / 64; ++w) n += static_cast<std::size_t>(__builtin_popcountll(b.end[w]));
+  return n;
 }
 
 }  // namespace scenewatch::background

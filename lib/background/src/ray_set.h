@@ -1,14 +1,20 @@
 #pragma once
-// The voxels the rays of one frame pass through, deduplicated in a dense bitmap over the frame's
-// key bounding box (a segment's voxels never leave the box of its two end voxels), with a hash
-// set as fallback when that box is too large for a bitmap.
+// The voxels the rays of one frame pass through and end in, kept in blocks of 8x8x8 voxels.
+//
+// A block is the cube of one tree node three levels above the leaves, aligned as OctoMap's keys
+// are, and holds its voxels' bits in Morton order (bit = the three child indices of the levels
+// below it): one 64-byte line of "passed through" bits and one of "ended here" bits. A ray's
+// consecutive steps mostly stay in one line, and the tree update (bulk_update.h) reads a node's
+// cube as a contiguous run of bits: no per-voxel key list and no sort of millions of keys.
+// Blocks are created on first touch; a dense index over the frame's box finds them, or a hash
+// map when that box holds too many blocks for an index.
 // OcTreeKey.h uses uint16_t and size_t without including their headers.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include <octomap/OcTreeKey.h>
-#include <tsl/robin_set.h>
+#include <tsl/robin_map.h>
 
 #include "scenewatch/core/hash.h"
 
@@ -16,93 +22,108 @@ namespace scenewatch::background {
 
 class RaySet {
  public:
+  static constexpr unsigned kBlockLevels = 3;  // a block is 2^3 voxels per axis
+  static constexpr unsigned kBlockVoxels = 1u << (3 * kBlockLevels);
+
+  struct alignas(64) Block {
+    std::uint64_t free[kBlockVoxels / 64];  // passed through by a ray
+    std::uint64_t end[kBlockVoxels / 64];   // a ray's end voxel
+  };
+
   /// Prepares for keys inside [lo, hi] (inclusive) plus a margin of one voxel (float rounding can
   /// take a ray one voxel past its end box); clears the previous frame.
   void reset(const octomap::OcTreeKey& lo, const octomap::OcTreeKey& hi);
-  void insert_free(const octomap::OcTreeKey& k) { insert(k, free_bits_); }
-  void insert_end(const octomap::OcTreeKey& k) { insert(k, end_bits_); }
-  bool is_free(const octomap::OcTreeKey& k) const { return contains(k, free_bits_); }
-  bool is_end(const octomap::OcTreeKey& k) const { return contains(k, end_bits_); }
+  void insert_free(const octomap::OcTreeKey& k) { set(k, &Block::free); }
+  void insert_end(const octomap::OcTreeKey& k) { set(k, &Block::end); }
+  bool is_free(const octomap::OcTreeKey& k) const { return test(k, &Block::free); }
+  bool is_end(const octomap::OcTreeKey& k) const { return test(k, &Block::end); }
   /// Passed through by a ray and not an endpoint (endpoints win, as in OctoMap's computeUpdate).
   bool freed(const octomap::OcTreeKey& k) const { return is_free(k) && !is_end(k); }
-  /// Calls f(key, is_end) for every key that is an endpoint or freed.
-  template <typename F>
-  void for_each(F&& f) const;
   void clear();
   /// Adds every key of `other`, which was reset() with the same bounds.
   void merge(const RaySet& other);
 
- private:
-  using Bits = std::vector<std::uint64_t>;
-  static constexpr std::uint64_t kMaxBitmapVoxels = std::uint64_t{1} << 30;  // 128 MiB per bitmap
+  const std::vector<Block>& blocks() const { return blocks_; }
+  /// The blocks in the order of a depth-first tree walk, each as (code << kNumberBits) | number:
+  /// the code is the Morton code of the block's coordinates (its voxels' keys shifted right by
+  /// three), so its voxels' codes are (code << 9) | bit; the number indexes blocks().
+  void morton_order(std::vector<std::uint64_t>& sorted, std::vector<std::uint64_t>& scratch) const;
+  static constexpr unsigned kNumberBits = 25;
+  /// Voxels freed (passed through and not an end) and voxels ended in.
+  std::size_t count_freed() const;
+  std::size_t count_ends() const;
 
-  bool in_box(const octomap::OcTreeKey& k) const {
-    return k[0] >= lo_[0] && k[1] >= lo_[1] && k[2] >= lo_[2] && k[0] < lo_[0] + dim_[0] && k[1] < lo_[1] + dim_[1] &&
-           k[2] < lo_[2] + dim_[2];
-  }
-  std::uint64_t index(const octomap::OcTreeKey& k) const {
-    return (static_cast<std::uint64_t>(k[0] - lo_[0]) * dim_[1] + (k[1] - lo_[1])) * dim_[2] + (k[2] - lo_[2]);
-  }
-  static std::uint64_t pack(const octomap::OcTreeKey& k) {
-    return (static_cast<std::uint64_t>(k[0]) << 32) | (static_cast<std::uint64_t>(k[1]) << 16) | k[2];
-  }
-  void insert(const octomap::OcTreeKey& k, Bits& bits) {
-    if (use_bitmap_) {
-      if (!in_box(k)) return;  // cannot happen with the padded box; never write outside the bitmap
-      const std::uint64_t i = index(k);
-      bits[i >> 6] |= std::uint64_t{1} << (i & 63);
-    } else {
-      (&bits == &free_bits_ ? free_set_ : end_set_).insert(pack(k));
-    }
-  }
-  bool contains(const octomap::OcTreeKey& k, const Bits& bits) const {
-    if (use_bitmap_) {
-      if (!in_box(k)) return false;
-      const std::uint64_t i = index(k);
-      return (bits[i >> 6] >> (i & 63)) & 1;
-    }
-    return (&bits == &free_bits_ ? free_set_ : end_set_).count(pack(k)) > 0;
-  }
-
-  bool use_bitmap_ = true;
-  octomap::OcTreeKey lo_{0, 0, 0};
-  std::uint32_t dim_[3] = {0, 0, 0};
-  Bits free_bits_, end_bits_;
-  tsl::robin_set<std::uint64_t, MixHash64> free_set_, end_set_;
-};
-
-template <typename F>
-void RaySet::for_each(F&& f) const {
-  if (use_bitmap_) {
-    const std::uint64_t dz = dim_[2], dy = dim_[1];
-    for (std::size_t w = 0; w < free_bits_.size(); ++w) {
-      std::uint64_t any = free_bits_[w] | end_bits_[w];
-      if (!any) continue;
-      // The word's first index split into x, y, z once (divisions); the bits after it step along
-      // z, wrapping into y and x.
-      const std::uint64_t first = static_cast<std::uint64_t>(w) << 6;
-      std::uint64_t z = first % dz, y = (first / dz) % dy, x = first / (dz * dy), at = first;
-      while (any) {
-        const int b = __builtin_ctzll(any);
-        any &= any - 1;
-        const std::uint64_t i = first | static_cast<std::uint64_t>(b);
-        z += i - at;
-        at = i;
-        while (z >= dz) {
-          z -= dz;
-          if (++y == dy) y = 0, ++x;
-        }
-        const octomap::OcTreeKey k(static_cast<octomap::key_type>(lo_[0] + x), static_cast<octomap::key_type>(lo_[1] + y),
-                                   static_cast<octomap::key_type>(lo_[2] + z));
-        f(k, static_cast<bool>((end_bits_[w] >> b) & 1));
+  /// Sets voxels' "passed through" bits along one ray, keeping the current block at hand: a
+  /// ray's steps mostly stay in one block. While a writer is in use, nothing else may add to
+  /// its set (a new block can move the others).
+  class FreeWriter {
+   public:
+    explicit FreeWriter(RaySet& set) : set_(set) {}
+    /// Sets k's bit; true if it was set already.
+    bool test_and_set(const octomap::OcTreeKey& k) {
+      const unsigned bx = k[0] >> kBlockLevels, by = k[1] >> kBlockLevels, bz = k[2] >> kBlockLevels;
+      if (block_ == nullptr || bx != bx_ || by != by_ || bz != bz_) {
+        const std::uint32_t b = set_.find_or_add(bx, by, bz);
+        if (b == kNone) return true;  // outside the padded box: cannot happen; write nothing
+        block_ = &set_.blocks_[b];
+        bx_ = bx, by_ = by, bz_ = bz;
       }
+      const unsigned bit = bit_of(k);
+      std::uint64_t& word = block_->free[bit >> 6];
+      const std::uint64_t mask = std::uint64_t{1} << (bit & 63);
+      const bool was_set = (word & mask) != 0;
+      word |= mask;
+      return was_set;
     }
-    return;
+
+   private:
+    RaySet& set_;
+    Block* block_ = nullptr;
+    unsigned bx_ = 0, by_ = 0, bz_ = 0;
+  };
+
+  /// The bit of a key inside its block: its low three bits per axis, interleaved (x lowest).
+  static unsigned bit_of(const octomap::OcTreeKey& k) {
+    return kSpread3[k[0] & 7] | (kSpread3[k[1] & 7] << 1) | (kSpread3[k[2] & 7] << 2);
   }
-  for (std::uint64_t p : end_set_) f(octomap::OcTreeKey(p >> 32, (p >> 16) & 0xffff, p & 0xffff), true);
-  for (std::uint64_t p : free_set_) {
-    if (end_set_.count(p) == 0) f(octomap::OcTreeKey(p >> 32, (p >> 16) & 0xffff, p & 0xffff), false);
+
+ private:
+  static constexpr unsigned kSpread3[8] = {0, 1, 8, 9, 64, 65, 72, 73};
+  static constexpr std::size_t kMaxIndexedBlocks = std::size_t{1} << 22;  // a 16 MiB index
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+  using Words = std::uint64_t (Block::*)[kBlockVoxels / 64];
+
+  static std::uint64_t pack(unsigned bx, unsigned by, unsigned bz) {
+    return (static_cast<std::uint64_t>(bx) << 32) | (static_cast<std::uint64_t>(by) << 16) | bz;
   }
-}
+  /// The index cell of block (bx, by, bz), or nullptr outside the indexed box.
+  const std::uint32_t* cell(unsigned bx, unsigned by, unsigned bz) const {
+    const unsigned x = bx - lo_[0], y = by - lo_[1], z = bz - lo_[2];  // wraps below lo_
+    if (x >= dim_[0] || y >= dim_[1] || z >= dim_[2]) return nullptr;
+    return &index_[(static_cast<std::size_t>(x) * dim_[1] + y) * dim_[2] + z];
+  }
+  std::uint32_t find(unsigned bx, unsigned by, unsigned bz) const;
+  std::uint32_t find_or_add(unsigned bx, unsigned by, unsigned bz);
+  void set(const octomap::OcTreeKey& k, Words words) {
+    const std::uint32_t b = find_or_add(k[0] >> kBlockLevels, k[1] >> kBlockLevels, k[2] >> kBlockLevels);
+    if (b == kNone) return;  // outside the padded box: cannot happen; never write outside the index
+    const unsigned bit = bit_of(k);
+    (blocks_[b].*words)[bit >> 6] |= std::uint64_t{1} << (bit & 63);
+  }
+  bool test(const octomap::OcTreeKey& k, Words words) const {
+    const std::uint32_t b = find(k[0] >> kBlockLevels, k[1] >> kBlockLevels, k[2] >> kBlockLevels);
+    if (b == kNone) return false;
+    const unsigned bit = bit_of(k);
+    return ((blocks_[b].*words)[bit >> 6] >> (bit & 63)) & 1;
+  }
+
+  bool use_index_ = true;
+  unsigned lo_[3] = {0, 0, 0};   // block coordinates of the indexed box's corner
+  unsigned dim_[3] = {0, 0, 0};  // and its size in blocks
+  std::vector<std::uint32_t> index_;  // block number per cell of the box, kNone where untouched
+  tsl::robin_map<std::uint64_t, std::uint32_t, MixHash64> by_coords_;  // when the box is too large
+  std::vector<Block> blocks_;
+  std::vector<std::uint64_t> coords_;  // pack(bx, by, bz) of each block
+};
 
 }  // namespace scenewatch::background
