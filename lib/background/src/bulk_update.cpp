@@ -46,9 +46,14 @@ struct Summary {
 
 // The updates of the voxels [first, first + n) of a block, in its Morton order (n = 512, 64 or 8:
 // the cube of a node at the block's level or one or two below it).
+// The bits of [first, first + n) within their word (n < 64 stays inside one word).
+std::uint64_t span_mask(unsigned first, unsigned n) {
+  return n >= 64 ? ~std::uint64_t{0} : ((std::uint64_t{1} << n) - 1) << (first & 63);
+}
+
 Summary summarise(const Block& block, unsigned first, unsigned n) {
   Summary s;
-  const std::uint64_t mask = n >= 64 ? ~std::uint64_t{0} : ((std::uint64_t{1} << n) - 1) << (first & 63);
+  const std::uint64_t mask = span_mask(first, n);
   for (unsigned w = first >> 6; w < ((first + n + 63) >> 6); ++w) {
     const std::uint64_t hit = block.end[w] & mask, miss = block.free[w] & ~block.end[w] & mask;
     s.all_freed = s.all_freed && miss == mask;
@@ -58,9 +63,9 @@ Summary summarise(const Block& block, unsigned first, unsigned n) {
   return s;
 }
 
-bool touched(const Block& block, unsigned bit) { return ((block.free[bit >> 6] | block.end[bit >> 6]) >> (bit & 63)) & 1; }
+// Whether any voxel of [first, first + n) is updated.
 bool touched(const Block& block, unsigned first, unsigned n) {
-  const std::uint64_t mask = n >= 64 ? ~std::uint64_t{0} : ((std::uint64_t{1} << n) - 1) << (first & 63);
+  const std::uint64_t mask = span_mask(first, n);
   for (unsigned w = first >> 6; w < ((first + n + 63) >> 6); ++w)
     if ((block.free[w] | block.end[w]) & mask) return true;
   return false;
@@ -173,7 +178,7 @@ struct Descent {
     const unsigned part = n / 8;
     for (unsigned c = 0; c < 8; ++c) {
       const unsigned sub = first + c * part;
-      if (!(part == 1 ? touched(block, sub) : touched(block, sub, part))) continue;
+      if (!touched(block, sub, part)) continue;
       bool child_fresh = false;
       Node* ch = child(node, c, child_fresh);
       in_block(ch, level + 1, block, block_code, sub, child_fresh);
