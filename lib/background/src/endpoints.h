@@ -14,18 +14,10 @@
 #include <octomap/OcTreeKey.h>
 #include <tsl/robin_map.h>
 
+#include "packed_key.h"
 #include "scenewatch/core/hash.h"
 
 namespace scenewatch::background {
-
-/// A key as one 64-bit integer (x in bits 32-47, y in 16-31, z in 0-15), and back.
-inline std::uint64_t pack_key(const octomap::OcTreeKey& k) {
-  return (static_cast<std::uint64_t>(k[0]) << 32) | (static_cast<std::uint64_t>(k[1]) << 16) | k[2];
-}
-inline octomap::OcTreeKey unpack_key(std::uint64_t v) {
-  return octomap::OcTreeKey(static_cast<octomap::key_type>(v >> 32), static_cast<octomap::key_type>((v >> 16) & 0xffff),
-                            static_cast<octomap::key_type>(v & 0xffff));
-}
 
 struct ColorSum {
   std::uint32_t r = 0, g = 0, b = 0, n = 0;

@@ -39,7 +39,7 @@ std::uint32_t RaySet::find(unsigned bx, unsigned by, unsigned bz) const {
 std::uint32_t RaySet::find_or_add(unsigned bx, unsigned by, unsigned bz) {
   std::uint32_t* slot = nullptr;
   if (use_index_) {
-    slot = const_cast<std::uint32_t*>(cell(bx, by, bz));
+    slot = cell(bx, by, bz);
     if (slot == nullptr) return kNone;
   } else {
     slot = &by_coords_.try_emplace(pack(bx, by, bz), kNone).first.value();
@@ -56,9 +56,7 @@ std::uint32_t RaySet::find_or_add(unsigned bx, unsigned by, unsigned bz) {
 void RaySet::clear() {
   if (use_index_) {
     for (std::uint64_t c : coords_) {
-      const std::uint32_t* cellp = cell(static_cast<unsigned>(c >> 32), static_cast<unsigned>((c >> 16) & 0xffff),
-                                        static_cast<unsigned>(c & 0xffff));
-      if (cellp != nullptr) *const_cast<std::uint32_t*>(cellp) = kNone;
+      if (std::uint32_t* slot = cell(unpack_key(c))) *slot = kNone;
     }
   }
   by_coords_.clear();
@@ -68,9 +66,8 @@ void RaySet::clear() {
 
 void RaySet::merge(const RaySet& other) {
   for (std::size_t i = 0; i < other.blocks_.size(); ++i) {
-    const std::uint64_t c = other.coords_[i];
-    const std::uint32_t b = find_or_add(static_cast<unsigned>(c >> 32), static_cast<unsigned>((c >> 16) & 0xffff),
-                                        static_cast<unsigned>(c & 0xffff));
+    const octomap::OcTreeKey block = unpack_key(other.coords_[i]);
+    const std::uint32_t b = find_or_add(block[0], block[1], block[2]);
     if (b == kNone) continue;  // other was reset with other bounds
     for (unsigned w = 0; w < kBlockVoxels / 64; ++w) {
       blocks_[b].free[w] |= other.blocks_[i].free[w];
@@ -82,27 +79,29 @@ void RaySet::merge(const RaySet& other) {
 void RaySet::morton_order(std::vector<std::uint64_t>& sorted, std::vector<std::uint64_t>& scratch) const {
   sorted.resize(blocks_.size());
   for (std::size_t i = 0; i < blocks_.size(); ++i) {
-    const std::uint64_t c = coords_[i];
-    const octomap::OcTreeKey block(static_cast<octomap::key_type>(c >> 32), static_cast<octomap::key_type>((c >> 16) & 0xffff),
-                                   static_cast<octomap::key_type>(c & 0xffff));
-    sorted[i] = (morton_encode(block) << kNumberBits) | i;
+    sorted[i] = (morton_encode(unpack_key(coords_[i])) << kNumberBits) | i;
   }
   // Block coordinates have 16 - 3 bits per axis: the codes fit in 39 bits above the numbers.
   radix_sort(sorted, scratch, 3 * (16 - kBlockLevels) + kNumberBits);
 }
 
-std::size_t RaySet::count_freed() const {
+namespace {
+// The bits of every block's words that `bits(free, end)` keeps.
+template <typename Bits>
+std::size_t count_bits(const std::vector<RaySet::Block>& blocks, Bits bits) {
   std::size_t n = 0;
-  for (const Block& b : blocks_)
-    for (unsigned w = 0; w < kBlockVoxels / 64; ++w) n += static_cast<std::size_t>(__builtin_popcountll(b.free[w] & ~b.end[w]));
+  for (const RaySet::Block& b : blocks)
+    for (unsigned w = 0; w < RaySet::kBlockVoxels / 64; ++w) n += static_cast<std::size_t>(__builtin_popcountll(bits(b.free[w], b.end[w])));
   return n;
+}
+}  // namespace
+
+std::size_t RaySet::count_freed() const {
+  return count_bits(blocks_, [](std::uint64_t free, std::uint64_t end) { return free & ~end; });
 }
 
 std::size_t RaySet::count_ends() const {
-  std::size_t n = 0;
-  for (const Block& b : blocks_)
-    for (unsigned w = 0; w < kBlockVoxels / 64; ++w) n += static_cast<std::size_t>(__builtin_popcountll(b.end[w]));
-  return n;
+  return count_bits(blocks_, [](std::uint64_t, std::uint64_t end) { return end; });
 }
 
 }  // namespace scenewatch::background

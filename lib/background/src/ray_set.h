@@ -16,6 +16,7 @@
 #include <octomap/OcTreeKey.h>
 #include <tsl/robin_map.h>
 
+#include "packed_key.h"
 #include "scenewatch/core/hash.h"
 
 namespace scenewatch::background {
@@ -93,8 +94,10 @@ class RaySet {
   static constexpr std::uint32_t kNone = 0xffffffffu;
   using Words = std::uint64_t (Block::*)[kBlockVoxels / 64];
 
+  /// A block's coordinates (its voxels' keys shifted right by three) as one packed key.
   static std::uint64_t pack(unsigned bx, unsigned by, unsigned bz) {
-    return (static_cast<std::uint64_t>(bx) << 32) | (static_cast<std::uint64_t>(by) << 16) | bz;
+    return pack_key(octomap::OcTreeKey(static_cast<octomap::key_type>(bx), static_cast<octomap::key_type>(by),
+                                       static_cast<octomap::key_type>(bz)));
   }
   /// The index cell of block (bx, by, bz), or nullptr outside the indexed box.
   const std::uint32_t* cell(unsigned bx, unsigned by, unsigned bz) const {
@@ -102,6 +105,10 @@ class RaySet {
     if (x >= dim_[0] || y >= dim_[1] || z >= dim_[2]) return nullptr;
     return &index_[(static_cast<std::size_t>(x) * dim_[1] + y) * dim_[2] + z];
   }
+  std::uint32_t* cell(unsigned bx, unsigned by, unsigned bz) {
+    return const_cast<std::uint32_t*>(static_cast<const RaySet&>(*this).cell(bx, by, bz));
+  }
+  std::uint32_t* cell(const octomap::OcTreeKey& block) { return cell(block[0], block[1], block[2]); }
   std::uint32_t find(unsigned bx, unsigned by, unsigned bz) const;
   std::uint32_t find_or_add(unsigned bx, unsigned by, unsigned bz);
   void set(const octomap::OcTreeKey& k, Words words) {
