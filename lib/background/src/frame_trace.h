@@ -22,7 +22,7 @@ namespace scenewatch::background {
 
 struct TraceSettings {
   double max_range_m = 5.0;  ///< rays are cut here and end in a freed voxel; <= 0: no limit
-  int ray_stop_after = 16;   ///< see cast_ray_back(); 0 casts every ray whole
+  int ray_stop_after = 32;   ///< see cast_ray_back(); 0 casts every ray whole
   int stride = 1;            ///< every Nth pixel of every Nth row of an organized cloud
 };
 

@@ -25,7 +25,7 @@ struct Config {
   bool fast_insertion = true;
   /// Fast insertion only: a ray is cast from its end back towards the sensor and stops after this
   /// many voxels in a row already freed by other rays of the frame (0: every ray to the sensor).
-  int ray_stop_after = 16;
+  int ray_stop_after = 32;
   /// The working memory's frames (organized, fast insertion): rays end at every Nth pixel of
   /// every Nth row, N at most this and at most what keeps the samples within one voxel of each
   /// other at max_range_m on a surface facing the camera (floor(resolution_m fx / max_range_m):
