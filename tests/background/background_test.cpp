@@ -278,8 +278,9 @@ TEST(OccupancyMap, AgreesWithPlainOctomapOnRealFrames) {
     std::printf("redkitchen, 10 frames at %.0f cm: occupied fast %zu plain %zu common %zu, Jaccard %.4f; "
                 "state agreement along rays %.4f (%zu points)\n",
                 res * 100, g.fast, g.plain, g.common, g.jaccard(), double(same) / n, n);
-    EXPECT_GE(g.jaccard(), 0.95);
-    EXPECT_GE(double(same) / n, 0.95);
+    // Measured (ray_stop_after 32): Jaccard 0.9896 at 2 cm, 0.9862 at 5 cm; states 0.9996 at both.
+    EXPECT_GE(g.jaccard(), 0.98);
+    EXPECT_GE(double(same) / n, 0.999);
   }
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn33.pcd");
   auto mosd = io::read_cloud(test::data_dir() / "mosd/learn/learn33.pcd");
@@ -290,7 +291,7 @@ TEST(OccupancyMap, AgreesWithPlainOctomapOnRealFrames) {
   const Agreement g = compare_occupied(fast, plain);
   std::printf("mOSD learn33 at 2 cm: occupied fast %zu plain %zu common %zu, Jaccard %.4f\n", g.fast, g.plain, g.common,
               g.jaccard());
-  EXPECT_GE(g.jaccard(), 0.95);
+  EXPECT_GE(g.jaccard(), 0.999);  // one frame: the same 4055 voxels
 }
 
 // The dense copy of the map (the change detector's per-frame view of it) says, voxel by voxel,
