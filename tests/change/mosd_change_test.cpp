@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
+#include <string>
 
 #include "scenewatch/change/diff.h"
 #include "scenewatch/change/evaluation.h"
@@ -42,6 +43,14 @@ Scene load(int i) {
 // depth (the scenes of one session share the recording's exact table depth).
 bool same_camera(const Scene& a, const Scene& b) {
   return change::same_camera_by_labels(a.xyz, a.labels, b.xyz, b.labels);
+}
+
+// "precision P (matched/events) recall R (matched/changes) mean IoU I", as every line below says it.
+std::string describe(const ChangeScore& s) {
+  char text[160];
+  std::snprintf(text, sizeof text, "precision %.3f (%zu/%zu) recall %.3f (%zu/%zu) mean IoU %.3f", s.precision(),
+                s.matched_events, s.events, s.recall(), s.matched_changes, s.true_changes, s.mean_iou());
+  return text;
 }
 
 std::vector<Scene> load_scenes() {
@@ -114,13 +123,10 @@ TEST(MosdChange, SameCameraPairs) {
     std::sort(v.begin(), v.end());
     return v.empty() ? 0.0 : v[v.size() / 2];
   };
-  std::printf("mOSD same-camera pairs: %zu (%zu with a change): precision %.3f (%zu/%zu) recall %.3f (%zu/%zu) mean IoU %.3f, "
-              "median %.1f ms per pair, of which whole-object completion %.1f ms\n",
-              pairs, pairs_with_change, total.precision(), total.matched_events, total.events, total.recall(),
-              total.matched_changes, total.true_changes, total.mean_iou(), median(ms), median(completion_ms));
-  std::printf("the evidence alone (no completion): precision %.3f (%zu/%zu) recall %.3f (%zu/%zu) mean IoU %.3f\n",
-              evidence_only.precision(), evidence_only.matched_events, evidence_only.events, evidence_only.recall(),
-              evidence_only.matched_changes, evidence_only.true_changes, evidence_only.mean_iou());
+  std::printf("mOSD same-camera pairs: %zu (%zu with a change): %s, median %.1f ms per pair, of which whole-object "
+              "completion %.1f ms\n",
+              pairs, pairs_with_change, describe(total).c_str(), median(ms), median(completion_ms));
+  std::printf("the evidence alone (no completion): %s\n", describe(evidence_only).c_str());
   EXPECT_GE(pairs, 15u) << "the data README lists about twenty same-camera pairs";
   EXPECT_GE(total.true_changes, 8u);
   // Strict scoring (IoU >= 0.5 with the whole object, both ways), pixel truth: 0.972 (70/72) and
@@ -162,12 +168,8 @@ TEST(MosdChange, MapPathOnSameCameraPairs) {
     evidence_only += score_changes(fringe->events, truth);
     ++pairs;
   });
-  std::printf("mOSD same-camera pairs through the map path (1 cm): %zu pairs: precision %.3f (%zu/%zu) recall %.3f "
-              "(%zu/%zu) mean IoU %.3f; the evidence alone: precision %.3f (%zu/%zu) recall %.3f (%zu/%zu) mean IoU %.3f\n",
-              pairs, total.precision(), total.matched_events, total.events, total.recall(), total.matched_changes,
-              total.true_changes, total.mean_iou(), evidence_only.precision(), evidence_only.matched_events,
-              evidence_only.events, evidence_only.recall(), evidence_only.matched_changes, evidence_only.true_changes,
-              evidence_only.mean_iou());
+  std::printf("mOSD same-camera pairs through the map path (1 cm): %zu pairs: %s; the evidence alone: %s\n", pairs,
+              describe(total).c_str(), describe(evidence_only).c_str());
   EXPECT_GE(pairs, 15u);
   // Measured when these floors were set: whole objects 0.957 (66/69) and 0.908 (99/109), the
   // same at ray_stop_after 16, 32 and 0 (completion fills what the holes lose); the evidence alone

@@ -16,13 +16,15 @@
 
 #include "endpoints.h"
 #include "ray_set.h"
+#include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/core/cloud.h"
 
 namespace scenewatch::background {
 
 struct TraceSettings {
-  double max_range_m = 5.0;  ///< rays are cut here and end in a freed voxel; <= 0: no limit
-  int ray_stop_after = 32;   ///< see cast_ray_back(); 0 casts every ray whole
+  // The map's defaults (occupancy_map.h), which OccupancyMap::insert overrides from its Config.
+  double max_range_m = Config{}.max_range_m;  ///< rays are cut here and end in a freed voxel; <= 0: no limit
+  int ray_stop_after = Config{}.ray_stop_after;  ///< see cast_ray_back(); 0 casts every ray whole
   int stride = 1;            ///< every Nth pixel of every Nth row of an organized cloud
 };
 
