@@ -106,6 +106,11 @@ Result<DiffResult> diff(const Frame& before, const Frame& after, const DiffOptio
     background::OccupancyMap map(options.map);
     map.insert(b, before.pose_or_identity());
     Config config = options.change;  // every surface of a one-frame map was hit once
+    if (same_pose(before, after)) {  // one unmoved camera: the relative pose is exact
+      config.sensor.pose_sigma_m = 0;
+      config.sensor.pose_sigma_deg = 0;
+      config.measure_pose = false;
+    }
     config.min_surface_probability = std::min(config.min_surface_probability, options.map.prob_hit - 1e-3);
     auto mm = mismatch_against_map(map, a, after.pose_or_identity(), *K, config);
     if (!mm) return mm.error();

@@ -2,6 +2,7 @@
 // same-camera pairs.
 #include "scenewatch/change/mismatch.h"
 
+#include "scenewatch/core/depth_validity.h"
 #include "scenewatch/io/rgbd.h"
 
 #include <algorithm>
@@ -23,6 +24,7 @@ constexpr double kHalfDiagonal = 0.8660254;
 }  // namespace
 
 Status validate(const Config& c) {
+  if (auto st = scenewatch::validate(c.sensor); !st) return st;
   auto bad = [](const std::string& key, const std::string& why) { return invalid_argument("change." + key + ": " + why); };
   if (!(c.sigma_factor > 0 && c.sigma_factor <= 20)) return bad("sigma_factor", "must be in (0, 20]");
   if (!(c.min_tolerance_m >= 0 && c.min_tolerance_m <= 0.5)) return bad("min_tolerance_m", "must be in [0, 0.5] m");
@@ -47,10 +49,11 @@ Status validate(const Config& c) {
   return {};
 }
 
-double tolerance_m(const Config& c, double z) {
-  const double d = z - 0.4;
-  const double sigma = 0.0012 + 0.0019 * d * d;  // Nguyen, Izadi & Lovell 2012, eq. (2), z in m
-  return std::max(c.min_tolerance_m, c.sigma_factor * sigma);
+double tolerance_m(const Config& c, double z) { return std::max(c.min_tolerance_m, c.sigma_factor * c.sensor.sigma_z(z)); }
+
+double map_tolerance_m(const Config& c, double z, double pose_shift_m) {
+  const double sensor = c.sensor.sigma_z(z), pose = c.sensor.pose_sigma_at(z);
+  return std::max(c.min_tolerance_m, c.sigma_factor * std::sqrt(sensor * sensor + pose * pose)) + pose_shift_m;
 }
 
 Result<Intrinsics> observation_camera(const Cloud& cloud, const std::optional<Intrinsics>& K) {
@@ -127,10 +130,25 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   if (auto filled = map.fill_dense_grid(box, grid, config.max_grid_voxels); !filled) return filled.error();
   out.grid_ms = ms_since(t0);
 
+  // What the sensor model makes of each pixel (in range, off the border, away from depth edges and
+  // holes; core/depth_validity.h).
+  const DepthView depth = depth_view(cloud, K);
+  const DepthValidity trusted = depth_validity(depth.z, K.width, K.height, std::min(K.fx, K.fy), config.sensor, config.sigma_factor);
+  out.trusted_pixels = trusted.trusted;
+  // How far this frame's pose is off the map: every tolerance below grows with it.
+  if (config.measure_pose) out.pose = pose_agreement(grid, cloud, T, K, trusted, config.sensor);
+  const PoseAgreement& measured_pose = out.pose;
+  // Evidence comes from pixels with a depth in the sensor's range, off the image border. The bands
+  // around depth edges and holes serve the pose measurement above, not the evidence: a new
+  // object's silhouette lies in such a band, and its pixels there are as new as the rest.
+  constexpr std::uint8_t kEvidence = DepthValidity::kInRange | DepthValidity::kInterior;
+  auto trusted_at = [&](int u, int v) { return !config.trusted_pixels_only || trusted.has(u, v, kEvidence); };
+
   // 2. Added: points whose voxel the model holds free and whose distance to every occupied voxel
   //    centre exceeds half a voxel diagonal plus the tolerance at their depth (a surface inside an
   //    occupied voxel may lie anywhere in it). Only points in free voxels pay for the search.
   const auto t1 = Clock::now();
+  const bool organized = cloud.height > 1 && static_cast<int>(cloud.width) == K.width;
   using background::Occupancy;
   const long sx = 1, sy = grid.nx, sz = static_cast<long>(grid.nx) * grid.ny;
   for (std::size_t i = 0; i < cloud.size(); ++i) {
@@ -139,7 +157,12 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
     const Eigen::Vector3d w = (Tf * p.getVector3fMap()).cast<double>();
     const long idx = grid.index_of(w);
     if (grid.at(idx) != Occupancy::kFree) continue;
-    const double reach = kHalfDiagonal * res + tolerance_m(config, p.z);
+    if (config.trusted_pixels_only) {
+      const int u = organized ? static_cast<int>(i % cloud.width) : static_cast<int>(std::lround(K.fx * p.x / p.z + K.cx));
+      const int v = organized ? static_cast<int>(i / cloud.width) : static_cast<int>(std::lround(K.fy * p.y / p.z + K.cy));
+      if (!trusted_at(u, v)) continue;
+    }
+    const double reach = kHalfDiagonal * res + map_tolerance_m(config, p.z, measured_pose.shift_at(w));
     const int ring = std::min(3, static_cast<int>(std::ceil(reach / res - 0.5)));
     const long i0 = idx % grid.nx, j0 = (idx / grid.nx) % grid.ny, k0 = idx / sz;
     double nearest2 = reach * reach;
@@ -174,9 +197,10 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   // 3. Removed: occupied voxels whose whole projected footprint shows depth behind them by more
   //    than the tolerance. A footprint pixel at or in front of the voxel (the surface is still
   //    there, or something occludes it) vetoes; so does one without depth (a hole at a grazing
-  //    edge may be the surface itself).
+  //    edge may be the surface itself) or one the sensor model does not trust. The footprint is
+  //    the voxel's, grown by the pose's uncertainty at that range: wherever the voxel may really
+  //    project, the frame must see behind it.
   const auto t2 = Clock::now();
-  const DepthView depth = depth_view(cloud, K);
   const Eigen::Isometry3d T_camera_world = T.inverse();
   const auto min_probability = static_cast<std::uint8_t>(std::floor(255.0 * config.min_surface_probability));
   for (const background::DenseGrid::Surface& surface : grid.occupied) {
@@ -185,9 +209,10 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
     const Eigen::Vector3d q = T_camera_world * c;
     if (q.z() <= res || q.z() > config.max_range_m) continue;
     const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
-    const double half_px = K.fx * kHalfDiagonal * res / q.z();
+    const double shift = measured_pose.shift_at(c);
+    const double half_px = K.fx * (kHalfDiagonal * res + config.sigma_factor * config.sensor.pose_sigma_at(q.z()) + shift) / q.z();
     if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) continue;
-    const double limit = q.z() + kHalfDiagonal * res + tolerance_m(config, q.z());
+    const double limit = q.z() + kHalfDiagonal * res + map_tolerance_m(config, q.z(), shift);
     constexpr int kSteps = 3;  // (2 kSteps + 1)^2 samples over the footprint
     int with_depth = 0, total = 0;
     float nearest = std::numeric_limits<float>::infinity();
@@ -198,7 +223,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
         const int v = static_cast<int>(std::lround(vc + half_px * b / kSteps));
         ++total;
         const float z = depth.at(u, v);
-        if (!(z > 0)) continue;
+        if (!(z > 0) || !trusted_at(u, v)) continue;
         ++with_depth;
         if (z <= limit) {
           veto = true;

@@ -34,7 +34,7 @@ Status YamlSection::finish() const {
 }
 
 const std::vector<std::string>& pipeline_sections() {
-  static const std::vector<std::string> kSections = {"background", "segmentation", "tracking", "change",
+  static const std::vector<std::string> kSections = {"sensor", "background", "segmentation", "tracking", "change",
                                                      "appearance", "surprise", "events", "foreground"};
   return kSections;
 }
@@ -47,9 +47,38 @@ Status read_all(Reads&&... reads) {
   ((st.ok() ? (st = reads(), 0) : 0), ...);
   return st;
 }
+
+// The `sensor:` section: a profile's defaults first, then any coefficient written beside it.
+Status read_sensor(const YAML::Node& node, SensorModel& sensor) {
+  YamlSection s(node, "sensor");
+  if (auto st = s.check_is_map(); !st) return st;
+  std::string profile = sensor.profile;
+  if (auto st = s.read("profile", profile); !st) return st;
+  if (profile != sensor.profile) {
+    auto named = sensor_profile(profile);
+    if (!named) return named.error();
+    sensor = *named;
+  }
+  if (auto st = read_all([&] { return s.read("axial_base_m", sensor.axial_base_m); },
+                         [&] { return s.read("axial_quad_per_m", sensor.axial_quad_per_m); },
+                         [&] { return s.read("axial_offset_m", sensor.axial_offset_m); },
+                         [&] { return s.read("lateral_px", sensor.lateral_px); },
+                         [&] { return s.read("min_range_m", sensor.min_range_m); },
+                         [&] { return s.read("max_range_m", sensor.max_range_m); },
+                         [&] { return s.read("border_px", sensor.border_px); },
+                         [&] { return s.read("registration_px", sensor.registration_px); },
+                         [&] { return s.read("pose_sigma_m", sensor.pose_sigma_m); },
+                         [&] { return s.read("pose_sigma_deg", sensor.pose_sigma_deg); });
+      !st)
+    return st;
+  return s.finish();
+}
+
 }  // namespace
 
 Status read_pipeline_config(const YAML::Node& root, Config& c) {
+  if (auto st = read_sensor(root["sensor"], c.sensor); !st) return st;
+  c.change.sensor = c.sensor;  // what reads config.change alone (scenewatch diff) sees the same sensor
   {
     YamlSection s(root["background"], "background");
     auto& b = c.background;
@@ -129,7 +158,9 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("complete_objects", g.complete_objects); },
                            [&] { return s.read("completion_evidence_share", g.completion_evidence_share); },
                            [&] { return s.read("completion_object_share", g.completion_object_share); },
-                           [&] { return s.read("completion_stride_px", g.completion_stride_px); });
+                           [&] { return s.read("completion_stride_px", g.completion_stride_px); },
+                           [&] { return s.read("trusted_pixels_only", g.trusted_pixels_only); },
+                           [&] { return s.read("measure_pose", g.measure_pose); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

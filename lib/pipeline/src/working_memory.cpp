@@ -399,6 +399,7 @@ struct WorkingMemory::Impl {
 };
 
 Status validate(const Config& c) {
+  if (auto st = scenewatch::validate(c.sensor); !st) return st;
   if (auto st = background::validate(c.background); !st) return st;
   if (auto st = segmentation::validate(c.segmentation); !st) return st;
   if (!(c.tracking.match_distance_m > 0 && c.tracking.match_distance_m < 5)) return invalid_argument("tracking.match_distance_m: must be in (0, 5) m");
@@ -420,7 +421,15 @@ Status validate(const Config& c) {
   return {};
 }
 
-WorkingMemory::WorkingMemory(Config config) : config_(std::move(config)), impl_(std::make_unique<Impl>(config_)) {}
+namespace {
+// The one sensor model, handed to every stage that weighs evidence.
+Config with_sensor(Config c) {
+  c.change.sensor = c.sensor;
+  return c;
+}
+}  // namespace
+
+WorkingMemory::WorkingMemory(Config config) : config_(with_sensor(std::move(config))), impl_(std::make_unique<Impl>(config_)) {}
 WorkingMemory::~WorkingMemory() = default;
 
 Result<FrameResult> WorkingMemory::process(const Frame& frame) {

@@ -10,17 +10,30 @@
 #include <vector>
 
 #include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/change/pose_agreement.h"
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/geometry.h"
 #include "scenewatch/core/result.h"
+#include "scenewatch/core/sensor_model.h"
 
 namespace scenewatch::change {
 
 struct Config {
-  /// Tolerance at depth z: max(min_tolerance_m, sigma_factor * sigma(z)), with the Kinect's axial
-  /// noise sigma(z) = 0.0012 + 0.0019 (z - 0.4)^2 m (Nguyen, Izadi & Lovell 2012).
+  /// The depth camera and the pose source every piece of evidence is measured against (in the
+  /// working memory: its `sensor:` section, copied in by WorkingMemory).
+  SensorModel sensor;
+  /// Tolerance at depth z: max(min_tolerance_m, sigma_factor * sigma), sigma the sensor's axial
+  /// noise at z (structured light: 0.0012 + 0.0019 (z - 0.4)^2 m, Nguyen, Izadi & Lovell 2012)
+  /// combined, against a map, with the pose's uncertainty at that range.
   double sigma_factor = 3.0;
   double min_tolerance_m = 0.01;
+  /// Against a map: only pixels with a depth in the sensor's working range and off its image
+  /// border (sensor.border_px) are evidence. false: every pixel with depth.
+  bool trusted_pixels_only = true;
+  /// Against a map: the pose's uncertainty in each frame is measured (pose_agreement.h), and the
+  /// larger of it and the declared one (sensor.pose_sigma_m, pose_sigma_deg) counts. false: the
+  /// declared one alone.
+  bool measure_pose = true;
   /// Only voxels the map holds occupied with at least this probability can be claimed removed:
   /// a surface seen once (a flying pixel at a silhouette) is no evidence of an object. A map
   /// built from one frame holds prob_hit (0.7); diff() lowers the threshold to it.
@@ -70,8 +83,12 @@ struct Config {
 /// Validates ranges; the message names the key ("change.persistence_frames: ...").
 Status validate(const Config& config);
 
-/// The tolerance at depth z (metres).
+/// The tolerance at depth z (metres): the sensor's noise alone (same-camera pairs).
 double tolerance_m(const Config& config, double z);
+/// The tolerance at depth z against a map (metres): sigma_factor times the sensor's noise and the
+/// declared pose uncertainty (sensor.pose_sigma_*) together, plus how far the frame's measured
+/// misalignment (pose_agreement.h) has moved the point: a measured offset, not a spread.
+double map_tolerance_m(const Config& config, double z, double pose_shift_m = 0.0);
 
 /// A depth image in some camera: z per pixel (NaN where none), plus that camera.
 struct DepthView {
@@ -102,6 +119,8 @@ struct Mismatch {
   std::vector<float> added_gap_m;     ///< per added point: distance to the nearest model surface (capped)
   std::vector<MissingVoxel> missing;  ///< model voxels the rays passed through
   double voxel_m = 0.0;               ///< the map's voxel edge (map path)
+  PoseAgreement pose;                 ///< map path: how well the frame's pose agrees with the map
+  std::size_t trusted_pixels = 0;     ///< map path: pixels the sensor model trusts
   /// Removed side given as points of an earlier organized observation (same-camera pairs); its
   /// indices index that observation. Empty for the map path.
   std::vector<int> removed_points;

@@ -21,6 +21,7 @@
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
+#include "scenewatch/core/sensor_model.h"
 #include "scenewatch/foreground/foreground_tracker.h"
 #include "scenewatch/pipeline/event_fusion.h"
 #include "scenewatch/pipeline/object_tracker.h"
@@ -31,6 +32,9 @@ namespace scenewatch::pipeline {
 
 /// Everything the pipeline needs; loaded from YAML by load_config().
 struct Config {
+  /// The depth camera and the pose source (the `sensor:` section): every stage that weighs
+  /// evidence takes it from here (WorkingMemory copies it into change.sensor).
+  SensorModel sensor;
   background::Config background;
   segmentation::Config segmentation;
   TrackingConfig tracking;
