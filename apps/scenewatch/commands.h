@@ -29,7 +29,14 @@ struct RemoteOptions {
   double timeout_s = 30.0;  ///< per call; 0 = wait forever
   /// The daemon's access token file (calls that change the model need the token).
   std::string token_file = service::default_token_path().string();
+  /// ingest: the name of the camera the frames come from (empty: one name per run, from the first
+  /// path's folder and this process's id; see camera_name()).
+  std::string camera;
 };
+
+/// The camera name an ingest run gives its frames: `given`, else "<folder>#<pid>" from the first
+/// path (a sequence folder's own name, a cloud file's folder), so that two runs are two cameras.
+std::string camera_name(const std::string& given, const std::vector<std::string>& paths);
 
 int run_health(const RemoteOptions& options);
 int run_stats(const RemoteOptions& options);

@@ -71,6 +71,10 @@ int main(int argc, char** argv) {
                      "stream sequence folders as a live sensor: FPS frames per second without waiting for replies; "
                      "the daemon skips a frame when a newer one is already waiting, and the summary counts them")
       ->check(CLI::Range(0.1, 1000.0));
+  ingest->add_option("--camera", remote.camera,
+                     "the name of the camera the frames come from; frames of several cameras may feed one daemon at "
+                     "once, each run its own camera (default: the first path's folder and this process's id, "
+                     "e.g. redkitchen#4242)");
   add_depth_scale_option(ingest, ingest_depth_scale);
   add_remote_options(ingest, remote);
   ingest->callback([&] {

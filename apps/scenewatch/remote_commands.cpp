@@ -176,8 +176,22 @@ int run_stats(const RemoteOptions& options) {
   });
 }
 
+std::string camera_name(const std::string& given, const std::vector<std::string>& paths) {
+  if (!given.empty()) return given;
+  std::string folder = "camera";
+  if (!paths.empty()) {
+    fs::path p = fs::path(paths.front()).lexically_normal();
+    if (p.filename().empty()) p = p.parent_path();  // "dir/"
+    if (!fs::is_directory(p)) p = p.parent_path();
+    const fs::path absolute = fs::absolute(p).lexically_normal();
+    if (!absolute.filename().empty()) folder = absolute.filename().string();
+  }
+  return folder + "#" + std::to_string(::getpid());
+}
+
 int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side,
                const std::optional<double>& depth_scale_m) {
+  const std::string camera = camera_name(options.camera, paths);
   auto client = connect(options);
   if (!client) return fail(client.error().message);
   const bool show_progress = !options.json && ::isatty(STDOUT_FILENO) == 1;
@@ -248,6 +262,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
           continue;
         }
         frame->source = source;
+        frame->camera = camera;
         proto::Request request;
         *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
         auto id = client->start(std::move(request));
@@ -267,6 +282,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       continue;
     }
     frame->source = path;
+    frame->camera = camera;
     proto::Request request;
     *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
     if (!send(std::move(request), path, nullptr)) return kExitError;
@@ -276,6 +292,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
 
 int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,
                     const std::optional<double>& depth_scale_m) {
+  const std::string camera = camera_name(options.camera, paths);
   auto client = connect(options);
   if (!client) return fail(client.error().message);
   // A live sensor: frames leave at `fps` whether or not the daemon has answered; the daemon skips
@@ -314,6 +331,7 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
         continue;
       }
       std::this_thread::sleep_until(start + std::chrono::duration<double>(sent / fps));
+      frame->camera = camera;
       proto::Request request;
       *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
       request.mutable_ingest_frame()->set_live(true);

@@ -87,3 +87,42 @@ TEST(PoseAgreement, AWrongPoseIsMeasuredAtItsSize) {
 
 }  // namespace
 }  // namespace scenewatch::change
+
+namespace scenewatch::change {
+namespace {
+
+TEST(SurfaceWitness, ACameraClaimsOnlyAgainstWhatItHasSeen) {
+  SurfaceWitness witness(0.02);
+  auto cloud = std::make_shared<Cloud>();
+  PointT p;
+  p.x = 0.1f;
+  p.y = 0.0f;
+  p.z = 1.0f;
+  cloud->push_back(p);
+  witness.witness(*cloud, Pose::Identity(), /*camera=*/3);
+  const Eigen::Vector3d seen(0.1, 0.0, 1.0), elsewhere(0.5, 0.0, 1.0);
+  EXPECT_EQ(witness.seen(seen, 3), SurfaceWitness::Seen::kBySelf);
+  EXPECT_EQ(witness.seen(seen, 4), SurfaceWitness::Seen::kByOthersOnly);
+  EXPECT_EQ(witness.seen(elsewhere, 4), SurfaceWitness::Seen::kByNone);
+  witness.witness(*cloud, Pose::Identity(), 4);
+  EXPECT_EQ(witness.seen(seen, 4), SurfaceWitness::Seen::kBySelf);
+  witness.forget({seen});
+  EXPECT_EQ(witness.seen(seen, 3), SurfaceWitness::Seen::kByNone);
+  // Bounded: beyond the limit the surfaces seen least recently go.
+  SurfaceWitness small(0.02, 100);
+  for (int i = 0; i < 200; ++i) {
+    auto one = std::make_shared<Cloud>();
+    PointT q;
+    q.x = 0.05f * static_cast<float>(i);
+    q.y = 0.0f;
+    q.z = 1.0f;
+    one->push_back(q);
+    small.witness(*one, Pose::Identity(), 0);
+  }
+  EXPECT_LE(small.size(), 100u);
+  EXPECT_EQ(small.seen(Eigen::Vector3d(0.05 * 199 + 0.001, 0, 1.0), 0), SurfaceWitness::Seen::kBySelf);
+  EXPECT_EQ(small.seen(Eigen::Vector3d(0.001, 0, 1.0), 0), SurfaceWitness::Seen::kByNone);
+}
+
+}  // namespace
+}  // namespace scenewatch::change

@@ -218,6 +218,17 @@ TEST(WorkingMemory, BadFramesChangeNothing) {
   ASSERT_FALSE(r.ok()) << "finite but absurd coordinates";
   EXPECT_NE(r.error().message.find("2 points lie farther than 1000 m"), std::string::npos) << r.error().message;
 
+  Frame long_camera = make_frame({kCube}, 2.0);
+  long_camera.camera = std::string(129, 'c');
+  r = wm.process(long_camera);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("camera name is 129 bytes long"), std::string::npos) << r.error().message;
+  Frame control_camera = make_frame({kCube}, 2.0);
+  control_camera.camera = "head\n";
+  r = wm.process(control_camera);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.error().message.find("control character"), std::string::npos) << r.error().message;
+
   EXPECT_EQ(wm.snapshot(), before) << "the snapshot was not replaced";
   const Stats after = wm.stats();
   EXPECT_EQ(after.frames_processed, stats_before.frames_processed);

@@ -21,6 +21,28 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // of its centre.
 constexpr double kHalfDiagonal = 0.8660254;
 
+// How far behind a point in free space its ray is followed for the surface the frame would have
+// seen there without it.
+constexpr double kBehindM = 1.0;
+
+// Whether a point in free space may claim a new surface for its camera. Not when the camera itself
+// has seen a surface in that voxel before (another camera's rays freed it: its own surface, not a
+// new one), nor when the first surface behind it along its ray is one only other cameras have seen
+// (its own version of that surface, displaced, is what this camera sees).
+bool claims_new_surface(const background::DenseGrid& grid, const Eigen::Vector3d& origin, const Eigen::Vector3d& p,
+                        const SurfaceWitness& witness, std::uint32_t camera) {
+  if (witness.seen(p, camera) == SurfaceWitness::Seen::kBySelf) return false;
+  const Eigen::Vector3d dir = (p - origin).normalized();
+  const double step = 0.5 * grid.resolution;
+  for (double s = step; s <= kBehindM; s += step) {
+    const long idx = grid.index_of(p + s * dir);
+    if (idx < 0) return true;  // left the grid: nothing behind to ask about
+    if (grid.at(idx) != background::Occupancy::kOccupied) continue;
+    return witness.seen(grid.center(idx), camera) != SurfaceWitness::Seen::kByOthersOnly;
+  }
+  return true;
+}
+
 }  // namespace
 
 Status validate(const Config& c) {
@@ -104,7 +126,8 @@ DepthView depth_view(const Cloud& cloud, const Intrinsics& K) {
 }
 
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& cloud, const Pose& T,
-                                      const Intrinsics& K, const Config& config, background::DenseGrid* grid_scratch) {
+                                      const Intrinsics& K, const Config& config, background::DenseGrid* grid_scratch,
+                                      const SurfaceWitness* witness, std::uint32_t camera) {
   if (!K.valid()) return invalid_argument("mismatch: intrinsics are invalid");
   Mismatch out;
   out.voxel_m = map.resolution();
@@ -189,6 +212,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
       }
     }
     if (near_surface) continue;
+    if (witness != nullptr && !claims_new_surface(grid, T.translation(), w, *witness, camera)) continue;
     out.added.push_back(static_cast<int>(i));
     out.added_gap_m.push_back(static_cast<float>(reach));
   }
@@ -206,6 +230,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   for (const background::DenseGrid::Surface& surface : grid.occupied) {
     if (surface.probability < min_probability) continue;
     const Eigen::Vector3d c = grid.center(static_cast<long>(surface.index));
+    if (witness != nullptr && witness->seen(c, camera) == SurfaceWitness::Seen::kByOthersOnly) continue;
     const Eigen::Vector3d q = T_camera_world * c;
     if (q.z() <= res || q.z() > config.max_range_m) continue;
     const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;

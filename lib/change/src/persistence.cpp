@@ -14,7 +14,7 @@ constexpr std::size_t kMaxZones = 256;
 
 std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeCluster>& clusters,
                                                     std::vector<ChangeCluster>* pending,
-                                                    std::vector<ChangeCluster>* absorbed) {
+                                                    std::vector<ChangeCluster>* absorbed, std::uint32_t camera) {
   const int k = config_.persistence_frames;
   std::vector<char> matched(candidates_.size(), 0);
   for (const auto& c : clusters) {
@@ -27,7 +27,7 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
     int best = -1;
     double best_d = config_.persistence_match_m;
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
-      if (matched[i] || candidates_[i].latest.kind != c.kind) continue;
+      if (matched[i] || candidates_[i].camera != camera || candidates_[i].latest.kind != c.kind) continue;
       const double d = (candidates_[i].latest.centroid_world - c.centroid_world).norm();
       if (d <= best_d) {
         best_d = d;
@@ -35,7 +35,7 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
       }
     }
     if (best < 0) {
-      candidates_.push_back(Candidate{c, 1, 0, 0});
+      candidates_.push_back(Candidate{c, 1, 0, 0, camera});
       matched.push_back(1);
       continue;
     }
@@ -46,7 +46,7 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
     matched[best] = 1;
   }
   for (std::size_t i = 0; i < candidates_.size(); ++i) {
-    if (!matched[i]) ++candidates_[i].misses;
+    if (!matched[i] && candidates_[i].camera == camera) ++candidates_[i].misses;
   }
   // A candidate not seen for k frames in a row was noise (or left the view before it could be
   // confirmed).
@@ -138,6 +138,11 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
   }
   candidates_.swap(rest);
   return out;
+}
+
+void PersistenceFilter::forget_camera(std::uint32_t camera) {
+  candidates_.erase(std::remove_if(candidates_.begin(), candidates_.end(), [&](const Candidate& c) { return c.camera == camera; }),
+                    candidates_.end());
 }
 
 }  // namespace scenewatch::change

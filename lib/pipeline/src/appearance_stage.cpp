@@ -59,7 +59,8 @@ bool AppearanceStage::familiar(const Pose& T_world_camera) const {
 }
 
 std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& frame,
-                                                              const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known) {
+                                                              const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known,
+                                                              std::uint32_t camera) {
   if (!appearance_config_.enabled && !config_.enabled) return nullptr;
   // Without a pose the camera frame would be taken as the world: keyframes from a moving camera
   // would then be placed wrongly, so only posed frames take part.
@@ -79,14 +80,15 @@ std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& fram
   }
   std::unique_lock<std::shared_mutex> write(mutex_);
   if (result) last_ = result;
-  changed_streak_ = (result && !result->events.empty()) ? changed_streak_ + 1 : 0;
+  int& streak = changed_streak_[camera];
+  streak = (result && !result->events.empty()) ? streak + 1 : 0;
   ++frames_;
   if (!appearance_config_.enabled) return result;
-  if (config_.adopt_after_frames > 0 && changed_streak_ >= config_.adopt_after_frames &&
+  if (config_.adopt_after_frames > 0 && streak >= config_.adopt_after_frames &&
       !memory_.is_new_view(observed->T_world_camera)) {
     // The change held for long enough from a view the memory holds: remember it.
     if (auto id = memory_.replace_nearest(std::move(*observed))) added_at_[*id] = frames_;
-    changed_streak_ = 0;
+    streak = 0;
   } else if (memory_.is_new_view(observed->T_world_camera)) {
     // A new view becomes a keyframe (what AppearanceMemory::consider does, keeping the id).
     if (auto id = memory_.add(std::move(*observed))) added_at_[*id] = frames_;
@@ -101,6 +103,11 @@ std::shared_ptr<const SurpriseResult> AppearanceStage::process(const Frame& fram
     added_at_.swap(live);
   }
   return result;
+}
+
+void AppearanceStage::forget_camera(std::uint32_t camera) {
+  std::unique_lock<std::shared_mutex> write(mutex_);
+  changed_streak_.erase(camera);
 }
 
 Result<std::shared_ptr<const SurpriseResult>> AppearanceStage::evaluate(const Frame& observation) const {
@@ -150,7 +157,7 @@ void AppearanceStage::reset() {
   std::unique_lock<std::shared_mutex> write(mutex_);
   memory_.clear();
   last_.reset();
-  changed_streak_ = 0;
+  changed_streak_.clear();
   added_at_.clear();
 }
 

@@ -21,8 +21,13 @@ class AppearanceStage {
   /// A frame with a pose, intrinsics and an organized colour cloud: its surprise against the
   /// memory (when the memory has keyframes; the expected view with the `known` surfaces splatted
   /// in), then the keyframe update. Other frames are skipped (null result). Events come without ids.
+  /// `camera` names the frame's camera: a change is adopted after `adopt_after_frames` frames of
+  /// one camera in a row that saw it.
   std::shared_ptr<const SurpriseResult> process(const Frame& frame,
-                                                const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known = {});
+                                                const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known = {},
+                                                std::uint32_t camera = 0);
+  /// Forgets what is kept of a camera that is no longer followed.
+  void forget_camera(std::uint32_t camera);
 
   /// The surprise of an observation against the memory; nothing changes.
   Result<std::shared_ptr<const SurpriseResult>> evaluate(const Frame& observation) const;
@@ -50,7 +55,7 @@ class AppearanceStage {
   mutable std::shared_mutex mutex_;
   background::AppearanceMemory memory_;
   std::shared_ptr<const SurpriseResult> last_;
-  int changed_streak_ = 0;  ///< consecutive frames with regions (writer only)
+  std::map<std::uint32_t, int> changed_streak_;  ///< per camera: its consecutive frames with regions (writer only)
   std::uint64_t frames_ = 0;  ///< posed colour frames seen (writer only)
   std::map<std::uint64_t, std::uint64_t> added_at_;  ///< keyframe id -> frames_ when it was taken
 };

@@ -19,7 +19,7 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
                                        const std::vector<change::ChangeCluster>& pending, std::vector<Event> geometric,
                                        std::vector<Aabb> geometric_boxes, bool familiar_view,
                                        const std::vector<TrackedObject>& objects,
-                                       const std::vector<ObjectCluster>& clusters) {
+                                       const std::vector<ObjectCluster>& clusters, std::uint32_t camera) {
   // Whole objects: a removal takes the listed object where it was, an addition this frame's
   // segmented object where it is.
   for (auto& e : geometric) {
@@ -148,7 +148,7 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
     int best = -1;
     double best_d = config_.match_m;
     for (std::size_t i = 0; i < candidates_.size(); ++i) {
-      if (matched[i]) continue;
+      if (matched[i] || candidates_[i].camera != camera) continue;
       const double d = (candidates_[i].latest.centroid_world - region->centroid_world).norm();
       if (d <= best_d) {
         best_d = d;
@@ -156,7 +156,7 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
       }
     }
     if (best < 0) {
-      candidates_.push_back(Candidate{*region, 1, 0, region->score});
+      candidates_.push_back(Candidate{*region, 1, 0, region->score, camera});
       matched.push_back(1);
       continue;
     }
@@ -171,7 +171,7 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
   std::vector<Candidate> kept;
   for (std::size_t i = 0; i < candidates_.size(); ++i) {
     Candidate& c = candidates_[i];
-    if (!matched[i]) ++c.misses;
+    if (!matched[i] && c.camera == camera) ++c.misses;
     if (c.hits >= config_.persistence_frames) {
       Event e = c.latest;
       e.evidence["frames_seen"] = c.hits;
@@ -185,6 +185,11 @@ std::vector<Event> EventFusion::update(const std::vector<Event>& appearance,
   candidates_.swap(kept);
   if (zones_.size() > kMaxZones) zones_.erase(zones_.begin(), zones_.end() - kMaxZones);
   return out;
+}
+
+void EventFusion::forget_camera(std::uint32_t camera) {
+  candidates_.erase(std::remove_if(candidates_.begin(), candidates_.end(), [&](const Candidate& c) { return c.camera == camera; }),
+                    candidates_.end());
 }
 
 void EventFusion::reset() {

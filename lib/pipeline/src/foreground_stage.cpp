@@ -97,7 +97,7 @@ void ForegroundStage::drop_static_hands(const Cloud& cloud, const Pose& T, const
 
 Frame ForegroundStage::prepare(const Frame& frame, std::uint64_t frame_index, const std::vector<Plane>& planes,
                                const std::optional<Eigen::Vector3d>& configured_up, const OccupiedFraction& occupied,
-                               FrameResult& result) {
+                               FrameResult& result, std::uint32_t camera) {
   const Pose T = frame.pose_or_identity();
   cloud_ = frame.cloud;
   planes_ = planes;
@@ -117,12 +117,13 @@ Frame ForegroundStage::prepare(const Frame& frame, std::uint64_t frame_index, co
   if (config_.hands.enabled && frame.has_color && frame.cloud->height > 1) {
     // A moving camera: the remembered planes move with it (a hand-held room sequence otherwise
     // searched its planes again in every frame).
-    if (frame.T_world_camera && last_pose_) {
-      const Pose T_now_prev = frame.T_world_camera->inverse() * *last_pose_;
-      if (!T_now_prev.matrix().isIdentity(1e-9)) hand_memory_.camera_moved(T_now_prev.cast<float>());
+    CameraView& seen_by = cameras_[camera];
+    if (frame.T_world_camera && seen_by.last_pose) {
+      const Pose T_now_prev = frame.T_world_camera->inverse() * *seen_by.last_pose;
+      if (!T_now_prev.matrix().isIdentity(1e-9)) seen_by.hand_memory.camera_moved(T_now_prev.cast<float>());
     }
-    last_pose_ = frame.T_world_camera;
-    detection_ = foreground::detect_hands(*frame.cloud, config_.hands, &hand_memory_);
+    seen_by.last_pose = frame.T_world_camera;
+    detection_ = foreground::detect_hands(*frame.cloud, config_.hands, &seen_by.hand_memory);
     drop_static_hands(*frame.cloud, T, occupied);
   }
   view_.hands = &detection_;
@@ -167,8 +168,7 @@ foreground::ForegroundUpdate ForegroundStage::update(const std::vector<ObjectClu
 
 void ForegroundStage::reset() {
   tracker_.reset();
-  hand_memory_.reset();
-  last_pose_.reset();
+  cameras_.clear();
   recent_hands_.clear();
   hands_ = HandsSeen{};
   cloud_.reset();

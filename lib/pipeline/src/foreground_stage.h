@@ -7,6 +7,7 @@
 #include <deque>
 #include <optional>
 #include <functional>
+#include <map>
 #include <vector>
 
 #include "scenewatch/core/frame.h"
@@ -23,8 +24,13 @@ class ForegroundStage {
   /// (the frame itself when there are none). `planes` are the last frame's, world frame.
   /// The share of world points the background map holds occupied.
   using OccupiedFraction = std::function<double(const std::vector<Eigen::Vector3d>&)>;
+  /// `camera` names the frame's camera: the support planes follow each camera from its own frame
+  /// to its next.
   Frame prepare(const Frame& frame, std::uint64_t frame_index, const std::vector<Plane>& planes,
-                const std::optional<Eigen::Vector3d>& configured_up, const OccupiedFraction& occupied, FrameResult& result);
+                const std::optional<Eigen::Vector3d>& configured_up, const OccupiedFraction& occupied, FrameResult& result,
+                std::uint32_t camera = 0);
+  /// Forgets what is kept of a camera that is no longer followed.
+  void forget_camera(std::uint32_t camera) { cameras_.erase(camera); }
 
   /// Contacts and promotion, after the segmentation (`clusters` world frame, indices into the frame).
   foreground::ForegroundUpdate update(const std::vector<ObjectCluster>& clusters, const std::vector<TrackedObject>& known,
@@ -38,8 +44,11 @@ class ForegroundStage {
  private:
   foreground::ForegroundConfig config_;
   foreground::ForegroundTracker tracker_;
-  foreground::HandMemory hand_memory_;  // the support planes, from frame to frame
-  std::optional<Pose> last_pose_;        // the camera of the frame before, for the planes to follow
+  struct CameraView {
+    foreground::HandMemory hand_memory;  // the support planes, from frame to frame
+    std::optional<Pose> last_pose;       // the camera of its frame before, for the planes to follow
+  };
+  std::map<std::uint32_t, CameraView> cameras_;
   // This frame's, between prepare() and update().
   foreground::HandDetection detection_;
   foreground::FrameView view_;

@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "appearance_stage.h"
+#include "camera_registry.h"
 #include "foreground_stage.h"
 #include "model_store.h"
 #include "timing.h"
@@ -27,6 +28,19 @@ namespace {
 
 // Farther than any depth sensor sees (lidars reach a few hundred metres).
 constexpr float kMaxPointRangeM = 1000.0f;
+// A camera's name is a label (a serial number, a topic, "head"), not a text.
+constexpr std::size_t kMaxCameraName = 128;
+
+Status validate_camera_name(const std::string& name, const std::string& where) {
+  if (name.size() > kMaxCameraName) {
+    return invalid_argument(where + ": camera name is " + std::to_string(name.size()) + " bytes long, at most " +
+                            std::to_string(kMaxCameraName) + " are allowed");
+  }
+  for (unsigned char c : name) {
+    if (c < 0x20 || c == 0x7f) return invalid_argument(where + ": camera name contains a control character");
+  }
+  return {};
+}
 
 // Checks a frame; returns its number of valid points (one pass over the cloud serves both).
 Result<std::size_t> validate_frame(const Frame& f) {
@@ -54,6 +68,7 @@ Result<std::size_t> validate_frame(const Frame& f) {
                             std::to_string(first_far->z) + "): coordinates must be metres in the camera frame");
   }
   if (!std::isfinite(f.stamp_s)) return invalid_argument(where + ": stamp is not finite");
+  if (auto st = validate_camera_name(f.camera, where); !st) return st.error();
   if (f.T_world_camera) {
     if (auto st = validate_rigid(f.T_world_camera->matrix()); !st) return invalid_argument(where + ": " + st.error().message);
   }
@@ -192,7 +207,8 @@ struct ChangeOutcome {
 
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
-      : map(c.background), appearance(c.appearance, c.surprise), changes(c.change), tracker(c.tracking), fusion(c.fusion),
+      : map(c.background), witness(c.background.resolution_m), appearance(c.appearance, c.surprise), changes(c.change),
+        tracker(c.tracking), fusion(c.fusion),
         foreground(c.foreground), snapshot(std::make_shared<SceneSnapshot>()), up(c.segmentation.up) {}
 
   // process() and the other writers hold this for their whole duration.
@@ -201,6 +217,7 @@ struct WorkingMemory::Impl {
   mutable std::shared_mutex map_mutex;
   background::OccupancyMap map;
   background::DenseGrid map_grid;  // the change detector's dense copy of the map, its buffers kept between frames
+  change::SurfaceWitness witness;  // which cameras saw each surface of the map (guarded with it)
   AppearanceStage appearance;  // keyframes, mesh and image surprise; locks itself for readers
 
   // Owned by the writer.
@@ -208,7 +225,9 @@ struct WorkingMemory::Impl {
   ObjectTracker tracker;
   EventFusion fusion;
   ForegroundStage foreground;
-  std::vector<Plane> planes;
+  CameraRegistry cameras;
+  std::vector<Plane> planes;  // the last frame's
+  std::map<std::uint32_t, std::vector<Plane>> planes_by_camera;  // each camera's last frame's
   Pose last_camera = Pose::Identity();
   std::uint64_t frames = 0, points = 0;
   double total_ms = 0, last_ms = 0;
@@ -282,18 +301,18 @@ struct WorkingMemory::Impl {
   // a removed one, within a few frames). A frame whose region is too large for a dense grid is
   // left without change detection.
   ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
-                               const change::Config& config) {
+                               const change::Config& config, std::uint32_t camera) {
     ChangeOutcome out;
     if (!K) return out;
     out.K = *K;
     std::shared_lock<std::shared_mutex> read(map_mutex);
-    auto mismatch = change::mismatch_against_map(map, *frame.cloud, T, *K, config, &map_grid);
+    auto mismatch = change::mismatch_against_map(map, *frame.cloud, T, *K, config, &map_grid, &witness, camera);
     if (!mismatch) return out;
     change::ClusterInput input;
     input.after_camera = frame.cloud.get();
     input.T_world_after = T;
     input.K_after = *K;
-    out.confirmed = changes.update(change::cluster_mismatch(*mismatch, input, config), &out.pending, &out.absorbed);
+    out.confirmed = changes.update(change::cluster_mismatch(*mismatch, input, config), &out.pending, &out.absorbed, camera);
     return out;
   }
 
@@ -317,11 +336,11 @@ struct WorkingMemory::Impl {
   // map (without the points of unconfirmed candidates); confirmed changes are written into it at
   // once. Runs beside the segmentation and the image surprise, which do not read the map.
   ChangeOutcome update_map(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
-                           FrameResult& result) {
+                           FrameResult& result, std::uint32_t camera) {
     ChangeOutcome changed;
     if (config.change_enabled && frames > 0) {
       const auto t_change = Clock::now();
-      changed = detect_changes(frame, T, K, config.change);
+      changed = detect_changes(frame, T, K, config.change, camera);
       result.change_ms = ms_since(t_change);
       result.change_candidates = changes.candidates();
     }
@@ -332,8 +351,12 @@ struct WorkingMemory::Impl {
     const int stride = sample_stride(frame, K, b.resolution_m, b.max_range_m, b.insert_stride_px);
     std::unique_lock<std::shared_mutex> write(map_mutex);
     result.insert_stats = map.insert(*to_insert, T, stride);
+    witness.witness(*to_insert, T, camera, stride);
     for (const auto& c : changed.confirmed) {
-      if (c.before) map.set_voxels(c.before->points_world, background::Occupancy::kFree);
+      if (c.before) {
+        map.set_voxels(c.before->points_world, background::Occupancy::kFree);
+        witness.forget(c.before->points_world);
+      }
       if (c.after) map.set_voxels(c.after->points_world, background::Occupancy::kOccupied);
     }
     for (const auto& c : changed.absorbed) {
@@ -357,7 +380,7 @@ struct WorkingMemory::Impl {
   // One fact, one event: appearance regions where geometry changes are its evidence; others must
   // persist. What the foreground explains (a carried object's old and new place) is not a change.
   std::vector<Event> fuse(const FrameResult& result, const ChangeOutcome& changed, const std::vector<Aabb>& quiet,
-                          double stamp_s) {
+                          double stamp_s, std::uint32_t camera) {
     auto explained = [&](const Aabb& box) {
       return std::any_of(quiet.begin(), quiet.end(), [&](const Aabb& q) { return q.overlaps(box); });
     };
@@ -378,7 +401,21 @@ struct WorkingMemory::Impl {
     }
     const bool familiar = result.surprise && result.surprise->familiar_view;
     return fusion.update(appearance, changed.pending, std::move(geometric), std::move(boxes), familiar, tracker.objects(),
-                         result.objects);
+                         result.objects, camera);
+  }
+
+  // The id of the frame's camera; a camera forgotten to make room takes its per-camera state along.
+  std::uint32_t camera_of(const Frame& frame) {
+    std::optional<std::uint32_t> forgotten;
+    const std::uint32_t id = cameras.id(frame.camera, &forgotten);
+    if (forgotten) {
+      changes.forget_camera(*forgotten);
+      fusion.forget_camera(*forgotten);
+      foreground.forget_camera(*forgotten);
+      appearance.forget_camera(*forgotten);
+      planes_by_camera.erase(*forgotten);
+    }
+    return id;
   }
 
   void emit(std::vector<Event>& batch, std::size_t max_log) {
@@ -443,7 +480,11 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   result.frame_index = m.frames;
   result.points = *valid_points;
   // Hands, the person and the foreground objects are blanked out of what the background sees.
-  const Frame seen = m.foreground.prepare(frame, m.frames, m.planes, config_.segmentation.up, m.occupied_fraction(), result);
+  const std::uint32_t camera_id = m.camera_of(frame);
+  // The planes this camera saw last (world frame); a camera's first frame starts from the model's.
+  const auto own_planes = m.planes_by_camera.find(camera_id);
+  const Frame seen = m.foreground.prepare(frame, m.frames, own_planes != m.planes_by_camera.end() ? own_planes->second : m.planes,
+                                          config_.segmentation.up, m.occupied_fraction(), result, camera_id);
 
   // Three independent parts, each against the memory as it stands before this frame: the
   // geometric change detection with the map update (the octree), the image surprise (keyframes
@@ -455,10 +496,10 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   const auto known_surfaces = m.current_known_surfaces();
   const std::optional<Intrinsics> camera = frame_camera(seen);
   const auto t_parallel = Clock::now();
-  auto map_update = std::async(std::launch::async, [&] { return m.update_map(seen, T, camera, config_, result); });
+  auto map_update = std::async(std::launch::async, [&] { return m.update_map(seen, T, camera, config_, result, camera_id); });
   {
     const auto t_surprise = Clock::now();
-    result.surprise = m.appearance.process(seen, known_surfaces);  // then its keyframe update
+    result.surprise = m.appearance.process(seen, known_surfaces, camera_id);  // then its keyframe update
     result.surprise_ms = ms_since(t_surprise);
   }
 
@@ -478,7 +519,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   result.parallel_ms = ms_since(t_parallel);
   const auto t_after = Clock::now();
   foreground::ForegroundUpdate fg = m.foreground.update(result.objects, m.tracker.objects(), result);
-  result.events = m.fuse(result, changed, fg.quiet_boxes, frame.stamp_s);
+  result.events = m.fuse(result, changed, fg.quiet_boxes, frame.stamp_s, camera_id);
 
   m.track_objects(result, frame, T, fg.claimed_clusters, config_.segmentation.up);
   for (std::uint64_t id : fg.promoted) m.tracker.remove(id);
@@ -491,6 +532,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
 
   m.planes = result.planes;
   for (auto& p : m.planes) p.indices.clear();
+  m.planes_by_camera[camera_id] = m.planes;
   m.last_camera = T;
   ++m.frames;
   m.last_stamp_s = frame.stamp_s;
@@ -573,6 +615,7 @@ void WorkingMemory::reset() {
   {
     std::unique_lock<std::shared_mutex> write(impl_->map_mutex);
     impl_->map.reset();
+    impl_->witness.reset();
   }
   impl_->appearance.reset();
   {
@@ -584,6 +627,8 @@ void WorkingMemory::reset() {
   impl_->fusion.reset();
   impl_->foreground.reset();
   impl_->planes.clear();
+  impl_->planes_by_camera.clear();
+  impl_->cameras.reset();
   impl_->last_camera = Pose::Identity();
   impl_->frames = impl_->points = 0;
   impl_->total_ms = impl_->last_ms = 0;
@@ -786,6 +831,7 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
   {
     std::unique_lock<std::shared_mutex> write(m.map_mutex);
     m.map = std::move(map);
+    m.witness = change::SurfaceWitness(m.map.resolution());  // the loaded surfaces: seen by none of this session
   }
   config_.background.resolution_m = m.map.resolution();
   m.tracker.restore(std::move(objects), std::move(samples), next_object_id);
@@ -794,6 +840,8 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
   m.changes.reset();
   m.fusion.reset();
   m.planes = std::move(planes);
+  m.planes_by_camera.clear();
+  m.cameras.reset();
   m.frames = frames;
   m.points = points;
   m.last_stamp_s = last_stamp_s;

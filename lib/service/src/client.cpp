@@ -275,6 +275,7 @@ proto::IngestFrame make_ingest_frame(const Frame& frame) {
   if (frame.intrinsics) convert::to_proto(*frame.intrinsics, msg.mutable_intrinsics());
   msg.set_stamp_s(frame.stamp_s);
   msg.set_source(frame.source);
+  msg.set_camera(frame.camera);
   return msg;
 }
 

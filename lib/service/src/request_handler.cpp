@@ -278,6 +278,7 @@ struct RequestHandler::Impl {
     if (!std::isfinite(msg.stamp_s())) return invalid_argument("stamp_s is not finite");
     frame.stamp_s = msg.stamp_s();
     frame.source = msg.source().empty() ? std::string("api") : msg.source().substr(0, kMaxSourceLabel);
+    frame.camera = msg.camera();  // checked by the working memory with the rest of the frame
     return frame;
   }
 

@@ -11,6 +11,7 @@
 
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/change/pose_agreement.h"
+#include "scenewatch/change/surface_witness.h"
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/geometry.h"
 #include "scenewatch/core/result.h"
@@ -130,10 +131,13 @@ struct Mismatch {
 /// Compares an observation (points in the camera frame, placed with T_world_camera) with the
 /// map. Error when the region is too large for a dense grid or the camera is invalid. A caller
 /// that compares every frame passes `grid_scratch`, the dense copy of the map, kept between calls
-/// so that its buffers are allocated once.
+/// so that its buffers are allocated once. With `witness`, the observation's camera (`camera`)
+/// claims nothing against a surface only other cameras have seen: a point in free space whose ray
+/// meets such a surface behind it, a voxel only they saw (surface_witness.h).
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& points_camera,
                                       const Pose& T_world_camera, const Intrinsics& K, const Config& config,
-                                      background::DenseGrid* grid_scratch = nullptr);
+                                      background::DenseGrid* grid_scratch = nullptr, const SurfaceWitness* witness = nullptr,
+                                      std::uint32_t camera = 0);
 
 /// Same-camera pair of organized clouds of equal size (the camera did not move): exact per-pixel
 /// reasoning. A pixel whose AFTER depth is in front of BEFORE by more than the tolerance is added

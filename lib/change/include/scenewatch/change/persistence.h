@@ -19,8 +19,12 @@ class PersistenceFilter {
   /// lie where a change of their kind was already confirmed (the other sides of an object that
   /// was added or taken away, seen from new views): the caller writes them into the model
   /// without a new event.
+  /// `camera` names the camera of the frame: a candidate is matched, and counted missing, only in
+  /// frames of the camera that saw it (another camera looking elsewhere is no evidence against it).
   std::vector<ObjectChange> update(const std::vector<ChangeCluster>& clusters, std::vector<ChangeCluster>* pending,
-                                   std::vector<ChangeCluster>* absorbed = nullptr);
+                                   std::vector<ChangeCluster>* absorbed = nullptr, std::uint32_t camera = 0);
+  /// Drops the candidates of a camera that is no longer followed.
+  void forget_camera(std::uint32_t camera);
 
   std::size_t candidates() const { return candidates_.size(); }
   void reset() {
@@ -34,6 +38,7 @@ class PersistenceFilter {
     int hits = 0;
     int misses = 0;  ///< consecutive frames without a match
     int waited = 0;  ///< frames waited, once confirmed, for a move partner
+    std::uint32_t camera = 0;  ///< the camera that saw it
   };
   struct Zone {
     ChangeKind kind;

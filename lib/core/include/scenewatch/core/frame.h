@@ -15,6 +15,10 @@ struct Frame {
   double stamp_s = 0.0;
   bool has_color = true;               ///< false when the source had no colour field
   std::string source;                  ///< file path or "api", for messages
+  /// Which camera took it: frames of one camera share what is kept per camera (remembered planes,
+  /// hand memory, the persistence of change candidates); several cameras may feed one model,
+  /// interleaved. Empty: the default camera.
+  std::string camera;
 
   /// The pose used to place the frame in the world (identity when none was given).
   Pose pose_or_identity() const { return T_world_camera.value_or(Pose::Identity()); }

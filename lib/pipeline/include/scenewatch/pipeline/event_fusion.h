@@ -45,11 +45,14 @@ class EventFusion {
   /// Returns the frame's events: the geometric ones (with appearance evidence merged in), then
   /// the appearance-only changes that became persistent.
   /// `objects` is the object list before this frame, `clusters` this frame's segmented objects
-  /// (world frame, with their indices in the frame).
+  /// (world frame, with their indices in the frame). `camera` names the frame's camera: an
+  /// appearance candidate persists, or misses, only in frames of the camera that saw it.
   std::vector<Event> update(const std::vector<Event>& appearance, const std::vector<change::ChangeCluster>& pending,
                             std::vector<Event> geometric, std::vector<Aabb> geometric_boxes, bool familiar_view,
                             const std::vector<TrackedObject>& objects = {},
-                            const std::vector<ObjectCluster>& clusters = {});
+                            const std::vector<ObjectCluster>& clusters = {}, std::uint32_t camera = 0);
+  /// Drops the candidates of a camera that is no longer followed.
+  void forget_camera(std::uint32_t camera);
 
   std::size_t candidates() const { return candidates_.size(); }
   void reset();
@@ -60,6 +63,7 @@ class EventFusion {
     int hits = 0;
     int misses = 0;
     double best_kl = 0.0;
+    std::uint32_t camera = 0;
   };
   struct Claimed {  ///< appearance evidence gathered for a pending geometric change
     Aabb box;

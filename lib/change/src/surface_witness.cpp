@@ -1,0 +1,63 @@
+#include "scenewatch/change/surface_witness.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace scenewatch::change {
+
+SurfaceWitness::SurfaceWitness(double voxel_m, std::size_t max_voxels) : voxel_m_(voxel_m), max_voxels_(max_voxels) {}
+
+std::uint64_t SurfaceWitness::key(const Eigen::Vector3d& p) const {
+  // 21 bits per axis around the origin: +-20 km at 2 cm.
+  auto c = [&](double x) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x / voxel_m_)) + (1 << 20)) & 0x1fffff; };
+  return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
+}
+
+void SurfaceWitness::witness(const Cloud& cloud, const Pose& T, std::uint32_t camera, int stride) {
+  ++frame_;
+  const std::uint64_t bit = std::uint64_t{1} << (camera % 64);
+  const Eigen::Isometry3f Tf = T.cast<float>();
+  auto add = [&](const PointT& p) {
+    if (!is_valid(p)) return;
+    Entry& e = voxels_[key((Tf * p.getVector3fMap()).cast<double>())];
+    e.cameras |= bit;
+    e.last_frame = frame_;
+  };
+  if (cloud.height > 1 && stride > 1) {
+    for (std::uint32_t v = 0; v < cloud.height; v += static_cast<std::uint32_t>(stride))
+      for (std::uint32_t u = 0; u < cloud.width; u += static_cast<std::uint32_t>(stride)) add(cloud.points[v * cloud.width + u]);
+  } else {
+    for (const auto& p : cloud.points) add(p);
+  }
+  if (voxels_.size() > max_voxels_) prune();
+}
+
+SurfaceWitness::Seen SurfaceWitness::seen(const Eigen::Vector3d& p, std::uint32_t camera) const {
+  const auto it = voxels_.find(key(p));
+  if (it == voxels_.end()) return Seen::kByNone;
+  return (it->second.cameras & (std::uint64_t{1} << (camera % 64))) != 0 ? Seen::kBySelf : Seen::kByOthersOnly;
+}
+
+void SurfaceWitness::forget(const std::vector<Eigen::Vector3d>& points) {
+  for (const auto& p : points) voxels_.erase(key(p));
+}
+
+// Keeps the three quarters of the limit seen most recently.
+void SurfaceWitness::prune() {
+  std::vector<std::uint64_t> frames;
+  frames.reserve(voxels_.size());
+  for (const auto& [k, e] : voxels_) frames.push_back(e.last_frame);
+  const std::size_t keep = max_voxels_ * 3 / 4;
+  std::nth_element(frames.begin(), frames.end() - static_cast<long>(keep), frames.end());
+  const std::uint64_t oldest_kept = *(frames.end() - static_cast<long>(keep));
+  for (auto it = voxels_.begin(); it != voxels_.end();) {
+    if (it->second.last_frame < oldest_kept) {
+      it = voxels_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+}
+
+}  // namespace scenewatch::change
