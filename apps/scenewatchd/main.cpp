@@ -2,6 +2,8 @@
 // over TCP, keeps the working memory of the scene, and persists it in the model directory.
 #include <CLI/CLI.hpp>
 
+#include <sys/resource.h>
+
 #include <chrono>
 #include <csignal>
 #include <ctime>
@@ -50,6 +52,27 @@ class StderrLog {
   LogLevel min_level_;
   std::mutex mutex_;
 };
+
+/// Raises the soft limit of open files to the hard one: every client holds a socket, and a burst
+/// of newcomers (each answered, then closed) briefly holds more; at the usual soft limit of 1024,
+/// accept() would fail while they go. Says so when even the hard limit is tight.
+void raise_open_file_limit(const scenewatch::service::ServerConfig& server, StderrLog& log) {
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_NOFILE, &limit) != 0) return;
+  if (limit.rlim_cur < limit.rlim_max) {
+    rlimit raised = limit;
+    raised.rlim_cur = limit.rlim_max;
+    if (::setrlimit(RLIMIT_NOFILE, &raised) == 0) limit = raised;
+  }
+  // Each counted client, each connection of the live view, and as many again for connections
+  // being turned away or closed to make room, plus the daemon's own files.
+  const rlim_t wanted = 2 * (server.max_connections + 32) + 64;
+  if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur < wanted) {
+    log(LogLevel::kWarning, "open files limited to " + std::to_string(limit.rlim_cur) + ", below the " +
+                                std::to_string(wanted) + " that server.max_connections " +
+                                std::to_string(server.max_connections) + " can use in a burst (raise ulimit -n)");
+  }
+}
 
 }  // namespace
 
@@ -130,6 +153,8 @@ int main(int argc, char** argv) {
   }
   config.server.access_token = std::move(*token);
   log(LogLevel::kInfo, "calls that change the model need the token in " + config.server.token_file.string());
+
+  raise_open_file_limit(config.server, log);
 
   scenewatch::pipeline::WorkingMemory memory(config.pipeline);
   const std::filesystem::path& model = config.server.model_dir;

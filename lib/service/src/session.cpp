@@ -17,6 +17,14 @@ namespace {
 constexpr std::size_t kMaxPendingRequests = 8;
 /// After an error reply, how long the client's remaining bytes are drained before closing.
 constexpr double kLingerS = 2.0;
+/// quiet_since_ns_ while the connection is in use, and once it was claimed for eviction.
+constexpr std::int64_t kBusy = -1;
+constexpr std::int64_t kClaimed = -2;
+
+std::int64_t steady_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
 
 std::string seconds(double s) {
   std::ostringstream os;
@@ -52,7 +60,8 @@ Session::Session(tcp::socket socket, const SessionOptions& options, RequestHandl
       registry_(registry),
       log_(log),
       number_(number),
-      parser_(options.max_message_bytes) {
+      parser_(options.max_message_bytes),
+      quiet_since_ns_(steady_now_ns()) {
   boost::system::error_code ec;
   const tcp::endpoint peer = socket_.remote_endpoint(ec);
   peer_ = ec ? std::string("unknown peer") : format_endpoint(peer);
@@ -124,8 +133,10 @@ void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
     do_read();  // an error reply is being flushed; the client's bytes are ignored
     return;
   }
+  // Claimed to make room for a newcomer before these bytes came: the eviction, already on its
+  // way to this strand, answers them.
+  if (!leave_quiet()) return;
   cancel_timer();  // progress: the stall clock restarts
-  quiet_since_ns_ = -1;  // and the client is not quiet
   const bool was_partial = parser_.has_partial();
   const Status fed = parser_.feed(std::string_view(read_buffer_.data(), n));
   bool completed = false;
@@ -161,19 +172,37 @@ void Session::maybe_resume_reading() {
   update_quiet();
 }
 
+// The quiet state is shared with the acceptor's thread, which may claim a quiet connection for
+// eviction at any time: every change is a compare-and-swap, and a claim is never undone.
 void Session::update_quiet() {
   const bool quiet = idle() && !parser_.has_partial() && context_.subscription < 0 && !closing_ && !closed_ && !lingering_;
+  std::int64_t seen = quiet_since_ns_.load();
+  if (seen == kClaimed) return;
   if (!quiet) {
-    quiet_since_ns_ = -1;
-  } else if (quiet_since_ns_.load() < 0) {
-    quiet_since_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                          std::chrono::steady_clock::now().time_since_epoch()).count();
+    quiet_since_ns_.compare_exchange_strong(seen, kBusy);
+  } else if (seen == kBusy) {
+    quiet_since_ns_.compare_exchange_strong(seen, steady_now_ns());
   }
+}
+
+bool Session::leave_quiet() {
+  std::int64_t seen = quiet_since_ns_.load();
+  while (seen != kClaimed) {
+    if (quiet_since_ns_.compare_exchange_weak(seen, kBusy)) return true;
+  }
+  return false;
+}
+
+bool Session::claim_for_eviction() {
+  std::int64_t seen = quiet_since_ns_.load();
+  while (seen >= 0) {
+    if (quiet_since_ns_.compare_exchange_weak(seen, kClaimed)) return true;
+  }
+  return false;
 }
 
 void Session::evict(std::string reason) {
   asio::post(executor_, [self = shared_from_this(), reason = std::move(reason)] {
-    if (self->quiet_since_ns_.load() < 0 || self->closing_ || self->closed_) return;
     self->fail_and_close(ErrorCode::kUnavailable, reason);
   });
 }
