@@ -98,4 +98,54 @@ inline IdleOutcome idle_outcome(std::vector<service::Client>& clients, double wa
   return outcome;
 }
 
+/// A frame header announcing `bytes` of payload.
+inline std::string frame_header(std::uint32_t bytes) {
+  return {static_cast<char>(bytes >> 24), static_cast<char>(bytes >> 16), static_cast<char>(bytes >> 8),
+          static_cast<char>(bytes)};
+}
+
+/// What a burst of half frames did.
+struct HalfFrames {
+  int busy = 0;           ///< clients told "server busy" (server.max_buffered_bytes)
+  int send_failed = 0;    ///< clients whose half could not be sent whole (closed on them first)
+  double peak_mib = 0;    ///< the daemon's VmRSS at its peak while they held their halves
+};
+
+/// `clients` clients connect, each announces a frame of `frame_bytes` and sends half of it, all
+/// at once; once every one has sent (or failed to), each reads whether it was told the server is
+/// busy, and all vanish together.
+inline HalfFrames send_half_frames_and_vanish(const Daemon& daemon, int clients, std::uint32_t frame_bytes) {
+  const std::string half = frame_header(frame_bytes) + std::string(frame_bytes / 2, 'h');
+  std::vector<service::Client> connections = open_idle_connections(daemon, clients);
+  std::atomic<int> busy{0}, send_failed{0};
+  std::mutex mutex;
+  std::condition_variable all_sent;
+  int sent = 0;
+  RssSampler rss(daemon.pid());
+  std::vector<std::thread> threads;
+  for (auto& c : connections) {
+    threads.emplace_back([&, client = &c] {
+      if (!client->send_raw(half).ok()) ++send_failed;
+      {
+        std::unique_lock<std::mutex> lock(mutex);
+        ++sent;
+        all_sent.notify_all();
+        all_sent.wait(lock, [&] { return sent == clients; });
+      }
+      auto reply = client->receive(1.0);
+      if (reply.ok() && reply->status().code() == proto::Status::UNAVAILABLE &&
+          reply->status().message().find("server.max_buffered_bytes") != std::string::npos) {
+        ++busy;
+      }
+    });
+  }
+  for (auto& t : threads) t.join();
+  HalfFrames result;
+  result.peak_mib = rss.stop();
+  result.busy = busy;
+  result.send_failed = send_failed;
+  for (auto& c : connections) c.close();
+  return result;
+}
+
 }  // namespace scenewatch::test

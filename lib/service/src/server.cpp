@@ -42,8 +42,8 @@ struct Server::Impl {
   ConnectionRegistry registry;
   tcp::acceptor acceptor{io};
   asio::signal_set signals{io};
-  // Bytes of unfinished frames held by all sessions (server.max_buffered_bytes).
-  std::shared_ptr<std::atomic<std::size_t>> buffered_total = std::make_shared<std::atomic<std::size_t>>(0);
+  // Memory reserved for the unfinished frames of all sessions (server.max_buffered_bytes).
+  std::shared_ptr<FrameBudget> frame_budget = std::make_shared<FrameBudget>(config.max_buffered_bytes);
   asio::steady_timer accept_retry{io};
   std::atomic<std::uint64_t> next_number{1};
   std::atomic<bool> stop_requested{false};
@@ -92,7 +92,7 @@ struct Server::Impl {
     boost::system::error_code ignored;
     socket.set_option(tcp::no_delay(true), ignored);
     const SessionOptions options{config.max_message_bytes, config.read_timeout_s, config.max_queued_bytes,
-                                 config.frame_timeout_s, buffered_total, config.max_buffered_bytes};
+                                 config.frame_timeout_s, frame_budget};
     auto session = std::make_shared<Session>(std::move(socket), options, handler, registry, log, next_number++);
     // At the limit, the connection quiet for longest makes room (idle clients cannot lock others
     // out); only when every connection is busy or subscribed is the newcomer turned away.

@@ -7,6 +7,9 @@
 
 #include <chrono>
 #include <sstream>
+#include <utility>
+
+#include "scenewatch/core/memory.h"
 
 namespace scenewatch::service {
 namespace asio = boost::asio;
@@ -17,6 +20,11 @@ namespace {
 constexpr std::size_t kMaxPendingRequests = 8;
 /// After an error reply, how long the client's remaining bytes are drained before closing.
 constexpr double kLingerS = 2.0;
+/// A client that sent a frame at least this large gives the heap's free pages back when it goes
+/// (malloc_trim): its complete frames were copied into heap strings for the handler. Below it,
+/// what it leaves is not worth the trim's cost. (Unfinished frames live in mappings of their own,
+/// FrameBuffer, which go back to the system when they are dropped.)
+constexpr std::size_t kLargeFrameBytes = 1u << 20;
 /// quiet_since_ns_ while the connection is in use, and once it was claimed for eviction.
 constexpr std::int64_t kBusy = -1;
 constexpr std::int64_t kClaimed = -2;
@@ -60,7 +68,7 @@ Session::Session(tcp::socket socket, const SessionOptions& options, RequestHandl
       registry_(registry),
       log_(log),
       number_(number),
-      parser_(options.max_message_bytes),
+      parser_(options.max_message_bytes, options.frame_budget),
       quiet_since_ns_(steady_now_ns()) {
   boost::system::error_code ec;
   const tcp::endpoint peer = socket_.remote_endpoint(ec);
@@ -141,14 +149,14 @@ void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
   const Status fed = parser_.feed(std::string_view(read_buffer_.data(), n));
   bool completed = false;
   while (auto frame = parser_.next()) {
+    held_large_frame_ = held_large_frame_ || frame->size() >= kLargeFrameBytes;
     pending_bytes_ += frame->size();
     pending_.push_back(std::move(*frame));
     completed = true;
   }
-  if (!account_buffered()) {
-    fail_and_close(ErrorCode::kUnavailable,
-                   "server busy: unfinished frames of all clients would hold more than " +
-                       std::to_string(options_.max_buffered_bytes) + " bytes (server.max_buffered_bytes); send again later");
+  if (!fed && fed.error().code == ErrorCode::kUnavailable) {
+    fail_and_close(ErrorCode::kUnavailable, "server busy: " + fed.error().message +
+                                                " (server.max_buffered_bytes); send again later");
     return;
   }
   // The whole-frame clock: from the first byte of a frame until it is complete.
@@ -396,8 +404,7 @@ void Session::fail_and_close(ErrorCode code, const std::string& message) {
   pending_bytes_ = 0;
   // No more of its bytes are read: the unfinished frame is dropped, and its share of the budget
   // given back, now rather than when the client finally goes.
-  parser_ = FrameParser(parser_.max_payload_bytes());
-  account_buffered();
+  release_frame_memory();
   enqueue(handler_.error_payload(code, message));
   // The client may not read the error either: give the write as long as a stalled read.
   arm_timer(options_.read_timeout_s, &Session::on_linger_timeout);
@@ -413,29 +420,23 @@ void Session::begin_linger() {
   do_read();
 }
 
-bool Session::account_buffered() {
-  if (!options_.buffered_total) return true;
-  const std::size_t now = closed_ ? 0 : parser_.buffered_bytes();
-  if (now >= accounted_bytes_) {
-    const std::size_t total = options_.buffered_total->fetch_add(now - accounted_bytes_) + (now - accounted_bytes_);
-    accounted_bytes_ = now;
-    return total <= options_.max_buffered_bytes || now == 0;
-  }
-  options_.buffered_total->fetch_sub(accounted_bytes_ - now);
-  accounted_bytes_ = now;
-  return true;
+void Session::release_frame_memory() {
+  parser_.drop_partial();
+  // glibc keeps freed frame-sized heap buffers (keep_frame_buffers_in_heap): once a client that
+  // sent large frames goes, hand the heap's free pages back.
+  if (std::exchange(held_large_frame_, false)) give_back_free_memory();
 }
 
 void Session::close(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
-  account_buffered();  // gives this session's share back
   cancel_timer();
   handler_.unsubscribe(context_);
   boost::system::error_code ignored;
   socket_.shutdown(tcp::socket::shutdown_both, ignored);
   socket_.close(ignored);
   pending_.clear();
+  release_frame_memory();
   log(LogLevel::kInfo, "disconnected (" + reason + ")");
   registry_.remove(shared_from_this());
 }

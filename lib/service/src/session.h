@@ -32,9 +32,8 @@ struct SessionOptions {
   double read_timeout_s = 10.0;
   std::size_t max_queued_bytes = 0;
   double frame_timeout_s = 30.0;  ///< a frame must arrive whole within this from its first byte
-  /// Bytes of unfinished frames held by all sessions together, and their limit.
-  std::shared_ptr<std::atomic<std::size_t>> buffered_total;
-  std::size_t max_buffered_bytes = 0;
+  /// Memory for the unfinished frames of all sessions together (null: no limit but max_message_bytes).
+  std::shared_ptr<FrameBudget> frame_budget;
 };
 
 /// Owned by shared_ptrs (the registry, pending operations, queued replies). The socket's
@@ -139,9 +138,10 @@ class Session : public std::enable_shared_from_this<Session> {
   bool closed_ = false;
   std::string close_reason_;
   std::atomic<std::int64_t> quiet_since_ns_;
-  std::size_t accounted_bytes_ = 0;  ///< this session's share of options_.buffered_total
-  /// Books the parser's buffered bytes in the shared total; false when the total is over its limit.
-  bool account_buffered();
+  bool held_large_frame_ = false;  ///< a frame of kLargeFrameBytes or more arrived since the last trim
+  /// Drops the unfinished frame (its mapping and its booking); trims the heap when a large frame
+  /// arrived.
+  void release_frame_memory();
 };
 
 }  // namespace scenewatch::service
