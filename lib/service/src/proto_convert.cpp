@@ -337,4 +337,17 @@ Result<Intrinsics> decode_intrinsics(const proto::Intrinsics& msg, const std::st
   return k;
 }
 
+std::string source_label(const std::string& sent) {
+  if (sent.empty()) return "api";
+  std::size_t keep = std::min(sent.size(), kMaxSourceLabelBytes);
+  // Not in the middle of a character: back off over UTF-8 continuation bytes (10xxxxxx).
+  while (keep < sent.size() && keep > 0 && (static_cast<unsigned char>(sent[keep]) & 0xC0) == 0x80) --keep;
+  std::string label = sent.substr(0, keep);
+  for (char& c : label) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) c = '?';  // one log line per message
+  }
+  if (keep < sent.size()) label += "... (cut from " + std::to_string(sent.size()) + " bytes)";
+  return label;
+}
+
 }  // namespace scenewatch::service::convert

@@ -50,4 +50,11 @@ Result<Eigen::Vector3d> decode_point(const proto::Vec3& msg, const std::string& 
 /// Positive focal lengths and image size.
 Result<Intrinsics> decode_intrinsics(const proto::Intrinsics& msg, const std::string& field);
 
+/// The bytes of a source label kept (IngestFrame.source, which messages and the log quote).
+inline constexpr std::size_t kMaxSourceLabelBytes = 256;
+/// IngestFrame.source as the label of the frame: "api" when empty; control characters as '?';
+/// longer than kMaxSourceLabelBytes, cut there (at a UTF-8 character's start) and marked
+/// "... (cut from N bytes)".
+std::string source_label(const std::string& sent);
+
 }  // namespace scenewatch::service::convert

@@ -33,7 +33,6 @@ namespace {
 
 constexpr std::uint32_t kDefaultEventCount = 1000;
 constexpr std::uint32_t kMaxEventCount = 10000;
-constexpr std::size_t kMaxSourceLabel = 256;
 
 /// Where a call runs: see the class comment of RequestHandler.
 enum class Route { kInline, kQuery, kMutate };
@@ -277,7 +276,7 @@ struct RequestHandler::Impl {
     }
     if (!std::isfinite(msg.stamp_s())) return invalid_argument("stamp_s is not finite");
     frame.stamp_s = msg.stamp_s();
-    frame.source = msg.source().empty() ? std::string("api") : msg.source().substr(0, kMaxSourceLabel);
+    frame.source = convert::source_label(msg.source());
     return frame;
   }
 
