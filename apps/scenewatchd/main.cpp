@@ -20,6 +20,7 @@
 #include "scenewatch/service/http_server.h"
 #include "scenewatch/service/live_view.h"
 #include "scenewatch/service/log.h"
+#include "scenewatch/service/model_directory.h"
 #include "scenewatch/service/server.h"
 #include "scenewatch/core/memory.h"
 
@@ -158,6 +159,20 @@ int main(int argc, char** argv) {
 
   scenewatch::pipeline::WorkingMemory memory(config.pipeline);
   const std::filesystem::path& model = config.server.model_dir;
+  // One daemon per model directory, held until this process ends; then what killed or failed
+  // saves left behind goes, before anything is loaded.
+  std::optional<scenewatch::service::ModelDirLock> model_lock;
+  if (!model.empty()) {
+    auto locked = scenewatch::service::ModelDirLock::acquire(model);
+    if (!locked) {
+      log(LogLevel::kError, "model directory: " + locked.error().message);
+      return 1;
+    }
+    model_lock = std::move(*locked);
+    for (const auto& name : scenewatch::service::remove_unfinished_snapshots(model)) {
+      log(LogLevel::kWarning, "removed " + (model / name).string() + ", left behind by a save that did not finish");
+    }
+  }
   if (!model.empty()) {
     if (auto s = memory.load_newest_good(model); s) {
       for (const auto& refused : s->refused) log(LogLevel::kError, "refused a damaged snapshot: " + refused);
@@ -246,7 +261,7 @@ int main(int argc, char** argv) {
 
   int rc = 0;
   if (!model.empty()) {
-    if (auto s = memory.save(model, config.server.keep_snapshots); s) {
+    if (auto s = scenewatch::service::save_model(memory, model, config.server.keep_snapshots); s) {
       log(LogLevel::kInfo, "saved the model to " + model.string());
     } else {
       log(LogLevel::kError, "cannot save the model to " + model.string() + ": " + s.error().message);

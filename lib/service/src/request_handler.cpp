@@ -18,6 +18,7 @@
 #include "scenewatch.pb.h"
 #include "scenewatch/core/files.h"
 #include "scenewatch/service/access_token.h"
+#include "scenewatch/service/model_directory.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/pipeline/working_memory.h"
@@ -541,7 +542,7 @@ struct RequestHandler::Impl {
 
   Status save_model(proto::Response& response) {
     if (Status s = require_model_dir(); !s) return s;
-    if (Status s = memory.save(config.model_dir, config.keep_snapshots); !s) return s;
+    if (Status s = service::save_model(memory, config.model_dir, config.keep_snapshots); !s) return s;
     response.mutable_save_model()->set_model_dir(config.model_dir.string());
     return {};
   }
