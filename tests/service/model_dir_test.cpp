@@ -1,5 +1,6 @@
 // The model directory on the real scenewatchd: one daemon per directory (a second one refuses to
-// start, naming the first), and no unfinished snapshot left behind by a killed save.
+// start, naming the first), no unfinished snapshot left behind by a killed or failed save, and a
+// save that fails for want of space says so.
 #include <gtest/gtest.h>
 
 #include <signal.h>
@@ -123,6 +124,33 @@ TEST_F(ModelDirTest, UnfinishedSnapshotsAreRemovedAtStartUp) {
   EXPECT_EQ(call(client, request([](proto::Request& r) { r.mutable_health(); })).health().frames_processed(), 3u);
   EXPECT_EQ(call(client, save_model()).status().code(), proto::Status::OK);
   EXPECT_EQ(fs::read_symlink(model_dir_ / "current").string().rfind("snap-", 0), 0u);
+}
+
+// A model directory on a file system that is full: the save fails with the system's reason, and
+// leaves no unfinished snapshot. The daemon runs in a mount namespace of its own (unshare) with a
+// 128 KiB tmpfs on its model directory: room for the class store (about 80 kB), not for the map of
+// the mug frame (120 kB).
+TEST_F(ModelDirTest, ASaveOnAFullDiskSaysWhyAndLeavesNothingBehind) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  if (run_command({"/usr/bin/unshare", "-rm", "true"}, tmp_).exit_code != 0) {
+    GTEST_SKIP() << "unshare -rm is not permitted here (user namespaces are off)";
+  }
+  fs::create_directories(model_dir_);
+  daemon_.set_command_prefix({"/usr/bin/unshare", "-rm", "/bin/sh", "-c",
+                              "mount -t tmpfs -o size=128k tmpfs \"$0\" && exec \"$@\"", model_dir_.string()});
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, model_yaml()));
+  service::Client client = daemon_.connect();
+  ASSERT_EQ(call(client, ingest_mug()).status().code(), proto::Status::OK);
+  const auto saved = call(client, save_model());
+  std::printf("SaveModel on a 128 KiB tmpfs: %s: %s\n", service::to_string(saved.status().code()).c_str(),
+              saved.status().message().c_str());
+  EXPECT_EQ(saved.status().code(), proto::Status::IO_ERROR);
+  EXPECT_NE(saved.status().message().find("No space left on device"), std::string::npos) << saved.status().message();
+  // The tmpfs is seen through the daemon's own root (its mount namespace).
+  const fs::path seen = fs::path("/proc") / std::to_string(daemon_.pid()) / "root" / model_dir_.relative_path();
+  ASSERT_TRUE(fs::is_directory(seen)) << seen;
+  EXPECT_EQ(unfinished_snapshots(seen), std::vector<std::string>());
+  EXPECT_EQ(call(client, request([](proto::Request& r) { r.mutable_health(); })).status().code(), proto::Status::OK);
 }
 
 }  // namespace

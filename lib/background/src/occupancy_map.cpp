@@ -374,13 +374,15 @@ Status OccupancyMap::save(const fs::path& path) const {
   std::string ext = path.extension().string();
   if (ext != ".ot" && ext != ".bt") return invalid_argument(quoted(path) + ": map files end in .ot or .bt");
   return write_atomically(path, [&](const fs::path& tmp) -> Status {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) return io_error(quoted(tmp) + ": cannot open for writing");
-    bool ok = ext == ".ot" ? impl_->tree.write(out) : impl_->tree.writeBinaryConst(out);
-    out.flush();
-    ok = ok && static_cast<bool>(out);
-    if (!ok) return io_error(quoted(path) + ": writing the map failed");
-    return {};
+    return with_system_reason([&]() -> Status {
+      std::ofstream out(tmp, std::ios::binary);
+      if (!out) return io_error(quoted(tmp) + ": cannot open for writing");
+      bool ok = ext == ".ot" ? impl_->tree.write(out) : impl_->tree.writeBinaryConst(out);
+      out.flush();
+      ok = ok && static_cast<bool>(out);
+      if (!ok) return io_error(quoted(path) + ": writing the map failed");
+      return {};
+    });
   });
 }
 
