@@ -65,9 +65,9 @@ void raise_open_file_limit(const scenewatch::service::ServerConfig& server, Stde
     raised.rlim_cur = limit.rlim_max;
     if (::setrlimit(RLIMIT_NOFILE, &raised) == 0) limit = raised;
   }
-  // Each counted client, each connection of the live view, and as many again for connections
-  // being turned away or closed to make room, plus the daemon's own files.
-  const rlim_t wanted = 2 * (server.max_connections + 32) + 64;
+  // Each counted client, each stream and page request of the live view, and as many again for
+  // connections being turned away or closed to make room, plus the daemon's own files.
+  const rlim_t wanted = 2 * (server.max_connections + server.http_max_streams + 32) + 64;
   if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur < wanted) {
     log(LogLevel::kWarning, "open files limited to " + std::to_string(limit.rlim_cur) + ", below the " +
                                 std::to_string(wanted) + " that server.max_connections " +
@@ -236,6 +236,9 @@ int main(int argc, char** argv) {
     scenewatch::service::HttpServerConfig http_config;
     http_config.address = config.server.http_bind;
     http_config.port = config.server.http_port;
+    http_config.max_streams = config.server.http_max_streams;
+    http_config.heartbeat_s = config.server.http_heartbeat_s;
+    http_config.stream_timeout_s = config.server.http_stream_timeout_s;
     http = std::make_unique<scenewatch::service::HttpServer>(
         http_config, [view = live_view.get()](const scenewatch::service::HttpRequest& r) { return view->handle(r); },
         [&log](LogLevel level, const std::string& message) { log(level, message); });
