@@ -16,6 +16,7 @@
 
 #include "bulk_update.h"
 #include "frame_trace.h"
+#include "octree_file_check.h"
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/core/files.h"
 #include "scenewatch/core/hash.h"
@@ -388,6 +389,7 @@ Status OccupancyMap::save(const fs::path& path) const {
 
 Status OccupancyMap::load(const fs::path& path) {
   if (auto st = check_readable_file(path); !st) return st;
+  if (auto st = check_octree_file(path); !st) return st;  // before OctoMap's unbounded recursion
   const std::string ext = path.extension().string();
   auto loaded = std::make_unique<Impl>(config_);
   if (ext == ".bt") {
