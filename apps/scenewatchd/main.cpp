@@ -174,7 +174,7 @@ int main(int argc, char** argv) {
     }
   }
   if (!model.empty()) {
-    if (auto s = memory.load_newest_good(model); s) {
+    if (auto s = scenewatch::service::load_newest_good(memory, model); s) {
       for (const auto& refused : s->refused) log(LogLevel::kError, "refused a damaged snapshot: " + refused);
       log(s->refused.empty() ? LogLevel::kInfo : LogLevel::kWarning,
           "loaded the model from " + s->folder.string() + " (" + std::to_string(memory.snapshot()->objects.size()) +

@@ -5,8 +5,11 @@
 
 #include <signal.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <fstream>
+#include <iterator>
 #include <thread>
 
 #include "daemon_harness.h"
@@ -124,6 +127,50 @@ TEST_F(ModelDirTest, UnfinishedSnapshotsAreRemovedAtStartUp) {
   EXPECT_EQ(call(client, request([](proto::Request& r) { r.mutable_health(); })).health().frames_processed(), 3u);
   EXPECT_EQ(call(client, save_model()).status().code(), proto::Status::OK);
   EXPECT_EQ(fs::read_symlink(model_dir_ / "current").string().rfind("snap-", 0), 0u);
+}
+
+// A snapshot the pipeline's loader throws on instead of refusing it (a scene.json with its
+// "background" record an array; found by fuzz_model_loader, kept in fuzz/regressions/): the
+// daemon stops its start-up with an error naming the model directory, as for any model that does
+// not load, instead of terminating on the exception (exit 134 before).
+TEST_F(ModelDirTest, ASnapshotTheLoaderThrowsOnStopsTheStartUpWithAnError) {
+  std::ifstream found(source_dir() / "fuzz/regressions/fuzz_model_loader/background_record_array", std::ios::binary);
+  const std::string input((std::istreambuf_iterator<char>(found)), std::istreambuf_iterator<char>());
+  const char* const names[] = {"scene.json", "background.ot", "events.jsonl", "keyframes/keyframe-000001.color.png",
+                               "keyframes/keyframe-000001.depth.png", "keyframes/keyframe-000001.pose.txt",
+                               "keyframes/keyframe-000001.intrinsics.txt"};
+  const fs::path snapshot = model_dir_ / "snap-000001";
+  fs::create_directories(snapshot / "keyframes");
+  fs::create_directory_symlink("snap-000001", model_dir_ / "current");
+  std::size_t from = 0;
+  for (const char* name : names) {
+    const std::size_t to = std::min(input.find("\n--8<--\n", from), input.size());
+    std::ofstream(snapshot / name, std::ios::binary) << input.substr(from, to - from);
+    from = to + 8;
+  }
+  const auto started = run_command({daemon_binary().string(), "--port", "0", "--model-dir", model_dir_.string(),
+                                    "--token-file", (tmp_ / "token").string()},
+                                   tmp_, 30.0);
+  EXPECT_EQ(started.exit_code, 1) << started.err;
+  EXPECT_NE(started.err.find("the model's loader failed on it"), std::string::npos) << started.err;
+  EXPECT_NE(started.err.find("repair or move the directory"), std::string::npos) << started.err;
+}
+
+// LoadModel of a snapshot whose scene.json is not JSON and holds bytes that are not UTF-8 (found by
+// fuzz_model_loader): the parser's message quotes them, and a Response whose status message is
+// not UTF-8 cannot be parsed by the client (protobuf refuses it), so the client saw a broken
+// connection instead of the refusal. The message is now made UTF-8 ('?' for such bytes).
+TEST_F(ModelDirTest, ARefusalQuotingBytesThatAreNotUtf8ReachesTheClient) {
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, model_yaml()));
+  fs::create_directories(model_dir_ / "snap-000001");
+  std::ofstream(model_dir_ / "snap-000001" / "scene.json", std::ios::binary) << "{\n  \"b\xea\xff\": t_id\": 1\n}";
+  fs::create_directory_symlink("snap-000001", model_dir_ / "current");
+  service::Client client = daemon_.connect();
+  auto reply = client.call(request([](proto::Request& r) { r.mutable_load_model(); }), kCallTimeoutS);
+  ASSERT_TRUE(reply.ok()) << reply.error().message;
+  EXPECT_EQ(reply->status().code(), proto::Status::INVALID_ARGUMENT);
+  EXPECT_NE(reply->status().message().find("scene.json"), std::string::npos) << reply->status().message();
+  EXPECT_EQ(call(client, request([](proto::Request& r) { r.mutable_health(); })).status().code(), proto::Status::OK);
 }
 
 // A model directory on a file system that is full: the save fails with the system's reason, and

@@ -3,6 +3,8 @@
 // part-way, or one that failed after its folder was made, leaves them; nothing else removes them.
 #include "scenewatch/service/model_directory.h"
 
+#include <exception>
+
 #include "scenewatch/pipeline/working_memory.h"
 
 namespace scenewatch::service {
@@ -28,6 +30,14 @@ std::vector<std::string> remove_unfinished_snapshots(const fs::path& model_dir) 
     if (!remove_ec) removed.push_back(name);
   }
   return removed;
+}
+
+Result<pipeline::LoadedSnapshot> load_newest_good(pipeline::WorkingMemory& memory, const fs::path& model_dir) {
+  try {
+    return memory.load_newest_good(model_dir);
+  } catch (const std::exception& e) {
+    return invalid_argument("'" + model_dir.string() + "': the model's loader failed on it: " + e.what());
+  }
 }
 
 Status save_model(const pipeline::WorkingMemory& memory, const fs::path& model_dir, std::size_t keep_snapshots) {

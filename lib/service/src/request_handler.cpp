@@ -95,7 +95,7 @@ Reply error_reply(std::uint64_t id, proto::Status::Code code, const std::string&
   proto::Response response;
   response.set_id(id);
   response.mutable_status()->set_code(code);
-  response.mutable_status()->set_message(message);
+  response.mutable_status()->set_message(convert::valid_utf8(message));
   return finish(response, std::move(call));
 }
 
@@ -182,7 +182,7 @@ struct RequestHandler::Impl {
       response.clear_result();
       const Error& e = status.error();
       response.mutable_status()->set_code(convert::to_proto(e.code));
-      response.mutable_status()->set_message(call + ": " + e.message);
+      response.mutable_status()->set_message(convert::valid_utf8(call + ": " + e.message));
     }
     return finish(response, std::move(call));
   }

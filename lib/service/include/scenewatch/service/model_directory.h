@@ -9,10 +9,7 @@
 #include <vector>
 
 #include "scenewatch/core/result.h"
-
-namespace scenewatch::pipeline {
-class WorkingMemory;
-}  // namespace scenewatch::pipeline
+#include "scenewatch/pipeline/working_memory.h"
 
 namespace scenewatch::service {
 
@@ -44,6 +41,14 @@ class ModelDirLock {
 /// current.tmp link); returns their names. Only for the holder of the directory's lock: another
 /// daemon's save in progress looks the same.
 std::vector<std::string> remove_unfinished_snapshots(const std::filesystem::path& model_dir);
+
+/// WorkingMemory::load_newest_good, for the start-up. The loader reports a damaged snapshot as an
+/// error and goes on to an older one; where it throws instead (a scene.json whose "background"
+/// record is not an object, found by fuzz_model_loader: nlohmann's value() throws on an array),
+/// the start-up ends with that error as for a model that does not load, rather than the daemon
+/// terminating. The memory is unchanged then (the loader builds everything aside first).
+Result<pipeline::LoadedSnapshot> load_newest_good(pipeline::WorkingMemory& memory,
+                                                  const std::filesystem::path& model_dir);
 
 /// WorkingMemory::save, and when it fails, remove_unfinished_snapshots(): a failed save leaves
 /// the model directory as it was.
