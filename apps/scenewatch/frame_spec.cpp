@@ -78,23 +78,34 @@ io::SequenceOptions sequence_options(const std::optional<double>& depth_scale_m)
 }
 
 Result<std::size_t> count_frames(const std::string& spec, const io::SequenceOptions& sequence) {
+  auto span = sequence_span(spec, sequence);
+  if (!span) return span.error();
+  return *span ? (*span)->last - (*span)->first + 1 : std::size_t{1};
+}
+
+Result<std::optional<SequenceSpan>> sequence_span(const std::string& spec, const io::SequenceOptions& sequence) {
   auto p = parse(spec);
   if (!p) return p.error();
-  if (!p->sequence) return std::size_t{1};
+  if (!p->sequence) return std::optional<SequenceSpan>();
   auto seq = io::open_sequence(p->path, sequence);
   if (!seq) return seq.error();
   if (auto st = resolve_name(*p, *seq, spec); !st) return st.error();
   const std::size_t n = seq->frames.size();
   if (p->first >= n) return invalid_argument("'" + spec + "': the sequence has " + std::to_string(n) + " frames");
-  return std::min(p->last, n - 1) - p->first + 1;
+  SequenceSpan span;
+  span.folder = p->path;
+  span.sequence = std::move(*seq);
+  span.first = p->first;
+  span.last = std::min(p->last, n - 1);
+  return std::optional<SequenceSpan>(std::move(span));
 }
 
 Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& intrinsics,
                       const std::function<Status(Frame)>& each, const io::SequenceOptions& sequence) {
-  auto p = parse(spec);
-  if (!p) return p.error();
-  if (!p->sequence) {
-    auto frame = io::load_cloud_frame(p->path);
+  auto span = sequence_span(spec, sequence);
+  if (!span) return span.error();
+  if (!*span) {
+    auto frame = io::load_cloud_frame(spec);
     if (!frame) return frame.error();
     if (intrinsics) {
       frame->intrinsics = *intrinsics;
@@ -106,16 +117,12 @@ Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& 
     }
     return each(std::move(*frame));
   }
-  auto seq = io::open_sequence(p->path, sequence);
-  if (!seq) return seq.error();
-  if (auto skipped = io::skipped_summary(*seq, sequence); !skipped.empty()) {
-    std::cerr << "scenewatch: " << p->path << ": " << skipped << "\n";
+  const SequenceSpan& s = **span;
+  if (auto skipped = io::skipped_summary(s.sequence, sequence); !skipped.empty()) {
+    std::cerr << "scenewatch: " << s.folder << ": " << skipped << "\n";
   }
-  if (auto st = resolve_name(*p, *seq, spec); !st) return st.error();
-  const std::size_t n = seq->frames.size();
-  if (p->first >= n) return invalid_argument("'" + spec + "': the sequence has " + std::to_string(n) + " frames");
-  for (std::size_t i = p->first; i <= std::min(p->last, n - 1); ++i) {
-    auto frame = io::load_sequence_frame(*seq, i);
+  for (std::size_t i = s.first; i <= s.last; ++i) {
+    auto frame = io::load_sequence_frame(s.sequence, i);
     if (!frame) return frame.error();
     if (auto st = each(std::move(*frame)); !st) return st;
   }

@@ -30,6 +30,17 @@ Status for_each_frame(const std::string& spec, const std::optional<Intrinsics>& 
 /// that shows how to name one.
 Result<Frame> load_one_frame(const std::string& spec, const io::SequenceOptions& sequence = {});
 
+/// The frames of a sequence folder a spec names: the opened sequence and the indices first..last
+/// (inclusive, within the sequence).
+struct SequenceSpan {
+  std::string folder;
+  io::Sequence sequence;
+  std::size_t first = 0, last = 0;
+};
+/// The sequence frames `spec` names (SEQDIR, SEQDIR:N, SEQDIR:A-B, SEQDIR/frame-NNNNNN); nothing
+/// when it names a cloud file; an error naming the spec when it names neither.
+Result<std::optional<SequenceSpan>> sequence_span(const std::string& spec, const io::SequenceOptions& sequence = {});
+
 /// The SequenceOptions of a command's --depth-scale (unset: the folder's or the layout's unit).
 io::SequenceOptions sequence_options(const std::optional<double>& depth_scale_m);
 

@@ -230,31 +230,33 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       if (!send(std::move(request), path, nullptr)) return kExitError;
       continue;
     }
-    if (io::is_sequence_dir(path)) {
-      const io::SequenceOptions sequence_options = cli::sequence_options(depth_scale_m);
-      auto sequence = io::open_sequence(path, sequence_options);
-      if (!sequence) {
-        fail(naming(path, sequence.error().message));
-        ++failures;
-        continue;
-      }
-      if (auto skipped = io::skipped_summary(*sequence, sequence_options); !skipped.empty()) {
-        std::cerr << "scenewatch: " << path << ": " << skipped << "\n";
+    // A sequence folder, or some of its frames (SEQDIR:N, SEQDIR:A-B, SEQDIR/frame-NNNNNN).
+    const io::SequenceOptions sequence_options = cli::sequence_options(depth_scale_m);
+    auto span = cli::sequence_span(path, sequence_options);
+    if (!span) {
+      fail(naming(path, span.error().message));
+      ++failures;
+      continue;
+    }
+    if (*span) {
+      const cli::SequenceSpan& seq = **span;
+      if (auto skipped = io::skipped_summary(seq.sequence, sequence_options); !skipped.empty()) {
+        std::cerr << "scenewatch: " << seq.folder << ": " << skipped << "\n";
       }
       // Two frames in flight: the next frame is read from disk, sent and decoded by the daemon
       // while the one before it is processed; the answers come in the order sent.
       ProgressBar bar(show_progress);
-      const std::size_t total = sequence->frames.size();
+      const std::size_t total = seq.last - seq.first + 1;
       std::deque<std::pair<std::uint64_t, std::string>> in_flight;  // request id, source
       auto answer_oldest = [&] {
         const auto [id, source] = in_flight.front();
         in_flight.pop_front();
         return take(client->wait_for(id, options.timeout_s), source, &bar);
       };
-      for (std::size_t i = 0; i < total; ++i) {
-        const std::string source = (fs::path(path) / sequence->frames[i].name).string();
-        bar.draw(i, total, sequence->frames[i].name);
-        auto frame = io::load_sequence_frame(*sequence, i);
+      for (std::size_t i = seq.first; i <= seq.last; ++i) {
+        const std::string source = (fs::path(seq.folder) / seq.sequence.frames[i].name).string();
+        bar.draw(i - seq.first, total, seq.sequence.frames[i].name);
+        auto frame = io::load_sequence_frame(seq.sequence, i);
         if (!frame) {
           bar.clear();
           fail(naming(source, frame.error().message));
@@ -320,13 +322,14 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
   };
   const auto start = std::chrono::steady_clock::now();
   for (const std::string& path : paths) {
-    const io::SequenceOptions sequence_options = cli::sequence_options(depth_scale_m);
-    auto sequence = io::open_sequence(path, sequence_options);
-    if (!sequence) return fail(naming(path, sequence.error().message + " (--live takes RGB-D sequence folders)"));
-    for (std::size_t i = 0; i < sequence->frames.size(); ++i) {
-      auto frame = io::load_sequence_frame(*sequence, i);
+    auto span = cli::sequence_span(path, cli::sequence_options(depth_scale_m));
+    if (!span) return fail(naming(path, span.error().message + " (--live takes RGB-D sequence folders)"));
+    if (!*span) return fail(naming(path, "not a sequence folder (--live takes RGB-D sequence folders)"));
+    const cli::SequenceSpan& seq = **span;
+    for (std::size_t i = seq.first; i <= seq.last; ++i) {
+      auto frame = io::load_sequence_frame(seq.sequence, i);
       if (!frame) {
-        fail(naming((fs::path(path) / sequence->frames[i].name).string(), frame.error().message));
+        fail(naming((fs::path(seq.folder) / seq.sequence.frames[i].name).string(), frame.error().message));
         ++failures;
         continue;
       }
@@ -337,7 +340,7 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
       request.mutable_ingest_frame()->set_live(true);
       request.set_token(client->token());
       request.set_id(++sent);
-      sources.push_back((fs::path(path) / sequence->frames[i].name).string());
+      sources.push_back((fs::path(seq.folder) / seq.sequence.frames[i].name).string());
       if (auto st = client->send(request); !st) return fail(st.error().message);
       while (answered < sent && take_reply(0.001)) {
       }

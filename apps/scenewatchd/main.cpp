@@ -2,6 +2,8 @@
 // over TCP, keeps the working memory of the scene, and persists it in the model directory.
 #include <CLI/CLI.hpp>
 
+#include <sys/resource.h>
+
 #include <chrono>
 #include <csignal>
 #include <ctime>
@@ -18,6 +20,7 @@
 #include "scenewatch/service/http_server.h"
 #include "scenewatch/service/live_view.h"
 #include "scenewatch/service/log.h"
+#include "scenewatch/service/model_directory.h"
 #include "scenewatch/service/server.h"
 #include "scenewatch/core/memory.h"
 
@@ -50,6 +53,27 @@ class StderrLog {
   LogLevel min_level_;
   std::mutex mutex_;
 };
+
+/// Raises the soft limit of open files to the hard one: every client holds a socket, and a burst
+/// of newcomers (each answered, then closed) briefly holds more; at the usual soft limit of 1024,
+/// accept() would fail while they go. Says so when even the hard limit is tight.
+void raise_open_file_limit(const scenewatch::service::ServerConfig& server, StderrLog& log) {
+  rlimit limit{};
+  if (::getrlimit(RLIMIT_NOFILE, &limit) != 0) return;
+  if (limit.rlim_cur < limit.rlim_max) {
+    rlimit raised = limit;
+    raised.rlim_cur = limit.rlim_max;
+    if (::setrlimit(RLIMIT_NOFILE, &raised) == 0) limit = raised;
+  }
+  // Each counted client, each stream and page request of the live view, and as many again for
+  // connections being turned away or closed to make room, plus the daemon's own files.
+  const rlim_t wanted = 2 * (server.max_connections + server.http_max_streams + 32) + 64;
+  if (limit.rlim_cur != RLIM_INFINITY && limit.rlim_cur < wanted) {
+    log(LogLevel::kWarning, "open files limited to " + std::to_string(limit.rlim_cur) + ", below the " +
+                                std::to_string(wanted) + " that server.max_connections " +
+                                std::to_string(server.max_connections) + " can use in a burst (raise ulimit -n)");
+  }
+}
 
 }  // namespace
 
@@ -131,10 +155,26 @@ int main(int argc, char** argv) {
   config.server.access_token = std::move(*token);
   log(LogLevel::kInfo, "calls that change the model need the token in " + config.server.token_file.string());
 
+  raise_open_file_limit(config.server, log);
+
   scenewatch::pipeline::WorkingMemory memory(config.pipeline);
   const std::filesystem::path& model = config.server.model_dir;
+  // One daemon per model directory, held until this process ends; then what killed or failed
+  // saves left behind goes, before anything is loaded.
+  std::optional<scenewatch::service::ModelDirLock> model_lock;
   if (!model.empty()) {
-    if (auto s = memory.load_newest_good(model); s) {
+    auto locked = scenewatch::service::ModelDirLock::acquire(model);
+    if (!locked) {
+      log(LogLevel::kError, "model directory: " + locked.error().message);
+      return 1;
+    }
+    model_lock = std::move(*locked);
+    for (const auto& name : scenewatch::service::remove_unfinished_snapshots(model)) {
+      log(LogLevel::kWarning, "removed " + (model / name).string() + ", left behind by a save that did not finish");
+    }
+  }
+  if (!model.empty()) {
+    if (auto s = scenewatch::service::load_newest_good(memory, model); s) {
       for (const auto& refused : s->refused) log(LogLevel::kError, "refused a damaged snapshot: " + refused);
       log(s->refused.empty() ? LogLevel::kInfo : LogLevel::kWarning,
           "loaded the model from " + s->folder.string() + " (" + std::to_string(memory.snapshot()->objects.size()) +
@@ -196,6 +236,9 @@ int main(int argc, char** argv) {
     scenewatch::service::HttpServerConfig http_config;
     http_config.address = config.server.http_bind;
     http_config.port = config.server.http_port;
+    http_config.max_streams = config.server.http_max_streams;
+    http_config.heartbeat_s = config.server.http_heartbeat_s;
+    http_config.stream_timeout_s = config.server.http_stream_timeout_s;
     http = std::make_unique<scenewatch::service::HttpServer>(
         http_config, [view = live_view.get()](const scenewatch::service::HttpRequest& r) { return view->handle(r); },
         [&log](LogLevel level, const std::string& message) { log(level, message); });
@@ -221,7 +264,7 @@ int main(int argc, char** argv) {
 
   int rc = 0;
   if (!model.empty()) {
-    if (auto s = memory.save(model, config.server.keep_snapshots); s) {
+    if (auto s = scenewatch::service::save_model(memory, model, config.server.keep_snapshots); s) {
       log(LogLevel::kInfo, "saved the model to " + model.string());
     } else {
       log(LogLevel::kError, "cannot save the model to " + model.string() + ": " + s.error().message);

@@ -5,8 +5,11 @@
 
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <set>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/core/frame.h"
@@ -206,6 +209,43 @@ TEST(OccupancyMap, SaveLoadOtAndBt) {
   OccupancyMap from_plain(at(0.02));
   ASSERT_TRUE(from_plain.load(dir / "plain.ot").ok());
   EXPECT_EQ(from_plain.query({1, 1, 1}), Occupancy::kOccupied);
+}
+
+// Damaged maps: OctoMap reads nodes recursively, following child flags without a depth limit or
+// an end-of-file check, so a flipped flag or a cut recursed until the stack overflowed, ending
+// the daemon while it loaded its model (fuzz_model_loader; the input is kept in
+// fuzz/regressions/fuzz_model_loader/). Such files are refused, and the map is left as it was.
+TEST(OccupancyMap, DamagedMapFilesAreRefusedBeforeOctomapRecursesIntoThem) {
+  const test::TempDir dir("bg");
+  const std::string header = "# Octomap OcTree file\nid ColorOcTree\nsize 3\nres 0.02\ndata\n";
+  std::string deep = header;
+  for (int level = 0; level < 40; ++level) deep += std::string(7, '\0') + '\x01';  // always one child
+  std::ofstream(dir / "deep.ot", std::ios::binary) << deep;
+  std::ofstream(dir / "cut.ot", std::ios::binary) << header + std::string(7, '\0') + '\xff' + std::string(5, '\0');
+  std::ofstream(dir / "stamped.ot", std::ios::binary) << "# Octomap OcTree file\nid OcTreeStamped\nsize 1\nres 0.02\ndata\n";
+  std::ofstream(dir / "no_res.ot", std::ios::binary) << "# Octomap OcTree file\nid OcTree\nsize 1\nres -1\ndata\n";
+  std::ofstream(dir / "deep.bt", std::ios::binary)
+      << "# Octomap OcTree binary file\nid OcTree\nsize 3\nres 0.02\ndata\n" + std::string(60, '\xff');
+  // The fuzzer's input: a saved model whose map had one byte changed (its size still agrees with
+  // scene.json's record), the map being the second part.
+  std::ifstream found(fs::path(SCENEWATCH_SOURCE_DIR) / "fuzz/regressions/fuzz_model_loader/deep_map_flags",
+                      std::ios::binary);
+  const std::string input((std::istreambuf_iterator<char>(found)), std::istreambuf_iterator<char>());
+  const std::size_t from = input.find("\n--8<--\n") + 8;
+  std::ofstream(dir / "fuzzed.ot", std::ios::binary) << input.substr(from, input.find("\n--8<--\n", from) - from);
+  OccupancyMap map(at(0.02));
+  map.insert(wall(), Pose::Identity());
+  const auto leaves = map.num_leaf_nodes();
+  for (const auto& [name, why] : std::vector<std::pair<std::string, std::string>>{
+           {"deep.ot", "deeper than an octree's 16 levels"}, {"cut.ot", "cut short"},
+           {"stamped.ot", "holds a OcTreeStamped"}, {"no_res.ot", "header is incomplete or invalid"},
+           {"deep.bt", "deeper than an octree's 16 levels"}, {"fuzzed.ot", "damaged"}}) {
+    const Status st = map.load(dir / name);
+    ASSERT_FALSE(st.ok()) << name;
+    EXPECT_EQ(st.error().code, ErrorCode::kInvalidArgument) << name;
+    EXPECT_NE(st.error().message.find(why), std::string::npos) << name << ": " << st.error().message;
+    EXPECT_EQ(map.num_leaf_nodes(), leaves) << name;
+  }
 }
 
 TEST(OccupancyMap, ResetAndValidate) {

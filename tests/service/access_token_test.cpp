@@ -83,6 +83,34 @@ TEST_F(AccessTokenTest, RefusesFilesOthersMayReadOrThatAreNotTokens) {
   EXPECT_NE(r.error().message.find("not a regular file"), std::string::npos) << r.error().message;
 }
 
+// In a folder every user may write to, anyone can rename the token file away and put their own in
+// its place (the daemon would then accept their token): refused, unless the folder has the sticky
+// bit (as /tmp has), which lets only a file's owner rename or remove it.
+TEST_F(AccessTokenTest, RefusesATokenInAFolderEveryoneMayWriteWithoutTheStickyBit) {
+  const fs::path shared = tmp_ / "shared";
+  fs::create_directories(shared);
+  const fs::path path = shared / "token";
+  auto made = ensure_token_file(path);
+  ASSERT_TRUE(made.ok()) << made.error().message;
+  fs::permissions(shared, fs::perms::all, fs::perm_options::replace);  // 0777
+  for (auto* const reader : {&ensure_token_file, &read_token_file}) {
+    auto r = reader(path);
+    ASSERT_FALSE(r.ok()) << "a token anyone could have swapped in is accepted";
+    EXPECT_EQ(r.error().code, ErrorCode::kPermissionDenied);
+    EXPECT_NE(r.error().message.find(shared.string()), std::string::npos) << r.error().message;
+    EXPECT_NE(r.error().message.find("sticky"), std::string::npos) << r.error().message;
+  }
+  auto fresh = ensure_token_file(shared / "fresh");
+  EXPECT_FALSE(fresh.ok()) << "nor is one created there";
+  EXPECT_FALSE(fs::exists(shared / "fresh"));
+
+  fs::permissions(shared, fs::perms::all | fs::perms::sticky_bit, fs::perm_options::replace);  // 1777, as /tmp
+  auto sticky = read_token_file(path);
+  ASSERT_TRUE(sticky.ok()) << sticky.error().message;
+  EXPECT_EQ(*sticky, *made);
+  fs::permissions(shared, fs::perms::owner_all, fs::perm_options::replace);
+}
+
 TEST_F(AccessTokenTest, TokensEqualOnlyWhenIdentical) {
   const std::string token = "0123456789abcdef0123456789abcdef";
   EXPECT_TRUE(tokens_equal(token, token));

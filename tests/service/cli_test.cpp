@@ -422,6 +422,40 @@ TEST_F(CliTest, ReplayTellsTheStreamAndCountsIt) {
   EXPECT_EQ(result.exit_code, 2) << "usage error";
 }
 
+// `ingest` takes the frame forms every other command takes (README, "Frames on the command line"):
+// SEQDIR:N, SEQDIR:A-B and SEQDIR/frame-NNNNNN, not only whole folders and cloud files.
+TEST_F(CliTest, IngestTakesOneFrameOrARangeOfASequence) {
+  const fs::path sample = source_dir() / "sample_clouds/tabletop";
+  const fs::path seq = tmp_ / "seq";
+  fs::create_directories(seq);
+  fs::copy_file(sample / "camera-intrinsics.txt", seq / "camera-intrinsics.txt");
+  for (const char* frame : {"frame-000000", "frame-000001", "frame-000002"}) {
+    for (const char* part : {".color.png", ".depth.png", ".pose.txt"}) {
+      fs::copy_file(sample / (std::string("frame-000000") + part), seq / (std::string(frame) + part));
+    }
+  }
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "segmentation:\n  up_vector: [0, 0, 1]\n"));
+  auto frames_processed = [&] { return parse(remote({"stats", "--json"}).out).at("frames_processed").get<int>(); };
+
+  auto result = remote({"ingest", seq.string() + ":1", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(parse(result.out).at("source"), (seq / "frame-000001").string());
+  EXPECT_EQ(frames_processed(), 1);
+
+  result = remote({"ingest", seq.string() + ":1-2"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(frames_processed(), 3);
+
+  result = remote({"ingest", (seq / "frame-000002").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(frames_processed(), 4);
+
+  result = remote({"ingest", seq.string() + ":7"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("the sequence has 3 frames"), std::string::npos) << result.err;
+  EXPECT_EQ(frames_processed(), 4);
+}
+
 TEST_F(CliTest, TumFoldersAndDepthScalesWhereverSequencesAreRead) {
   // The sample frame three ways: as shipped (depth in mm), as a TUM RGB-D folder (depth in
   // 1/5000 m, stamps in lists, pose in groundtruth.txt, one colour image without depth), and in

@@ -34,7 +34,8 @@ class Daemon {
     const auto config = work_dir / ("scenewatchd-" + std::to_string(++starts_) + ".yaml");
     std::ofstream(config) << "server:\n  address: 127.0.0.1\n  port: 0\n"
                           << (token_file_.empty() ? "" : "  token_file: " + token_file_.string() + "\n") << server_yaml;
-    std::vector<std::string> argv{daemon_binary().string(), "--config", config.string(), "--port", "0"};
+    std::vector<std::string> argv = command_prefix_;
+    argv.insert(argv.end(), {daemon_binary().string(), "--config", config.string(), "--port", "0"});
     argv.insert(argv.end(), extra_args.begin(), extra_args.end());
     auto child = ChildProcess::start(argv, work_dir / ("scenewatchd-" + std::to_string(starts_) + ".log"));
     ASSERT_TRUE(child.has_value()) << "cannot start " << daemon_binary();
@@ -51,6 +52,9 @@ class Daemon {
       token_ = *token;
     }
   }
+
+  /// Runs the daemon through a command that execs its arguments (`unshare -rm ...`); set before start().
+  void set_command_prefix(std::vector<std::string> prefix) { command_prefix_ = std::move(prefix); }
 
   /// SIGTERM, then waits; returns the exit code (nothing if it did not exit).
   std::optional<int> terminate() {
@@ -100,6 +104,7 @@ class Daemon {
   std::filesystem::path token_file_;
   std::string token_;
   int starts_ = 0;
+  std::vector<std::string> command_prefix_;
 };
 
 /// Makes one call; a transport error fails the test and yields an empty Response.

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -132,6 +133,57 @@ TEST(FrameParserTest, FramesBeforeABrokenHeaderAreStillDelivered) {
   auto frame = parser.next();
   ASSERT_TRUE(frame.has_value());
   EXPECT_EQ(*frame, "good");
+}
+
+// The budget counts what is reserved, step by step, before it is reserved: a frame announced and
+// dripped holds its first 64 KiB step, a growing frame doubles its step (the growth is booked: the
+// pages move, nothing is copied). Completed and dropped frames give their share back.
+TEST(FrameParserTest, TheBudgetCountsEachBufferStepBeforeItIsReserved) {
+  auto budget = std::make_shared<FrameBudget>(300 * 1024);
+  FrameParser parser(1u << 20, budget);
+  const std::string header("\x00\x10\x00\x00", 4);  // 1 MiB announced
+  ASSERT_TRUE(parser.feed(header + "x").ok());
+  EXPECT_EQ(budget->reserved(), 64u * 1024) << "the first step";
+  EXPECT_EQ(parser.reserved_bytes(), 64u * 1024);
+  ASSERT_TRUE(parser.feed(std::string(64 * 1024, 'x')).ok());  // 64 KiB + 1 received
+  EXPECT_EQ(budget->reserved(), 128u * 1024) << "doubled";
+
+  // A second parser on the same budget takes 100 KiB at once (a step is at least what the bytes
+  // need); then the first cannot grow: its next step, to 256 KiB, needs 128 KiB more beside its
+  // 128 KiB and the other's 100 KiB.
+  FrameParser other(1u << 20, budget);
+  ASSERT_TRUE(other.feed(header + std::string(100 * 1024, 'y')).ok());
+  EXPECT_EQ(budget->reserved(), 128u * 1024 + 100u * 1024);
+  const Status refused = parser.feed(std::string(64 * 1024, 'x'));
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().code, ErrorCode::kUnavailable);
+  EXPECT_NE(refused.error().message.find("307200 bytes"), std::string::npos) << refused.error().message;
+  EXPECT_TRUE(parser.failed());
+  EXPECT_EQ(budget->reserved(), 100u * 1024) << "the refused frame's share is given back";
+  EXPECT_EQ(other.drop_partial(), 100u * 1024);
+  EXPECT_EQ(budget->reserved(), 0u);
+}
+
+TEST(FrameParserTest, ACompleteFrameLeavesTheBudgetAndAMovedParserKeepsItsShare) {
+  auto budget = std::make_shared<FrameBudget>(1u << 20);
+  FrameParser parser(1u << 20, budget);
+  const std::string payload(200 * 1024, 'p');
+  const std::string frame = encode_frame(payload);
+  ASSERT_TRUE(parser.feed(std::string_view(frame).substr(0, 1000)).ok());
+  EXPECT_GT(budget->reserved(), 0u);
+  FrameParser moved = std::move(parser);
+  EXPECT_EQ(budget->reserved(), moved.reserved_bytes());
+  ASSERT_TRUE(moved.feed(std::string_view(frame).substr(1000)).ok());
+  EXPECT_EQ(budget->reserved(), 0u) << "a complete frame is no longer an unfinished one";
+  auto out = moved.next();
+  ASSERT_TRUE(out.has_value());
+  EXPECT_EQ(*out, payload);
+  {
+    FrameParser gone(1u << 20, budget);
+    ASSERT_TRUE(gone.feed(std::string_view(frame).substr(0, 5000)).ok());
+    EXPECT_GT(budget->reserved(), 0u);
+  }
+  EXPECT_EQ(budget->reserved(), 0u) << "a parser that goes gives its share back";
 }
 
 }  // namespace

@@ -15,12 +15,15 @@
 #include <filesystem>
 #include <chrono>
 #include <future>
+#include <memory>
+#include <mutex>
 #include <thread>
 #include <string>
 
 #include "daemon_harness.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/service/http_request.h"
+#include "scenewatch/service/http_server.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"
 
@@ -132,9 +135,11 @@ class LiveViewTest : public ::testing::Test {
     fs::remove_all(tmp_, ec);
   }
 
-  /// Starts scenewatchd with `--http 0` and reads the live view's port from its second line.
-  void start() {
-    ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "segmentation:\n  up_vector: [0, 0, 1]\n", {"--http", "0"}));
+  /// Starts scenewatchd with `--http 0` and reads the live view's port from its second line;
+  /// `server_yaml`: more lines of its server section.
+  void start(const std::string& server_yaml = "") {
+    ASSERT_NO_FATAL_FAILURE(
+        daemon_.start(tmp_, server_yaml + "segmentation:\n  up_vector: [0, 0, 1]\n", {"--http", "0"}));
     const auto line = daemon_.read_line();
     ASSERT_TRUE(line.has_value()) << "no 'live view on' line";
     const std::string prefix = "live view on http://127.0.0.1:";
@@ -193,6 +198,146 @@ TEST_F(LiveViewTest, BadRequestsGetAnErrorAndTheDaemonKeepsServing) {
   EXPECT_EQ(status_of(silent.get()), 408);
   ASSERT_NO_FATAL_FAILURE(expect_api_serves());
   ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
+}
+
+/// Connects to 127.0.0.1:port and sends `bytes`; the socket (-1 when that failed).
+int connect_and_send(std::uint16_t port, const std::string& bytes) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  if (fd < 0) return -1;
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_port = htons(port);
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  if (::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr) != 0 ||
+      ::send(fd, bytes.data(), bytes.size(), MSG_NOSIGNAL) != static_cast<ssize_t>(bytes.size())) {
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+/// What the server sent so far on `fd`, looked at without reading it (MSG_PEEK): the client stays
+/// one that has read nothing. Waits up to timeout_s for `wanted` to be there.
+std::string peek_until(int fd, const std::string& wanted, double timeout_s) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  std::string seen;
+  while (seen.find(wanted) == std::string::npos && std::chrono::steady_clock::now() < deadline) {
+    char buffer[4096];
+    const ssize_t n = ::recv(fd, buffer, sizeof buffer, MSG_PEEK | MSG_DONTWAIT);
+    if (n == 0) break;
+    if (n > 0) seen.assign(buffer, static_cast<std::size_t>(n));
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return seen;
+}
+
+// Event streams have slots of their own (server.http_max_streams): 32 clients that open a stream
+// and never read a byte of it do not take the slots page requests need.
+TEST_F(LiveViewTest, ThePageIsServedWhileThirtyTwoIdleStreamsAreOpen) {
+  ASSERT_NO_FATAL_FAILURE(start());
+  const std::string open_stream = "GET /api/events HTTP/1.1\r\nAccept: text/event-stream\r\n\r\n";
+  std::vector<int> streams;
+  for (int i = 0; i < 32; ++i) {
+    const int fd = connect_and_send(http_port_, open_stream);
+    ASSERT_GE(fd, 0);
+    streams.push_back(fd);
+  }
+  int streaming = 0;
+  for (const int fd : streams) streaming += peek_until(fd, "text/event-stream", 20.0).find("200 OK") != std::string::npos;
+  EXPECT_EQ(streaming, 32) << "each is a stream, unread";
+  const std::string page = get(http_port_, "/");
+  EXPECT_EQ(status_of(page), 200) << page.substr(0, 200);
+  EXPECT_EQ(status_of(get(http_port_, "/api/state?voxels=0")), 200);
+  EXPECT_EQ(status_of(get(http_port_, "/api/events?since=0")), 200);
+  const std::string one_more = raw_exchange(http_port_, open_stream);
+  EXPECT_EQ(status_of(one_more), 503) << one_more.substr(0, 300);
+  EXPECT_NE(one_more.find("server.http_max_streams"), std::string::npos) << one_more.substr(0, 300);
+  std::printf("32 idle event streams open: the page %d, a 33rd stream %d\n", status_of(page), status_of(one_more));
+  for (const int fd : streams) ::close(fd);
+  ASSERT_NO_FATAL_FAILURE(expect_api_serves());
+}
+
+std::string read_event_stream(std::uint16_t port, const std::string& wanted, double timeout_s);
+
+// A stream with nothing to say still carries a comment line every server.http_heartbeat_s, so
+// that a client (and every proxy between) sees it alive, and a peer that is gone is noticed.
+TEST_F(LiveViewTest, AQuietStreamCarriesAHeartbeat) {
+  ASSERT_NO_FATAL_FAILURE(start("  http_heartbeat_s: 0.5\n"));
+  const std::string streamed = read_event_stream(http_port_, "\n\n: heartbeat", 30.0);
+  EXPECT_EQ(streamed.rfind("HTTP/1.1 200 OK\r\n", 0), 0u) << streamed;
+  EXPECT_NE(streamed.find("\n\n: heartbeat"), std::string::npos) << streamed;
+  ASSERT_NO_FATAL_FAILURE(expect_api_serves());
+}
+
+// ---- streams of the HTTP server itself, whose handler here sends 3 MiB at once
+
+/// An HttpServer on a free loopback port whose /stream answer sends `bytes` bytes right away; the
+/// streams it opened are kept in `streams`.
+struct FloodServer {
+  explicit FloodServer(std::size_t bytes) {
+    service::HttpServerConfig config;
+    config.stream_timeout_s = 1.0;
+    config.heartbeat_s = 0.25;
+    server = std::make_unique<service::HttpServer>(config, [this, bytes](const service::HttpRequest&) {
+      service::HttpResponse r;
+      r.content_type = "text/event-stream";
+      r.heartbeat = ": heartbeat\n\n";
+      r.on_stream = [this, bytes](std::shared_ptr<service::HttpStream> stream) {
+        for (std::size_t sent = 0; sent < bytes; sent += 64 * 1024) stream->send(std::string(64 * 1024, 'x'));
+        std::lock_guard<std::mutex> lock(mutex);
+        streams.push_back(std::move(stream));
+      };
+      return r;
+    });
+    EXPECT_TRUE(server->listen().ok());
+    server->start();
+  }
+  /// Waits up to timeout_s for the first stream to be closed by the server; whether it was.
+  bool first_stream_closed(double timeout_s) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (std::chrono::steady_clock::now() < deadline) {
+      {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!streams.empty() && !streams.front()->open()) return true;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    return false;
+  }
+  std::mutex mutex;
+  std::vector<std::shared_ptr<service::HttpStream>> streams;
+  std::unique_ptr<service::HttpServer> server;
+};
+
+// A client that stops reading: once the socket buffers between are full, the server's bytes stop
+// moving, and after the stream timeout (1 s here; server.http_stream_timeout_s) the stream is
+// closed, though less than the 4 MiB that would close it as too slow is queued. A client that
+// reads takes the same 3 MiB, and its stream goes on.
+TEST(HttpServerStreams, AStreamWhoseClientReadsNothingIsClosedAfterTheTimeout) {
+  constexpr std::size_t kBytes = 3u << 20;
+  {
+    FloodServer flood(kBytes);
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    ASSERT_GE(fd, 0);
+    const int small = 4096;
+    ::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &small, sizeof small);  // before connect: a small window
+    sockaddr_in addr{};
+    addr.sin_family = AF_INET;
+    addr.sin_port = htons(flood.server->port());
+    addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    ASSERT_EQ(::connect(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+    const std::string request = "GET /stream HTTP/1.1\r\n\r\n";
+    ASSERT_EQ(::send(fd, request.data(), request.size(), MSG_NOSIGNAL), static_cast<ssize_t>(request.size()));
+    EXPECT_TRUE(flood.first_stream_closed(30.0)) << "a client that reads nothing holds its stream";
+    ::close(fd);
+  }
+  {
+    FloodServer flood(kBytes);
+    // The heartbeat follows once the 3 MiB are taken: the stream outlived them.
+    const std::string streamed = read_event_stream(flood.server->port(), ": heartbeat\n\n", 30.0);
+    EXPECT_GE(streamed.size(), kBytes) << "the reading client got it all";
+    EXPECT_NE(streamed.find(": heartbeat\n\n"), std::string::npos) << "and its stream stayed open";
+  }
 }
 
 // ---- the page in headless Chromium

@@ -1,17 +1,20 @@
 // Load: the real scenewatchd on loopback serving many well-behaved clients while frames are
 // ingested and hostile connections (idle, or dripping a frame one byte at a time) are held open.
 // No request of the well-behaved clients may be lost; p99 latency and the daemon's RSS are
-// printed, and the RSS is bounded.
+// printed, and the RSS is bounded. Then rounds of bursts: idle connections and half frames, with
+// the RSS before, at the peak and after each round.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdio>
 #include <mutex>
 #include <thread>
 #include <vector>
 
+#include "burst.h"
 #include "daemon_harness.h"
 #include "scenewatch/core/memory.h"
 #include "scenewatch.pb.h"
@@ -165,6 +168,54 @@ TEST(DaemonLoadTest, NoRequestLostUnderLoadWithHostileConnectionsHeld) {
   ASSERT_TRUE(alive.ok()) << alive.error().message;
   EXPECT_EQ(alive->status().code(), proto::Status::OK);
   if (HasFailure()) std::cerr << "---- scenewatchd log (tail) ----\n" << daemon.log().substr(daemon.log().size() > 4000 ? daemon.log().size() - 4000 : 0) << "\n";
+  std::error_code ec;
+  fs::remove_all(tmp, ec);
+}
+
+// Bursts a hostile client sends, round after round (issue 34 saw the same four times): 300 idle
+// connections opened at once, then 20 clients each sending half of a 30 MiB frame and vanishing.
+// Per round, the daemon's VmRSS before, at the peak and after: the peak within the unfinished
+// frames' budget (server.max_buffered_bytes, 256 MiB) plus an allowance for what else a burst costs
+// (sessions and their read buffers, the allocator's rounding), and after each round back within a
+// smaller allowance of where the run started: no round leaves memory behind for the next.
+constexpr int kRounds = 4;
+constexpr double kBurstBudgetMiB = 256;
+constexpr double kBurstPeakAllowanceMiB = 64;
+constexpr double kBurstAfterAllowanceMiB = 32;
+
+TEST(DaemonLoadTest, RoundsOfConnectionAndHalfFrameBurstsKeepMemoryBounded) {
+  const fs::path tmp = make_temp_dir("load-bursts");
+  Daemon daemon;
+  ASSERT_NO_FATAL_FAILURE(daemon.start(tmp, "  max_connections: 64\n"));
+  ASSERT_EQ(connections_now(daemon), 1u);
+  const double start_mib = resident_mib(daemon.pid());
+  for (int round = 1; round <= kRounds; ++round) {
+    const double before_mib = resident_mib(daemon.pid());
+    double peak_mib = before_mib;
+    std::uint32_t most_connections = 0;
+    {
+      RssSampler rss(daemon.pid());
+      std::vector<Client> idle = open_idle_connections(daemon, 300);
+      most_connections = connections_now(daemon);
+      idle.clear();
+      peak_mib = rss.stop();
+    }
+    ASSERT_EQ(wait_for_connections(daemon, 1), 1u) << "round " << round << ": the idle ones are gone";
+    const HalfFrames halves = send_half_frames_and_vanish(daemon, 20, 30u << 20);
+    ASSERT_EQ(wait_for_connections(daemon, 1), 1u) << "round " << round << ": the halves' clients are gone";
+    peak_mib = std::max(peak_mib, halves.peak_mib);
+    const double after_mib = resident_mib(daemon.pid());
+    std::printf("burst round %d: 300 idle connections (stats said %u, max_connections 64), 20 half frames of 30 MiB "
+                "(%d told busy); daemon VmRSS %.0f MiB before, %.0f MiB at the peak, %.0f MiB after (%.0f MiB at the "
+                "start of the run)\n",
+                round, most_connections, halves.busy, before_mib, peak_mib, after_mib, start_mib);
+    EXPECT_LE(most_connections, 64u) << "round " << round;
+    EXPECT_LE(peak_mib, start_mib + kBurstBudgetMiB + kBurstPeakAllowanceMiB) << "round " << round;
+    EXPECT_LE(after_mib, start_mib + kBurstAfterAllowanceMiB) << "round " << round;
+  }
+  service::Client probe = daemon.connect_without_token();
+  EXPECT_EQ(call(probe, request([](proto::Request& r) { r.mutable_health(); })).status().code(), proto::Status::OK);
+  if (HasFailure()) std::cerr << daemon.log().substr(daemon.log().size() > 4000 ? daemon.log().size() - 4000 : 0);
   std::error_code ec;
   fs::remove_all(tmp, ec);
 }

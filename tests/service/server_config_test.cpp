@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "test_data.h"
 
@@ -47,12 +50,36 @@ TEST_F(ServerConfigTest, ShippedConfigListsTheDefaults) {
   EXPECT_EQ(s.http_bind, defaults.http_bind);
   EXPECT_EQ(s.http_bind, "127.0.0.1");
   EXPECT_EQ(s.http_three_js, defaults.http_three_js);
+  EXPECT_EQ(s.http_max_streams, defaults.http_max_streams);
+  EXPECT_DOUBLE_EQ(s.http_heartbeat_s, defaults.http_heartbeat_s);
+  EXPECT_DOUBLE_EQ(s.http_stream_timeout_s, defaults.http_stream_timeout_s);
+  EXPECT_DOUBLE_EQ(loaded->pipeline.workspace_radius_m, pipeline::Config{}.workspace_radius_m);
   EXPECT_TRUE(loaded->ontology.classes_file.empty()) << "empty: the shipped config/ontology.yaml";
   const pipeline::Config pipeline_defaults;
   EXPECT_DOUBLE_EQ(loaded->pipeline.background.resolution_m, pipeline_defaults.background.resolution_m);
   EXPECT_DOUBLE_EQ(loaded->pipeline.segmentation.voxel_size_m, pipeline_defaults.segmentation.voxel_size_m);
   EXPECT_EQ(loaded->pipeline.segmentation.min_cluster_points, pipeline_defaults.segmentation.min_cluster_points);
   EXPECT_EQ(loaded->pipeline.max_event_log, pipeline_defaults.max_event_log);
+}
+
+TEST_F(ServerConfigTest, TheLiveViewsStreamKeysAndTheWorkspaceAreReadAndChecked) {
+  auto loaded = load_daemon_config(write("server:\n  http_max_streams: 4\n  http_heartbeat_s: 0.5\n"
+                                         "  http_stream_timeout_s: 5\nworkspace:\n  radius_m: 25\n"));
+  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+  EXPECT_EQ(loaded->server.http_max_streams, 4u);
+  EXPECT_DOUBLE_EQ(loaded->server.http_heartbeat_s, 0.5);
+  EXPECT_DOUBLE_EQ(loaded->server.http_stream_timeout_s, 5.0);
+  EXPECT_DOUBLE_EQ(loaded->pipeline.workspace_radius_m, 25.0);
+  for (const auto& [yaml, key] : std::vector<std::pair<std::string, std::string>>{
+           {"server:\n  http_max_streams: 0\n", "server.http_max_streams"},
+           {"server:\n  http_heartbeat_s: 0\n", "server.http_heartbeat_s"},
+           {"server:\n  http_stream_timeout_s: -1\n", "server.http_stream_timeout_s"},
+           {"workspace:\n  radius_m: -5\n", "workspace.radius_m"},
+           {"workspace:\n  radius: 5\n", "workspace.radius: unknown key"}}) {
+    auto bad = load_daemon_config(write(yaml));
+    ASSERT_FALSE(bad.ok()) << yaml;
+    EXPECT_NE(bad.error().message.find(key), std::string::npos) << bad.error().message;
+  }
 }
 
 TEST_F(ServerConfigTest, RelativePathsAreRelativeToTheConfigFile) {

@@ -16,6 +16,7 @@
 
 #include "bulk_update.h"
 #include "frame_trace.h"
+#include "octree_file_check.h"
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/core/files.h"
 #include "scenewatch/core/hash.h"
@@ -374,18 +375,21 @@ Status OccupancyMap::save(const fs::path& path) const {
   std::string ext = path.extension().string();
   if (ext != ".ot" && ext != ".bt") return invalid_argument(quoted(path) + ": map files end in .ot or .bt");
   return write_atomically(path, [&](const fs::path& tmp) -> Status {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) return io_error(quoted(tmp) + ": cannot open for writing");
-    bool ok = ext == ".ot" ? impl_->tree.write(out) : impl_->tree.writeBinaryConst(out);
-    out.flush();
-    ok = ok && static_cast<bool>(out);
-    if (!ok) return io_error(quoted(path) + ": writing the map failed");
-    return {};
+    return with_system_reason([&]() -> Status {
+      std::ofstream out(tmp, std::ios::binary);
+      if (!out) return io_error(quoted(tmp) + ": cannot open for writing");
+      bool ok = ext == ".ot" ? impl_->tree.write(out) : impl_->tree.writeBinaryConst(out);
+      out.flush();
+      ok = ok && static_cast<bool>(out);
+      if (!ok) return io_error(quoted(path) + ": writing the map failed");
+      return {};
+    });
   });
 }
 
 Status OccupancyMap::load(const fs::path& path) {
   if (auto st = check_readable_file(path); !st) return st;
+  if (auto st = check_octree_file(path); !st) return st;  // before OctoMap's unbounded recursion
   const std::string ext = path.extension().string();
   auto loaded = std::make_unique<Impl>(config_);
   if (ext == ".bt") {

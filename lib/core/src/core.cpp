@@ -1,15 +1,10 @@
 #include <cmath>
-#include <fstream>
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
 #include <sstream>
 #include <string>
 
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/geometry.h"
-#include "scenewatch/core/memory.h"
 #include "scenewatch/core/mesh.h"
 #include "scenewatch/core/result.h"
 
@@ -86,27 +81,6 @@ void ColoredMesh::append(const ColoredMesh& other) {
   colors.insert(colors.end(), other.colors.begin(), other.colors.end());
   triangles.reserve(triangles.size() + other.triangles.size());
   for (const auto& t : other.triangles) triangles.push_back({t[0] + offset, t[1] + offset, t[2] + offset});
-}
-
-void keep_frame_buffers_in_heap() {
-#if defined(__GLIBC__)
-  mallopt(M_MMAP_THRESHOLD, 512 << 20);
-  mallopt(M_TRIM_THRESHOLD, 1024 << 20);
-#endif
-}
-
-double resident_mib(int pid) {
-  std::ifstream status(pid == 0 ? std::string("/proc/self/status") : "/proc/" + std::to_string(pid) + "/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmRSS:") {
-      double kib = 0;
-      status >> kib;
-      return kib / 1024.0;
-    }
-    std::getline(status, key);
-  }
-  return 0.0;
 }
 
 std::size_t count_valid(const Cloud& cloud) {

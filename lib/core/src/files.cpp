@@ -49,6 +49,17 @@ Status fsync_path(const fs::path& path, bool directory) {
   return {};
 }
 
+Status with_system_reason(const std::function<Status()>& write) {
+  errno = 0;
+  Status status = write();
+  const int err = errno;
+  if (status || err == 0) return status;
+  const std::string reason = std::strerror(err);
+  Error error = status.error();
+  if (error.message.find(reason) == std::string::npos) error.message += ": " + reason;
+  return error;
+}
+
 Status write_atomically(const fs::path& path, const std::function<Status(const fs::path& tmp)>& write,
                         const std::string& tmp_suffix) {
   std::error_code ec;

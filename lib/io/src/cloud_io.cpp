@@ -315,8 +315,10 @@ Status write_pcd(const fs::path& path, const Cloud& cloud) {
   if (cloud.empty()) return invalid_argument(quoted(path) + ": refusing to write an empty cloud");
   return write_atomically(path, [&](const fs::path& tmp) -> Status {
     pcl::PCDWriter writer;
-    if (writer.writeBinary(tmp.string(), cloud) < 0) return io_error(quoted(path) + ": cannot write");
-    return {};
+    return with_system_reason([&]() -> Status {
+      if (writer.writeBinary(tmp.string(), cloud) < 0) return io_error(quoted(path) + ": cannot write");
+      return {};
+    });
   });
 }
 
@@ -325,8 +327,10 @@ Status write_ply(const fs::path& path, const Cloud& cloud) {
   if (cloud.empty()) return invalid_argument(quoted(path) + ": refusing to write an empty cloud");
   return write_atomically(path, [&](const fs::path& tmp) -> Status {
     pcl::PLYWriter writer;
-    if (writer.write(tmp.string(), cloud, true, false) < 0) return io_error(quoted(path) + ": cannot write");
-    return {};
+    return with_system_reason([&]() -> Status {
+      if (writer.write(tmp.string(), cloud, true, false) < 0) return io_error(quoted(path) + ": cannot write");
+      return {};
+    });
   });
 }
 
@@ -352,8 +356,10 @@ Status write_mesh_ply(const fs::path& path, const ColoredMesh& mesh) {
     for (std::uint32_t v : mesh.triangles[i]) out.polygons[i].vertices.push_back(static_cast<pcl::index_t>(v));
   }
   return write_atomically(path, [&](const fs::path& tmp) -> Status {
-    if (pcl::io::savePLYFileBinary(tmp.string(), out) < 0) return io_error(quoted(path) + ": cannot write");
-    return {};
+    return with_system_reason([&]() -> Status {
+      if (pcl::io::savePLYFileBinary(tmp.string(), out) < 0) return io_error(quoted(path) + ": cannot write");
+      return {};
+    });
   });
 }
 

@@ -33,7 +33,11 @@ Status write_mat(const fs::path& path, const cv::Mat& mat) {
   std::error_code ec;
   if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
   try {
-    if (!cv::imwrite(path.string(), mat)) return io_error(quoted(path) + ": cannot write image");
+    const Status written = with_system_reason([&]() -> Status {
+      if (!cv::imwrite(path.string(), mat)) return io_error(quoted(path) + ": cannot write image");
+      return {};
+    });
+    if (!written) return written;
   } catch (const cv::Exception& e) {
     return io_error(quoted(path) + ": cannot write image: " + e.what());
   }

@@ -59,11 +59,14 @@ Result<std::vector<double>> read_numbers(const fs::path& path) {
 Status write_text(const fs::path& path, const std::string& text) {
   std::error_code ec;
   if (path.has_parent_path()) fs::create_directories(path.parent_path(), ec);
-  std::ofstream out(path);
-  if (!out) return io_error(quoted(path) + ": cannot open for writing");
-  out << text;
-  if (!out) return io_error(quoted(path) + ": write failed");
-  return {};
+  return with_system_reason([&]() -> Status {
+    std::ofstream out(path);
+    if (!out) return io_error(quoted(path) + ": cannot open for writing");
+    out << text;
+    out.close();  // the bytes reach the file here: a full disk fails now, not silently in the destructor
+    if (!out) return io_error(quoted(path) + ": write failed");
+    return {};
+  });
 }
 
 }  // namespace

@@ -34,8 +34,8 @@ Status YamlSection::finish() const {
 }
 
 const std::vector<std::string>& pipeline_sections() {
-  static const std::vector<std::string> kSections = {"sensor", "background", "segmentation", "tracking", "change",
-                                                     "appearance", "surprise", "events", "foreground"};
+  static const std::vector<std::string> kSections = {"sensor",     "background", "segmentation", "tracking", "change",
+                                                     "appearance", "surprise",   "events",       "foreground", "workspace"};
   return kSections;
 }
 
@@ -245,6 +245,12 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("silence_frames", c.fusion.zone_frames); });
         !st)
       return st;
+    if (auto st = s.finish(); !st) return st;
+  }
+  {
+    YamlSection s(root["workspace"], "workspace");
+    if (auto st = s.check_is_map(); !st) return st;
+    if (auto st = s.read("radius_m", c.workspace_radius_m); !st) return st;
     if (auto st = s.finish(); !st) return st;
   }
   return validate(c);

@@ -42,23 +42,45 @@ Status validate_camera_name(const std::string& name, const std::string& where) {
   return {};
 }
 
-// Checks a frame; returns its number of valid points (one pass over the cloud serves both).
-Result<std::size_t> validate_frame(const Frame& f) {
+std::string metres(double m) {
+  std::ostringstream os;
+  os << m << " m";
+  return os.str();
+}
+
+// Checks a frame; returns its number of valid points (one pass over the cloud serves both). The
+// camera and every point must lie within `workspace_radius_m` of the world origin: a pose at 1e30
+// is finite and rigid, and would put objects, keyframes and a mesh there (OctoMap alone drops
+// such points without a word).
+Result<std::size_t> validate_frame(const Frame& f, double workspace_radius_m) {
   const std::string where = f.source.empty() ? std::string("frame") : "frame from '" + f.source + "'";
+  const std::string workspace = "outside the workspace (workspace.radius_m: " + metres(workspace_radius_m) +
+                                " around the world origin)";
   if (!f.cloud || f.cloud->empty()) return invalid_argument(where + ": cloud is empty");
   if (f.cloud->width * f.cloud->height != f.cloud->size()) {
     return invalid_argument(where + ": cloud width x height (" + std::to_string(f.cloud->width) + "x" +
                             std::to_string(f.cloud->height) + ") does not match its " + std::to_string(f.cloud->size()) + " points");
   }
+  if (f.T_world_camera) {
+    if (auto st = validate_rigid(f.T_world_camera->matrix()); !st) return invalid_argument(where + ": " + st.error().message);
+    const double camera_m = f.T_world_camera->translation().norm();
+    if (camera_m > workspace_radius_m) {
+      return invalid_argument(where + ": the camera pose lies " + metres(camera_m) + " from the world origin, " + workspace);
+    }
+  }
   // Finite is not enough: a point at 3e38 m would be ray-cast through the map. No depth sensor
   // sees that far; such coordinates are not metres (wrong units, garbage).
-  std::size_t valid = 0, far = 0;
+  const Pose T = f.pose_or_identity();
+  const double workspace_squared = workspace_radius_m * workspace_radius_m;
+  std::size_t valid = 0, far = 0, outside = 0;
   const PointT* first_far = nullptr;
+  Eigen::Vector3d first_outside = Eigen::Vector3d::Zero();
   for (const auto& p : f.cloud->points) {
     if (!is_valid(p)) continue;
     ++valid;
-    if (p.getVector3fMap().squaredNorm() <= kMaxPointRangeM * kMaxPointRangeM) continue;
-    if (far++ == 0) first_far = &p;
+    if (p.getVector3fMap().squaredNorm() > kMaxPointRangeM * kMaxPointRangeM && far++ == 0) first_far = &p;
+    const Eigen::Vector3d p_world = T * p.getVector3fMap().cast<double>();
+    if (p_world.squaredNorm() > workspace_squared && outside++ == 0) first_outside = p_world;
   }
   if (valid == 0) return invalid_argument(where + ": no valid points (all NaN or non-finite)");
   if (far > 0) {
@@ -67,11 +89,14 @@ Result<std::size_t> validate_frame(const Frame& f) {
                             std::to_string(first_far->x) + " " + std::to_string(first_far->y) + " " +
                             std::to_string(first_far->z) + "): coordinates must be metres in the camera frame");
   }
+  if (outside > 0) {
+    std::ostringstream at;
+    at << first_outside.x() << " " << first_outside.y() << " " << first_outside.z();
+    return invalid_argument(where + ": " + std::to_string(outside) + " points lie " + workspace + " (the first at " +
+                            at.str() + " in the world)");
+  }
   if (!std::isfinite(f.stamp_s)) return invalid_argument(where + ": stamp is not finite");
   if (auto st = validate_camera_name(f.camera, where); !st) return st.error();
-  if (f.T_world_camera) {
-    if (auto st = validate_rigid(f.T_world_camera->matrix()); !st) return invalid_argument(where + ": " + st.error().message);
-  }
   if (f.intrinsics) {
     const Intrinsics& K = *f.intrinsics;
     if (!K.valid()) return invalid_argument(where + ": intrinsics are invalid");
@@ -451,6 +476,8 @@ Status validate(const Config& c) {
   if (!(c.fusion.match_m > 0 && c.fusion.match_m <= 1)) return invalid_argument("events.appearance_match_m: must be in (0, 1] m");
   if (!(c.fusion.margin_m >= 0 && c.fusion.margin_m <= 1)) return invalid_argument("events.merge_margin_m: must be in [0, 1] m");
   if (c.fusion.zone_frames < 0 || c.fusion.zone_frames > 100000) return invalid_argument("events.silence_frames: must be in [0, 100000]");
+  if (!(c.workspace_radius_m > 0 && c.workspace_radius_m <= 100000))
+    return invalid_argument("workspace.radius_m: must be in (0, 100000] m, got " + metres(c.workspace_radius_m));
   if (auto st = background::validate(c.appearance); !st) return st;
   if (auto st = surprise::validate(c.surprise); !st) return st;
   if (auto st = change::validate(c.change); !st) return st;
@@ -470,7 +497,7 @@ WorkingMemory::WorkingMemory(Config config) : config_(with_sensor(std::move(conf
 WorkingMemory::~WorkingMemory() = default;
 
 Result<FrameResult> WorkingMemory::process(const Frame& frame) {
-  const auto valid_points = validate_frame(frame);
+  const auto valid_points = validate_frame(frame, config_.workspace_radius_m);
   if (!valid_points) return valid_points.error();
   const auto t0 = Clock::now();
   std::lock_guard<std::mutex> lock(impl_->writer);
@@ -876,7 +903,7 @@ std::vector<Event> WorkingMemory::events_since(std::uint64_t since, std::size_t 
 }
 
 Result<std::shared_ptr<const SurpriseResult>> WorkingMemory::surprise(const Frame& observation) const {
-  if (auto valid = validate_frame(observation); !valid) return valid.error();
+  if (auto valid = validate_frame(observation, config_.workspace_radius_m); !valid) return valid.error();
   return impl_->appearance.evaluate(observation);
 }
 

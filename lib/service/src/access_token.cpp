@@ -68,6 +68,25 @@ Result<std::string> read_from(int fd, const fs::path& path) {
   return text;
 }
 
+/// The token file's folder and every folder above it: none may be writable by every user without
+/// the sticky bit, or anyone could rename the token file (or its folder) away and put their own
+/// in its place, and the daemon would take their token.
+Status check_folders(const fs::path& path) {
+  std::error_code ec;
+  fs::path dir = fs::absolute(path, ec).parent_path();
+  for (; !dir.empty(); dir = dir.parent_path()) {
+    struct stat st {};
+    if (::stat(dir.c_str(), &st) == 0 && (st.st_mode & S_IWOTH) != 0 && (st.st_mode & S_ISVTX) == 0) {
+      return Error{ErrorCode::kPermissionDenied,
+                   quoted(path) + ": the token file lies in " + quoted(dir) + ", which every user may write to (mode " +
+                       mode_text(st.st_mode) + ") without the sticky bit: anyone could put their own token file in "
+                       "its place. Keep the token in a folder only you can write to (or chmod o-w, or +t, that folder)"};
+    }
+    if (dir == dir.root_path()) break;
+  }
+  return {};
+}
+
 Result<std::string> open_and_read(const fs::path& path) {
   const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) {
@@ -109,6 +128,7 @@ fs::path default_token_path() {
 
 Result<std::string> read_token_file(const fs::path& path) {
   if (path.empty()) return invalid_argument("no token file: HOME is not set; name one (server.token_file, --token-file)");
+  if (Status s = check_folders(path); !s) return s.error();
   return open_and_read(path);
 }
 

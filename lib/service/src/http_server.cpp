@@ -7,6 +7,10 @@
 #include <boost/asio/strand.hpp>
 #include <boost/asio/write.hpp>
 
+#include <netinet/in.h>
+#include <netinet/tcp.h>
+#include <sys/socket.h>
+
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -15,6 +19,7 @@
 #include <mutex>
 #include <set>
 #include <thread>
+#include <vector>
 
 #include "session.h"  // format_endpoint
 
@@ -61,33 +66,61 @@ std::string response_head(const HttpResponse& r, bool streaming) {
 
 class Connection;
 
-/// The open connections, so that stop() can close them all. Thread safe.
+/// The open connections, so that stop() can close them all: those before their answer (page
+/// requests, up to max_connections) and the streams (up to max_streams) are counted apart, so
+/// streams that stay open cannot take the slots page requests need. Thread safe.
 class Registry {
  public:
-  /// False when stopping or full (the connection is then answered and closed by the caller).
-  std::size_t add(const std::shared_ptr<Connection>& c) {
+  Registry(std::size_t max_requests, std::size_t max_streams) : max_requests_(max_requests), max_streams_(max_streams) {}
+  enum class Added { kAdded, kFull, kStopping };
+  /// Counts a new connection as a request; kFull (then it is only known to stop_all() until it
+  /// closes) when max_requests are counted already.
+  Added add(const std::shared_ptr<Connection>& c) {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (stopped_) return 0;
-    connections_.insert(c);
-    return connections_.size();
+    if (stopped_) return Added::kStopping;
+    if (requests_.size() >= max_requests_) {
+      uncounted_.insert(c);
+      return Added::kFull;
+    }
+    requests_.insert(c);
+    return Added::kAdded;
+  }
+  /// Moves a request that is answered with a stream to the streams; false (it stays a request)
+  /// when max_streams are open.
+  bool become_stream(const std::shared_ptr<Connection>& c) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (streams_.size() >= max_streams_ || requests_.erase(c) == 0) return false;
+    streams_.insert(c);
+    return true;
   }
   void remove(const std::shared_ptr<Connection>& c) {
     std::lock_guard<std::mutex> lock(mutex_);
-    connections_.erase(c);
+    requests_.erase(c);
+    streams_.erase(c);
+    uncounted_.erase(c);
   }
-  std::set<std::shared_ptr<Connection>> stop_all() {
+  std::vector<std::shared_ptr<Connection>> stop_all() {
     std::lock_guard<std::mutex> lock(mutex_);
     stopped_ = true;
-    return std::exchange(connections_, {});
+    std::vector<std::shared_ptr<Connection>> all(requests_.begin(), requests_.end());
+    all.insert(all.end(), streams_.begin(), streams_.end());
+    all.insert(all.end(), uncounted_.begin(), uncounted_.end());
+    requests_.clear();
+    streams_.clear();
+    uncounted_.clear();
+    return all;
   }
 
  private:
+  const std::size_t max_requests_, max_streams_;
   std::mutex mutex_;
-  std::set<std::shared_ptr<Connection>> connections_;
+  std::set<std::shared_ptr<Connection>> requests_, streams_, uncounted_;
   bool stopped_ = false;
 };
 
 struct Shared {
+  Shared(HttpServerConfig c, HttpHandler h, LogSink l)
+      : config(std::move(c)), handler(std::move(h)), log(std::move(l)), registry(config.max_connections, config.max_streams) {}
   HttpServerConfig config;
   HttpHandler handler;
   LogSink log;
@@ -190,17 +223,53 @@ class Connection : public std::enable_shared_from_this<Connection> {
     if (answered_ || closed_) return;
     answered_ = true;
     timer_.cancel();
+    if (response.on_stream && !shared_.registry.become_stream(shared_from_this())) {
+      response = http_error(503, "too many event streams open (limit " + std::to_string(shared_.config.max_streams) +
+                                     ", server.http_max_streams)");
+    }
     streaming_ = static_cast<bool>(response.on_stream);
     queue(response_head(response, streaming_) + response.body);
     if (streaming_) {
+      heartbeat_ = std::move(response.heartbeat);
+      start_stream_clock();
       // Registered before the head leaves: anything the stream sends is queued after it.
       response.on_stream(std::make_shared<Stream>(shared_from_this()));
       read();  // to notice the client's close
     }
   }
 
+  /// A stream's clock: every heartbeat_s, the heartbeat when nothing waits to be sent, and the
+  /// end of a stream whose client has taken none of its bytes for stream_timeout_s. The kernel
+  /// is told the same timeout for bytes it cannot deliver (a peer gone without a word).
+  void start_stream_clock() {
+    const unsigned timeout_ms = static_cast<unsigned>(shared_.config.stream_timeout_s * 1000);
+    ::setsockopt(socket_.native_handle(), IPPROTO_TCP, TCP_USER_TIMEOUT, &timeout_ms, sizeof timeout_ms);
+    last_progress_ = std::chrono::steady_clock::now();
+    tick();
+  }
+
+  void tick() {
+    timer_.expires_after(std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(std::min(shared_.config.heartbeat_s, shared_.config.stream_timeout_s))));
+    timer_.async_wait([self = shared_from_this()](const boost::system::error_code& ec) {
+      if (ec || self->closed_) return;
+      const double stalled_s =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - self->last_progress_).count();
+      if (!self->queue_.empty() && stalled_s >= self->shared_.config.stream_timeout_s) {
+        self->shared_.write_log(LogLevel::kWarning, "http: " + self->peer_ + ": stream closed, the client has taken "
+                                                    "nothing for " + std::to_string(stalled_s) +
+                                                    " s (server.http_stream_timeout_s)");
+        self->close();
+        return;
+      }
+      if (self->queue_.empty() && !self->heartbeat_.empty()) self->queue(self->heartbeat_);
+      self->tick();
+    });
+  }
+
   void queue(std::string bytes) {
     if (closed_) return;
+    if (queue_.empty()) last_progress_ = std::chrono::steady_clock::now();
     queued_bytes_ += bytes.size();
     if (streaming_ && queued_bytes_ > shared_.config.max_stream_queue_bytes) {
       shared_.write_log(LogLevel::kWarning, "http: " + peer_ + ": stream closed, the client reads too slowly");
@@ -221,6 +290,7 @@ class Connection : public std::enable_shared_from_this<Connection> {
                         }
                         self->queued_bytes_ -= self->queue_.front().size();
                         self->queue_.pop_front();
+                        self->last_progress_ = std::chrono::steady_clock::now();
                         if (!self->queue_.empty()) {
                           self->write_next();
                         } else if (!self->streaming_) {
@@ -279,6 +349,9 @@ class Connection : public std::enable_shared_from_this<Connection> {
   std::string peer_;
   std::deque<std::string> queue_;
   std::size_t queued_bytes_ = 0;
+  std::string heartbeat_;  ///< a stream's keep-alive bytes
+  /// When the client last took bytes (a write completed), or the queue last became non-empty.
+  std::chrono::steady_clock::time_point last_progress_;
   bool answered_ = false;
   bool streaming_ = false;
   bool lingering_ = false;
@@ -288,6 +361,8 @@ class Connection : public std::enable_shared_from_this<Connection> {
 }  // namespace
 
 struct HttpServer::Impl {
+  Impl(HttpServerConfig config, HttpHandler handler, LogSink log)
+      : shared(std::move(config), std::move(handler), std::move(log)) {}
   Shared shared;
   asio::io_context io;
   tcp::acceptor acceptor{io};
@@ -307,24 +382,24 @@ struct HttpServer::Impl {
         return;
       }
       auto connection = std::make_shared<Connection>(std::move(socket), shared);
-      const std::size_t count = shared.registry.add(connection);
-      if (count == 0) return;  // stopping
-      if (count > shared.config.max_connections) {
-        connection->reject(http_error(503, "too many connections (limit " +
-                                          std::to_string(shared.config.max_connections) + ")"));
-      } else {
-        connection->start();
+      switch (shared.registry.add(connection)) {
+        case Registry::Added::kStopping:
+          return;
+        case Registry::Added::kFull:
+          connection->reject(http_error(503, "too many connections (limit " +
+                                            std::to_string(shared.config.max_connections) + ")"));
+          break;
+        case Registry::Added::kAdded:
+          connection->start();
+          break;
       }
       do_accept();
     });
   }
 };
 
-HttpServer::HttpServer(HttpServerConfig config, HttpHandler handler, LogSink log) : impl_(std::make_unique<Impl>()) {
-  impl_->shared.config = std::move(config);
-  impl_->shared.handler = std::move(handler);
-  impl_->shared.log = std::move(log);
-}
+HttpServer::HttpServer(HttpServerConfig config, HttpHandler handler, LogSink log)
+    : impl_(std::make_unique<Impl>(std::move(config), std::move(handler), std::move(log))) {}
 
 HttpServer::~HttpServer() { stop(); }
 

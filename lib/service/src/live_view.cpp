@@ -173,6 +173,7 @@ struct LiveView::Impl {
     HttpResponse r;
     r.content_type = "text/event-stream";
     r.body = "retry: 2000\n\n";
+    r.heartbeat = ": heartbeat\n\n";  // a comment: EventSource ignores it
     r.on_stream = [this](std::shared_ptr<HttpStream> stream) {
       std::lock_guard<std::mutex> lock(streams_mutex);
       streams.push_back(std::move(stream));

@@ -337,4 +337,63 @@ Result<Intrinsics> decode_intrinsics(const proto::Intrinsics& msg, const std::st
   return k;
 }
 
+namespace {
+/// The length of the well-formed UTF-8 character at the start of `s`, 0 when there is none (RFC 3629:
+/// no overlong forms, no surrogates, nothing above U+10FFFF).
+std::size_t utf8_char_length(std::string_view s) {
+  const auto byte = [&](std::size_t i) { return static_cast<unsigned char>(s[i]); };
+  const unsigned char lead = byte(0);
+  if (lead < 0x80) return 1;
+  std::size_t n = 0;
+  unsigned char lo = 0x80, hi = 0xBF;  // the range of the second byte
+  if (lead >= 0xC2 && lead <= 0xDF) {
+    n = 2;
+  } else if (lead >= 0xE0 && lead <= 0xEF) {
+    n = 3;
+    if (lead == 0xE0) lo = 0xA0;
+    if (lead == 0xED) hi = 0x9F;
+  } else if (lead >= 0xF0 && lead <= 0xF4) {
+    n = 4;
+    if (lead == 0xF0) lo = 0x90;
+    if (lead == 0xF4) hi = 0x8F;
+  } else {
+    return 0;
+  }
+  if (s.size() < n || byte(1) < lo || byte(1) > hi) return 0;
+  for (std::size_t i = 2; i < n; ++i) {
+    if ((byte(i) & 0xC0) != 0x80) return 0;
+  }
+  return n;
+}
+}  // namespace
+
+std::string valid_utf8(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  while (!text.empty()) {
+    const std::size_t n = utf8_char_length(text);
+    if (n == 0) {
+      out += '?';
+      text.remove_prefix(1);
+    } else {
+      out.append(text.substr(0, n));
+      text.remove_prefix(n);
+    }
+  }
+  return out;
+}
+
+std::string source_label(const std::string& sent) {
+  if (sent.empty()) return "api";
+  std::size_t keep = std::min(sent.size(), kMaxSourceLabelBytes);
+  // Not in the middle of a character: back off over UTF-8 continuation bytes (10xxxxxx).
+  while (keep < sent.size() && keep > 0 && (static_cast<unsigned char>(sent[keep]) & 0xC0) == 0x80) --keep;
+  std::string label = sent.substr(0, keep);
+  for (char& c : label) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7F) c = '?';  // one log line per message
+  }
+  if (keep < sent.size()) label += "... (cut from " + std::to_string(sent.size()) + " bytes)";
+  return label;
+}
+
 }  // namespace scenewatch::service::convert

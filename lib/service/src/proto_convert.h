@@ -2,6 +2,7 @@
 // Conversions between core types and the wire protocol's messages. Private to the service module
 // (the client header re-exports only what the CLI needs).
 #include <string>
+#include <string_view>
 
 #include "scenewatch.pb.h"
 #include "scenewatch/core/cloud.h"
@@ -49,5 +50,17 @@ Result<Aabb> decode_box(const proto::Box& msg, const std::string& field);
 Result<Eigen::Vector3d> decode_point(const proto::Vec3& msg, const std::string& field);
 /// Positive focal lengths and image size.
 Result<Intrinsics> decode_intrinsics(const proto::Intrinsics& msg, const std::string& field);
+
+/// `text` with each byte that does not belong to a well-formed UTF-8 character replaced by '?'.
+/// The protocol's string fields must be UTF-8: a status message quoting a damaged file's bytes (a
+/// JSON parser's "last read: ...") made the whole Response one the client cannot parse.
+std::string valid_utf8(std::string_view text);
+
+/// The bytes of a source label kept (IngestFrame.source, which messages and the log quote).
+inline constexpr std::size_t kMaxSourceLabelBytes = 256;
+/// IngestFrame.source as the label of the frame: "api" when empty; control characters as '?';
+/// longer than kMaxSourceLabelBytes, cut there (at a UTF-8 character's start) and marked
+/// "... (cut from N bytes)".
+std::string source_label(const std::string& sent);
 
 }  // namespace scenewatch::service::convert

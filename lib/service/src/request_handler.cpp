@@ -18,6 +18,7 @@
 #include "scenewatch.pb.h"
 #include "scenewatch/core/files.h"
 #include "scenewatch/service/access_token.h"
+#include "scenewatch/service/model_directory.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/pipeline/working_memory.h"
@@ -33,7 +34,6 @@ namespace {
 
 constexpr std::uint32_t kDefaultEventCount = 1000;
 constexpr std::uint32_t kMaxEventCount = 10000;
-constexpr std::size_t kMaxSourceLabel = 256;
 
 /// Where a call runs: see the class comment of RequestHandler.
 enum class Route { kInline, kQuery, kMutate };
@@ -95,7 +95,7 @@ Reply error_reply(std::uint64_t id, proto::Status::Code code, const std::string&
   proto::Response response;
   response.set_id(id);
   response.mutable_status()->set_code(code);
-  response.mutable_status()->set_message(message);
+  response.mutable_status()->set_message(convert::valid_utf8(message));
   return finish(response, std::move(call));
 }
 
@@ -182,7 +182,7 @@ struct RequestHandler::Impl {
       response.clear_result();
       const Error& e = status.error();
       response.mutable_status()->set_code(convert::to_proto(e.code));
-      response.mutable_status()->set_message(call + ": " + e.message);
+      response.mutable_status()->set_message(convert::valid_utf8(call + ": " + e.message));
     }
     return finish(response, std::move(call));
   }
@@ -277,7 +277,7 @@ struct RequestHandler::Impl {
     }
     if (!std::isfinite(msg.stamp_s())) return invalid_argument("stamp_s is not finite");
     frame.stamp_s = msg.stamp_s();
-    frame.source = msg.source().empty() ? std::string("api") : msg.source().substr(0, kMaxSourceLabel);
+    frame.source = convert::source_label(msg.source());
     frame.camera = msg.camera();  // checked by the working memory with the rest of the frame
     return frame;
   }
@@ -543,7 +543,7 @@ struct RequestHandler::Impl {
 
   Status save_model(proto::Response& response) {
     if (Status s = require_model_dir(); !s) return s;
-    if (Status s = memory.save(config.model_dir, config.keep_snapshots); !s) return s;
+    if (Status s = service::save_model(memory, config.model_dir, config.keep_snapshots); !s) return s;
     response.mutable_save_model()->set_model_dir(config.model_dir.string());
     return {};
   }

@@ -42,8 +42,8 @@ struct Server::Impl {
   ConnectionRegistry registry;
   tcp::acceptor acceptor{io};
   asio::signal_set signals{io};
-  // Bytes of unfinished frames held by all sessions (server.max_buffered_bytes).
-  std::shared_ptr<std::atomic<std::size_t>> buffered_total = std::make_shared<std::atomic<std::size_t>>(0);
+  // Memory reserved for the unfinished frames of all sessions (server.max_buffered_bytes).
+  std::shared_ptr<FrameBudget> frame_budget = std::make_shared<FrameBudget>(config.max_buffered_bytes);
   asio::steady_timer accept_retry{io};
   std::atomic<std::uint64_t> next_number{1};
   std::atomic<bool> stop_requested{false};
@@ -92,25 +92,26 @@ struct Server::Impl {
     boost::system::error_code ignored;
     socket.set_option(tcp::no_delay(true), ignored);
     const SessionOptions options{config.max_message_bytes, config.read_timeout_s, config.max_queued_bytes,
-                                 config.frame_timeout_s, buffered_total, config.max_buffered_bytes};
+                                 config.frame_timeout_s, frame_budget};
     auto session = std::make_shared<Session>(std::move(socket), options, handler, registry, log, next_number++);
-    const std::size_t count = registry.add(session);
-    if (count == 0) return;  // stopping: the socket closes with the session
     // At the limit, the connection quiet for longest makes room (idle clients cannot lock others
     // out); only when every connection is busy or subscribed is the newcomer turned away.
-    std::shared_ptr<Session> room;
-    if (count > config.max_connections) room = registry.quietest(session);
-    if (room) {
-      room->evict("closed to make room for a new connection: this one was the quietest (server.max_connections " +
-                  std::to_string(config.max_connections) + ")");
-      asio::post(session->executor(), [session] { session->start(); });
-    } else if (count > config.max_connections) {
-      asio::post(session->executor(), [session, limit = config.max_connections] {
-        session->start_rejected(ErrorCode::kUnavailable,
-                                "too many connections (limit " + std::to_string(limit) + ", server.max_connections)");
-      });
-    } else {
-      asio::post(session->executor(), [session] { session->start(); });
+    const Admission admission = registry.admit(session, config.max_connections);
+    const std::string limit = "server.max_connections " + std::to_string(config.max_connections);
+    switch (admission.kind) {
+      case Admission::Kind::kStopping:
+        return;  // the socket closes with the session
+      case Admission::Kind::kRefused:
+        asio::post(session->executor(), [session, limit] {
+          session->start_rejected(ErrorCode::kUnavailable, "too many connections (" + limit + ")");
+        });
+        return;
+      case Admission::Kind::kAdmitted:
+        if (admission.evicted) {
+          admission.evicted->evict("closed to make room for a new connection: this one was the quietest (" + limit + ")");
+        }
+        asio::post(session->executor(), [session] { session->start(); });
+        return;
     }
   }
 

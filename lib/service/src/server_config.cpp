@@ -17,6 +17,9 @@ namespace {
 constexpr std::size_t kMinMessageBytes = 1024;
 constexpr std::size_t kMinQueuedBytes = 64 * 1024;
 constexpr int kMaxIoThreads = 64;
+constexpr double kMinHeartbeatS = 0.1, kMaxHeartbeatS = 3600;
+constexpr double kMinStreamTimeoutS = 1, kMaxStreamTimeoutS = 86400;
+constexpr long long kMaxHttpStreams = 1024;
 
 template <typename T>
 std::string str(const T& value) {
@@ -77,6 +80,16 @@ Status validate(const ServerConfig& config) {
   if (config.http_port != 0 && config.http_port == config.port) {
     return invalid_argument("server.http_port: must differ from server.port (" + std::to_string(config.port) + ")");
   }
+  if (!std::isfinite(config.http_heartbeat_s) || config.http_heartbeat_s < kMinHeartbeatS ||
+      config.http_heartbeat_s > kMaxHeartbeatS) {
+    return invalid_argument("server.http_heartbeat_s: must be in [" + str(kMinHeartbeatS) + ", " + str(kMaxHeartbeatS) +
+                            "] s, got " + str(config.http_heartbeat_s));
+  }
+  if (!std::isfinite(config.http_stream_timeout_s) || config.http_stream_timeout_s < kMinStreamTimeoutS ||
+      config.http_stream_timeout_s > kMaxStreamTimeoutS) {
+    return invalid_argument("server.http_stream_timeout_s: must be in [" + str(kMinStreamTimeoutS) + ", " +
+                            str(kMaxStreamTimeoutS) + "] s, got " + str(config.http_stream_timeout_s));
+  }
   for (std::size_t i = 0; i < config.data_roots.size(); ++i) {
     const fs::path& root = config.data_roots[i];
     std::error_code ec;
@@ -120,6 +133,9 @@ Status read_server_config(const YAML::Node& root, const fs::path& base_dir, Serv
 
   if (Status s = read_integer(section, "http_port", 0, 65535, config.http_port); !s) return s;
   if (Status s = section.read("http_bind", config.http_bind); !s) return s;
+  if (Status s = read_integer(section, "http_max_streams", 1, kMaxHttpStreams, config.http_max_streams); !s) return s;
+  if (Status s = section.read("http_heartbeat_s", config.http_heartbeat_s); !s) return s;
+  if (Status s = section.read("http_stream_timeout_s", config.http_stream_timeout_s); !s) return s;
   std::string three_js = config.http_three_js.string();
   if (Status s = section.read("http_three_js", three_js); !s) return s;
   config.http_three_js = resolve(base_dir, three_js);

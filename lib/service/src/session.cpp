@@ -7,6 +7,9 @@
 
 #include <chrono>
 #include <sstream>
+#include <utility>
+
+#include "scenewatch/core/memory.h"
 
 namespace scenewatch::service {
 namespace asio = boost::asio;
@@ -17,6 +20,19 @@ namespace {
 constexpr std::size_t kMaxPendingRequests = 8;
 /// After an error reply, how long the client's remaining bytes are drained before closing.
 constexpr double kLingerS = 2.0;
+/// A client that sent a frame at least this large gives the heap's free pages back when it goes
+/// (malloc_trim): its complete frames were copied into heap strings for the handler. Below it,
+/// what it leaves is not worth the trim's cost. (Unfinished frames live in mappings of their own,
+/// FrameBuffer, which go back to the system when they are dropped.)
+constexpr std::size_t kLargeFrameBytes = 1u << 20;
+/// quiet_since_ns_ while the connection is in use, and once it was claimed for eviction.
+constexpr std::int64_t kBusy = -1;
+constexpr std::int64_t kClaimed = -2;
+
+std::int64_t steady_now_ns() {
+  return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
+}
 
 std::string seconds(double s) {
   std::ostringstream os;
@@ -52,7 +68,8 @@ Session::Session(tcp::socket socket, const SessionOptions& options, RequestHandl
       registry_(registry),
       log_(log),
       number_(number),
-      parser_(options.max_message_bytes) {
+      parser_(options.max_message_bytes, options.frame_budget),
+      quiet_since_ns_(steady_now_ns()) {
   boost::system::error_code ec;
   const tcp::endpoint peer = socket_.remote_endpoint(ec);
   peer_ = ec ? std::string("unknown peer") : format_endpoint(peer);
@@ -124,20 +141,22 @@ void Session::on_read(const boost::system::error_code& ec, std::size_t n) {
     do_read();  // an error reply is being flushed; the client's bytes are ignored
     return;
   }
+  // Claimed to make room for a newcomer before these bytes came: the eviction, already on its
+  // way to this strand, answers them.
+  if (!leave_quiet()) return;
   cancel_timer();  // progress: the stall clock restarts
-  quiet_since_ns_ = -1;  // and the client is not quiet
   const bool was_partial = parser_.has_partial();
   const Status fed = parser_.feed(std::string_view(read_buffer_.data(), n));
   bool completed = false;
   while (auto frame = parser_.next()) {
+    held_large_frame_ = held_large_frame_ || frame->size() >= kLargeFrameBytes;
     pending_bytes_ += frame->size();
     pending_.push_back(std::move(*frame));
     completed = true;
   }
-  if (!account_buffered()) {
-    fail_and_close(ErrorCode::kUnavailable,
-                   "server busy: unfinished frames of all clients would hold more than " +
-                       std::to_string(options_.max_buffered_bytes) + " bytes (server.max_buffered_bytes); send again later");
+  if (!fed && fed.error().code == ErrorCode::kUnavailable) {
+    fail_and_close(ErrorCode::kUnavailable, "server busy: " + fed.error().message +
+                                                " (server.max_buffered_bytes); send again later");
     return;
   }
   // The whole-frame clock: from the first byte of a frame until it is complete.
@@ -161,19 +180,37 @@ void Session::maybe_resume_reading() {
   update_quiet();
 }
 
+// The quiet state is shared with the acceptor's thread, which may claim a quiet connection for
+// eviction at any time: every change is a compare-and-swap, and a claim is never undone.
 void Session::update_quiet() {
   const bool quiet = idle() && !parser_.has_partial() && context_.subscription < 0 && !closing_ && !closed_ && !lingering_;
+  std::int64_t seen = quiet_since_ns_.load();
+  if (seen == kClaimed) return;
   if (!quiet) {
-    quiet_since_ns_ = -1;
-  } else if (quiet_since_ns_.load() < 0) {
-    quiet_since_ns_ = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                          std::chrono::steady_clock::now().time_since_epoch()).count();
+    quiet_since_ns_.compare_exchange_strong(seen, kBusy);
+  } else if (seen == kBusy) {
+    quiet_since_ns_.compare_exchange_strong(seen, steady_now_ns());
   }
+}
+
+bool Session::leave_quiet() {
+  std::int64_t seen = quiet_since_ns_.load();
+  while (seen != kClaimed) {
+    if (quiet_since_ns_.compare_exchange_weak(seen, kBusy)) return true;
+  }
+  return false;
+}
+
+bool Session::claim_for_eviction() {
+  std::int64_t seen = quiet_since_ns_.load();
+  while (seen >= 0) {
+    if (quiet_since_ns_.compare_exchange_weak(seen, kClaimed)) return true;
+  }
+  return false;
 }
 
 void Session::evict(std::string reason) {
   asio::post(executor_, [self = shared_from_this(), reason = std::move(reason)] {
-    if (self->quiet_since_ns_.load() < 0 || self->closing_ || self->closed_) return;
     self->fail_and_close(ErrorCode::kUnavailable, reason);
   });
 }
@@ -367,8 +404,7 @@ void Session::fail_and_close(ErrorCode code, const std::string& message) {
   pending_bytes_ = 0;
   // No more of its bytes are read: the unfinished frame is dropped, and its share of the budget
   // given back, now rather than when the client finally goes.
-  parser_ = FrameParser(parser_.max_payload_bytes());
-  account_buffered();
+  release_frame_memory();
   enqueue(handler_.error_payload(code, message));
   // The client may not read the error either: give the write as long as a stalled read.
   arm_timer(options_.read_timeout_s, &Session::on_linger_timeout);
@@ -384,29 +420,23 @@ void Session::begin_linger() {
   do_read();
 }
 
-bool Session::account_buffered() {
-  if (!options_.buffered_total) return true;
-  const std::size_t now = closed_ ? 0 : parser_.buffered_bytes();
-  if (now >= accounted_bytes_) {
-    const std::size_t total = options_.buffered_total->fetch_add(now - accounted_bytes_) + (now - accounted_bytes_);
-    accounted_bytes_ = now;
-    return total <= options_.max_buffered_bytes || now == 0;
-  }
-  options_.buffered_total->fetch_sub(accounted_bytes_ - now);
-  accounted_bytes_ = now;
-  return true;
+void Session::release_frame_memory() {
+  parser_.drop_partial();
+  // glibc keeps freed frame-sized heap buffers (keep_frame_buffers_in_heap): once a client that
+  // sent large frames goes, hand the heap's free pages back.
+  if (std::exchange(held_large_frame_, false)) give_back_free_memory();
 }
 
 void Session::close(const std::string& reason) {
   if (closed_) return;
   closed_ = true;
-  account_buffered();  // gives this session's share back
   cancel_timer();
   handler_.unsubscribe(context_);
   boost::system::error_code ignored;
   socket_.shutdown(tcp::socket::shutdown_both, ignored);
   socket_.close(ignored);
   pending_.clear();
+  release_frame_memory();
   log(LogLevel::kInfo, "disconnected (" + reason + ")");
   registry_.remove(shared_from_this());
 }

@@ -32,9 +32,8 @@ struct SessionOptions {
   double read_timeout_s = 10.0;
   std::size_t max_queued_bytes = 0;
   double frame_timeout_s = 30.0;  ///< a frame must arrive whole within this from its first byte
-  /// Bytes of unfinished frames held by all sessions together, and their limit.
-  std::shared_ptr<std::atomic<std::size_t>> buffered_total;
-  std::size_t max_buffered_bytes = 0;
+  /// Memory for the unfinished frames of all sessions together (null: no limit but max_message_bytes).
+  std::shared_ptr<FrameBudget> frame_budget;
 };
 
 /// Owned by shared_ptrs (the registry, pending operations, queued replies). The socket's
@@ -54,10 +53,14 @@ class Session : public std::enable_shared_from_this<Session> {
   /// Closes the connection. Thread safe.
   void stop();
   /// Since when (steady clock, ns) the connection has been quiet: nothing asked, nothing being
-  /// answered or sent, no unfinished frame, no subscription. -1 while it is not. Thread safe.
+  /// answered or sent, no unfinished frame, no subscription; a new connection is quiet from its
+  /// accept. Negative while it is not, or once it was claimed for eviction. Thread safe.
   std::int64_t quiet_since_ns() const { return quiet_since_ns_.load(); }
-  /// Closes the connection with `reason` if it is still quiet when the strand gets to it (it may
-  /// have become busy since it was picked). Thread safe.
+  /// Claims a quiet connection for eviction: true when it was quiet, and from then on it stays
+  /// out of use (bytes it sends are not read as requests) until evict() closes it; false when it
+  /// was busy or claimed already. Thread safe; the ConnectionRegistry calls it under its lock.
+  bool claim_for_eviction();
+  /// Closes a connection claimed for eviction, telling the client `reason`. Thread safe.
   void evict(std::string reason);
   /// The strand the session runs on.
   const Executor& executor() const { return executor_; }
@@ -74,6 +77,9 @@ class Session : public std::enable_shared_from_this<Session> {
   void maybe_resume_reading();
   void resume_reading();
   void update_quiet();
+  /// The connection is in use from now on (bytes arrived); false when it was claimed for
+  /// eviction first.
+  bool leave_quiet();
   /// No request waiting or running and nothing left to send.
   bool idle() const;
   void dispatch_next();
@@ -131,10 +137,11 @@ class Session : public std::enable_shared_from_this<Session> {
   bool lingering_ = false;      ///< our side is shut down; draining the client's bytes
   bool closed_ = false;
   std::string close_reason_;
-  std::atomic<std::int64_t> quiet_since_ns_{-1};
-  std::size_t accounted_bytes_ = 0;  ///< this session's share of options_.buffered_total
-  /// Books the parser's buffered bytes in the shared total; false when the total is over its limit.
-  bool account_buffered();
+  std::atomic<std::int64_t> quiet_since_ns_;
+  bool held_large_frame_ = false;  ///< a frame of kLargeFrameBytes or more arrived since the last trim
+  /// Drops the unfinished frame (its mapping and its booking); trims the heap when a large frame
+  /// arrived.
+  void release_frame_memory();
 };
 
 }  // namespace scenewatch::service

@@ -28,6 +28,11 @@ Status write_atomically(const std::filesystem::path& path,
                         const std::function<Status(const std::filesystem::path& tmp)>& write,
                         const std::string& tmp_suffix = ".tmp");
 
+/// Runs `write` (a writer through a C++ stream or a C library: they leave errno as the failed
+/// system call set it) with errno cleared; when it fails with errno set, the system's reason is
+/// added to its message ("'a.ot': writing the map failed: No space left on device").
+Status with_system_reason(const std::function<Status()>& write);
+
 /// A regular file opened for reading beneath a directory: the kernel resolves the path at open
 /// time (openat2 with RESOLVE_BENEATH), so no `..`, absolute symlink or symlink swapped in after a
 /// check can lead outside it. Readers that take a path read it through `alias()`, a link with the

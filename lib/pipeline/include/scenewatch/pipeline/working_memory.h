@@ -47,6 +47,9 @@ struct Config {
   std::size_t max_event_log = 10000;  ///< events kept in memory for GetEvents
   FusionConfig fusion;                ///< one fact, one event (the `events:` section)
   foreground::ForegroundConfig foreground;  ///< hands, promotion, tracking, DoFs (issue 12)
+  /// Frames whose camera or points lie farther than this from the world origin are refused, metres
+  /// (the `workspace:` section's radius_m).
+  double workspace_radius_m = 1000.0;
 };
 
 /// The image-based surprise of one observation against the appearance memory.

@@ -1,7 +1,7 @@
 #pragma once
 /// A small read-only HTTP/1.1 server for the live view: GET only, one request per connection
 /// (then closed), a capped request head, a deadline for the head to arrive, and long-lived
-/// streams for Server-Sent Events. It knows nothing of perception: a handler maps each request to
+/// streams for Server-Sent Events, with slots, a heartbeat and a timeout of their own. It knows nothing of perception: a handler maps each request to
 /// a response (live_view.h). Boost.Asio stays inside its .cpp file.
 #include <cstddef>
 #include <cstdint>
@@ -27,12 +27,16 @@ class HttpStream {
 };
 
 /// One response. With `on_stream` set, the connection stays open after the head (and `body`)
-/// and on_stream is called once with its stream, before anything queued by it is sent.
+/// and on_stream is called once with its stream, before anything queued by it is sent; when
+/// every stream slot is taken the client gets 503 instead, and on_stream is not called.
 struct HttpResponse {
   int status = 200;
   std::string content_type = "text/plain; charset=utf-8";
   std::string body;
   std::function<void(std::shared_ptr<HttpStream>)> on_stream;
+  /// A stream's keep-alive: sent every HttpServerConfig::heartbeat_s when nothing else waits to
+  /// be sent (for Server-Sent Events, a comment line). Empty: none.
+  std::string heartbeat;
 };
 
 /// A plain-text error response ("404 Not Found\n" followed by the message).
@@ -49,8 +53,13 @@ struct HttpServerConfig {
   std::uint16_t port = 0;               ///< 0: pick a free port
   std::size_t max_head_bytes = 8192;    ///< a larger request head gets 413
   double head_timeout_s = 10.0;         ///< the head must arrive whole within this, else the connection closes
-  std::size_t max_connections = 32;     ///< further clients get 503
+  std::size_t max_connections = 32;     ///< connections before their answer (page requests); further ones get 503
+  std::size_t max_streams = 32;         ///< open streams, counted apart from requests; further ones get 503
   std::size_t max_stream_queue_bytes = 4u << 20;  ///< a stream whose client reads slower is closed
+  double heartbeat_s = 15.0;            ///< an idle stream sends its response's heartbeat this often
+  /// A stream whose queued bytes the client has not taken for this long is closed (and the
+  /// kernel drops a peer that acknowledges nothing for as long: TCP_USER_TIMEOUT).
+  double stream_timeout_s = 60.0;
 };
 
 /// Runs its own network thread: listen(), then start(); stop() (or the destructor) ends it.

@@ -42,6 +42,9 @@ struct ServerConfig {
   std::string http_bind = "127.0.0.1";          ///< the live view's listen address
   /// three.js for the page's 3D view (Debian's libjs-three).
   std::filesystem::path http_three_js = "/usr/share/javascript/three/three.min.js";
+  std::size_t http_max_streams = 32;            ///< event streams open at once, apart from page requests
+  double http_heartbeat_s = 15.0;               ///< an idle event stream carries a comment line this often
+  double http_stream_timeout_s = 60.0;          ///< a stream whose client takes nothing this long is closed
   /// Not read from YAML: the token itself (the contents of token_file), which calls that change
   /// the model must carry. Server::listen() refuses to serve without one.
   std::string access_token;
