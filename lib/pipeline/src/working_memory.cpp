@@ -674,7 +674,11 @@ namespace {
 // size in bytes and its leaf count): a damaged file is refused, not loaded in part and then saved
 // over the model. Models saved before the record existed are loaded unchecked.
 Status load_background(background::OccupancyMap& map, const fs::path& path, const nlohmann::json& scene) {
-  const auto record = scene.find("background");
+  const auto record = scene.is_object() ? scene.find("background") : scene.end();
+  if (record != scene.end() && !record->is_object()) {
+    return invalid_argument("'" + path.string() + "': the model's scene.json records its background as " +
+                            std::string(record->type_name()) + ", not an object with bytes and leaf_nodes");
+  }
   if (record != scene.end()) {
     std::error_code ec;
     const auto bytes = fs::file_size(path, ec);
@@ -795,7 +799,11 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
     return invalid_argument("'" + (dir / "scene.json").string() + "': " + e.what());
   }
   background::OccupancyMap map(config_.background);
-  if (auto st = load_background(map, dir / "background.ot", scene); !st) return st;
+  try {
+    if (auto st = load_background(map, dir / "background.ot", scene); !st) return st;
+  } catch (const std::exception& e) {  // a record of the wrong type: json's type_error
+    return invalid_argument("'" + (dir / "scene.json").string() + "': malformed background record: " + e.what());
+  }
   std::vector<TrackedObject> objects;
   std::map<std::uint64_t, std::vector<Eigen::Vector3d>> samples;
   std::vector<Plane> planes;
