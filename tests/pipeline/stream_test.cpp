@@ -141,8 +141,9 @@ TEST(Stream, StaticClutterSeenByAMovingCameraIsCalm) {
 // Real sequences: a posed recording read as the CLI and the daemon read it.
 // The frames are played in the order given (indices into the sequence), each from the camera named
 // beside it (none: one camera).
+// `frames_with_hands`, when given, counts the frames in which the hand detector kept a hand.
 std::vector<Event> run_recording(const std::filesystem::path& dir, const std::vector<std::size_t>& order,
-                                 const std::vector<std::string>& cameras = {}) {
+                                 const std::vector<std::string>& cameras = {}, std::size_t* frames_with_hands = nullptr) {
   std::vector<Event> events;
   auto seq = io::open_sequence(dir);
   EXPECT_TRUE(seq.ok()) << seq.error().message;
@@ -157,6 +158,7 @@ std::vector<Event> run_recording(const std::filesystem::path& dir, const std::ve
     auto result = memory.process(*frame);
     EXPECT_TRUE(result.ok()) << result.error().message;
     if (!result.ok()) return events;
+    if (frames_with_hands && result->hands > 0) ++*frames_with_hands;
     for (const auto& e : result->events) {
       print_event(dir.filename().string(), StreamEvent{e, 0, static_cast<int>(i)});
       events.push_back(e);
@@ -171,9 +173,13 @@ TEST(Stream, RealKitchenSeenByAHandHeldCameraIsCalm) {
   SCENEWATCH_REQUIRE_DATA("redkitchen/frame-000150.color.png");
   std::vector<std::size_t> forward;
   for (std::size_t i = 0; i < 50; ++i) forward.push_back(i);
-  const auto events = run_recording(test::data_dir() / "redkitchen", forward);
-  std::printf("redkitchen: %zu events in 50 frames\n", events.size());
+  std::size_t with_hands = 0;
+  const auto events = run_recording(test::data_dir() / "redkitchen", forward, {}, &with_hands);
+  std::printf("redkitchen: %zu events in 50 frames, hands in %zu frames\n", events.size(), with_hands);
   EXPECT_TRUE(events.empty());
+  // Nobody is in this kitchen. The wooden worktop seen first in frames 0-9 is taken for an arm
+  // until the map holds its surface (10 measured; none after frame 9).
+  EXPECT_LE(with_hands, 10u);
 }
 
 TEST(Stream, RealKitchenRevisitedIsCalm) {
@@ -194,9 +200,15 @@ TEST(Stream, RealKitchenStretchHeldOutFromTuningIsCalm) {
   SCENEWATCH_REQUIRE_DATA("redkitchen_long/frame-000498.color.jpg");
   std::vector<std::size_t> order;
   for (std::size_t i = 125; i < 250; ++i) order.push_back(i);
-  const auto events = run_recording(test::data_dir() / "redkitchen_long", order);
-  std::printf("redkitchen_long files 250-498: %zu events in 125 frames\n", events.size());
+  std::size_t with_hands = 0;
+  const auto events = run_recording(test::data_dir() / "redkitchen_long", order, {}, &with_hands);
+  std::printf("redkitchen_long files 250-498: %zu events in 125 frames, hands in %zu frames\n", events.size(), with_hands);
   EXPECT_LE(events.size(), 1u);
+  // Nobody is in it either: 13 frames with "hands" when a hand's points had to fall in an occupied
+  // voxel to count as furniture, 10 since they count within the sensor's axial tolerance along
+  // their ray (a wooden cupboard side entering the view, files 410-442, blanked as an arm and so
+  // never put in the map). Known shortfall of issue 28's item 4.
+  EXPECT_LE(with_hands, 10u);
 }
 
 TEST(Stream, TwoCamerasOnOneRoomInterleaved) {

@@ -70,8 +70,10 @@ HandsSeen summarise(const foreground::HandDetection& d, const Cloud& cloud, cons
 }  // namespace
 
 // A skin-coloured region where the map has remembered a surface for a while is furniture (a wooden
-// worktop), not a hand: hands come and go, the background stays. Drops such hands, and the person
-// grown from them when none is left.
+// worktop), not a hand: hands come and go, the background stays. A point is on a remembered
+// surface when an occupied voxel lies along its ray within the map tolerance of the sensor model
+// (change::map_tolerance_m: sigma_factor times the axial noise at its range), as for change
+// evidence. Drops such hands, and the person grown from them when none is left.
 void ForegroundStage::drop_static_hands(const Cloud& cloud, const Pose& T, const OccupiedFraction& occupied) {
   if (!occupied || detection_.hands.empty()) return;
   std::vector<foreground::Hand> kept;
@@ -82,7 +84,7 @@ void ForegroundStage::drop_static_hands(const Cloud& cloud, const Pose& T, const
       const PointT& p = cloud.points[static_cast<std::size_t>(h.indices[k])];
       if (is_valid(p)) pts.push_back(T * p.getVector3fMap().cast<double>());
     }
-    if (!pts.empty() && occupied(pts) > kStaticHandFraction) {
+    if (!pts.empty() && occupied(pts, T.translation()) > kStaticHandFraction) {
       for (int i : h.indices) detection_.labels[static_cast<std::size_t>(i)] = foreground::AgentLabel::kNone;
       continue;
     }

@@ -23,7 +23,7 @@ class ForegroundStage {
   /// Finds hands and registers the foreground objects; returns the frame without their pixels
   /// (the frame itself when there are none). `planes` are the last frame's, world frame.
   /// The share of world points the background map holds occupied.
-  using OccupiedFraction = std::function<double(const std::vector<Eigen::Vector3d>&)>;
+  using OccupiedFraction = std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d& camera)>;
   /// `camera` names the frame's camera: the support planes follow each camera from its own frame
   /// to its next.
   Frame prepare(const Frame& frame, std::uint64_t frame_index, const std::vector<Plane>& planes,

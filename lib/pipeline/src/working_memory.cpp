@@ -393,11 +393,22 @@ struct WorkingMemory::Impl {
   }
 
   // The share of world points on surfaces the map remembers (occupied), for the foreground.
-  ForegroundStage::OccupiedFraction occupied_fraction() {
-    return [this](const std::vector<Eigen::Vector3d>& pts) {
+  ForegroundStage::OccupiedFraction occupied_fraction(const change::Config& change_config) {
+    return [this, change_config](const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& camera) {
       std::shared_lock<std::shared_mutex> read(map_mutex);
+      const double step = 0.5 * map.resolution();
       std::size_t n = 0;
-      for (const auto& p : pts) n += map.query(p) == background::Occupancy::kOccupied ? 1 : 0;
+      for (const auto& p : pts) {
+        const Eigen::Vector3d ray = p - camera;
+        const double range = ray.norm();
+        const double reach = change::map_tolerance_m(change_config, range);
+        bool on = map.query(p) == background::Occupancy::kOccupied;
+        for (double t = step; !on && range > 0 && t <= reach + 1e-9; t += step) {
+          const Eigen::Vector3d d = (t / range) * ray;
+          on = map.query(p + d) == background::Occupancy::kOccupied || map.query(p - d) == background::Occupancy::kOccupied;
+        }
+        n += on ? 1 : 0;
+      }
       return pts.empty() ? 0.0 : static_cast<double>(n) / pts.size();
     };
   }
@@ -511,7 +522,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& frame) {
   // The planes this camera saw last (world frame); a camera's first frame starts from the model's.
   const auto own_planes = m.planes_by_camera.find(camera_id);
   const Frame seen = m.foreground.prepare(frame, m.frames, own_planes != m.planes_by_camera.end() ? own_planes->second : m.planes,
-                                          config_.segmentation.up, m.occupied_fraction(), result, camera_id);
+                                          config_.segmentation.up, m.occupied_fraction(config_.change), result, camera_id);
 
   // Three independent parts, each against the memory as it stands before this frame: the
   // geometric change detection with the map update (the octree), the image surprise (keyframes
