@@ -28,11 +28,23 @@ double percentile(std::vector<double> v, double q) {
   return v[i];
 }
 
-std::string event_line(std::size_t frame, const Event& e) {
-  char head[256];
-  std::snprintf(head, sizeof head, "frame %4zu  %-17s %-14s score %7.3f  at (%.3f, %.3f, %.3f)", frame, to_string(e.kind),
-                to_string(e.level), e.score, e.centroid_world.x(), e.centroid_world.y(), e.centroid_world.z());
+// How far the event lies from the camera that saw it (metres): what a false event's cause
+// usually hides in (the far end of the range, where depth noise grows with its square).
+double range_from_camera(const Frame& frame, const Event& e) {
+  return (e.centroid_world - frame.pose_or_identity().translation()).norm();
+}
+
+std::string event_line(std::size_t frame, const Event& e, double range_m) {
+  char head[320];
+  std::snprintf(head, sizeof head, "frame %4zu  %-17s %-14s score %7.3f  at (%.3f, %.3f, %.3f)  %.2f m from the camera", frame,
+                to_string(e.kind), to_string(e.level), e.score, e.centroid_world.x(), e.centroid_world.y(), e.centroid_world.z(),
+                range_m);
   std::string line = head;
+  if (e.region) {
+    std::snprintf(head, sizeof head, "  pixels x %d-%d, y %d-%d", e.region->x, e.region->x + e.region->width - 1, e.region->y,
+                  e.region->y + e.region->height - 1);
+    line += head;
+  }
   if (e.object_id) line += "  object " + std::to_string(*e.object_id);
   if (!e.detail.empty()) line += "  " + e.detail;
   return line;
@@ -89,9 +101,10 @@ int run_replay(const ReplayOptions& options) {
           nlohmann::json j = to_json(e);
           j["frame"] = frames;
           j["source"] = frame.source;
+          j["range_m"] = range_from_camera(frame, e);
           std::cout << j.dump() << "\n";
         } else {
-          std::cout << event_line(frames, e) << "\n";
+          std::cout << event_line(frames, e, range_from_camera(frame, e)) << "\n";
         }
       }
       ++frames;

@@ -5,6 +5,7 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -404,12 +405,16 @@ TEST_F(CliTest, ReplayTellsTheStreamAndCountsIt) {
     EXPECT_EQ(lines[i].at("frame"), 3) << "persistence: the third frame that shows it";
     EXPECT_EQ(lines[i].at("source"), after);
     EXPECT_GT(lines[i].at("indices_after").size(), 100u) << "the whole object's points";
+    // The cloud's camera is at the origin: the range is the centroid's distance from it.
+    const auto& c = lines[i].at("centroid_world");
+    EXPECT_NEAR(lines[i].at("range_m").get<double>(), std::hypot(c.at(0).get<double>(), c.at(1).get<double>(), c.at(2).get<double>()), 1e-6);
   }
   EXPECT_GT(summary.at("median_frame_ms").get<double>(), 0.0);
   // Text: one line per event, then the counts.
   result = cli({"replay", before, after, after, after});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.out.find("OBJECT_ADDED"), std::string::npos) << result.out;
+  EXPECT_NE(result.out.find(" m from the camera  pixels x "), std::string::npos) << result.out;
   EXPECT_NE(result.out.find("4 frames,"), std::string::npos) << result.out;
   // Bad input is named; a frame range beyond the sequence too.
   result = cli({"replay", (tmp_ / "absent").string()});
