@@ -61,10 +61,110 @@ std::optional<Recording> simulated(const std::string& scenario, int width, int h
   return r;
 }
 
+/// Frames of one real recording in a given order, each with the camera it is sent as (empty: the
+/// frame's own, unnamed).
+std::optional<Recording> reordered(const Options& o, const std::string& name, const std::string& folder,
+                                   std::vector<std::size_t> order, std::vector<std::string> cameras = {}) {
+  auto seq = io::open_sequence(o.data_dir / folder);
+  if (!seq) {
+    std::printf("  (skipped %s: %s)\n", name.c_str(), seq.error().message.c_str());
+    return std::nullopt;
+  }
+  auto shared = std::make_shared<io::Sequence>(std::move(*seq));
+  for (std::size_t i : order) {
+    if (i >= shared->frames.size()) {
+      std::printf("  (skipped %s: %s has %zu frames)\n", name.c_str(), folder.c_str(), shared->frames.size());
+      return std::nullopt;
+    }
+  }
+  const std::size_t n = order.size();
+  return Recording{name, n, [shared, order = std::move(order), cameras = std::move(cameras)](std::size_t k) -> std::optional<Frame> {
+                     auto f = io::load_sequence_frame(*shared, order[k]);
+                     if (!f) return std::nullopt;
+                     if (k < cameras.size()) f->camera = cameras[k];
+                     return std::move(*f);
+                   }};
+}
+
+std::vector<std::size_t> range(std::size_t from, std::size_t to) {  // [from, to)
+  std::vector<std::size_t> v;
+  for (std::size_t i = from; i < to; ++i) v.push_back(i);
+  return v;
+}
+
 struct Variant {
   const char* name;
   std::function<void(pipeline::Config&)> change;
 };
+
+/// Events per 100 frames of each recording under each variant, one row each.
+void run_table(const std::vector<Recording>& recordings, const std::vector<Variant>& variants) {
+  std::printf("%-48s %-28s %6s %7s %8s  %s\n", "recording", "configuration", "frames", "events", "per 100", "by kind");
+  for (const auto& r : recordings) {
+    for (const auto& v : variants) {
+      pipeline::Config config;
+      if (r.z_up) config.segmentation.up = Eigen::Vector3d::UnitZ();
+      v.change(config);
+      pipeline::WorkingMemory memory(config);
+      std::map<std::string, int> by_kind;
+      std::size_t events = 0, frames = 0;
+      for (std::size_t i = 0; i < r.frames; ++i) {
+        auto frame = r.frame(i);
+        if (!frame) break;
+        auto result = memory.process(*frame);
+        if (!result) {
+          std::printf("  %s frame %zu: %s\n", r.name.c_str(), i, result.error().message.c_str());
+          break;
+        }
+        ++frames;
+        for (const auto& e : result->events) {
+          ++events;
+          ++by_kind[to_string(e.kind)];
+        }
+      }
+      std::string kinds;
+      for (const auto& [k, n] : by_kind) kinds += k + " " + std::to_string(n) + "  ";
+      std::printf("%-48s %-28s %6zu %7zu %8.1f  %s\n", r.name.c_str(), v.name, frames, events,
+                  frames ? 100.0 * events / frames : 0.0, kinds.c_str());
+      std::fflush(stdout);
+    }
+  }
+}
+
+/// Issue 28: redkitchen_long, tuned on its first half (files 0-248), reported on the rest, with
+/// each remedy of the sensor model switched off in turn.
+void run_sensor_model_table(const Options& o) {
+  std::printf("\n== The calm stream on the kitchen it was not tuned on (issue 28): redkitchen_long, 250 frames (files 0-498,\n"
+              "   every second); remedies tuned on files 0-248 only\n");
+  std::vector<std::size_t> forth_and_back = range(0, 250);
+  for (std::size_t i = 250; i-- > 0;) forth_and_back.push_back(i);
+  std::vector<std::size_t> interleaved;
+  std::vector<std::string> two, one;
+  for (std::size_t i = 0; i < 100; ++i) {
+    interleaved.push_back(i), two.push_back("a"), one.push_back("one");
+    interleaved.push_back(150 + i), two.push_back("b"), one.push_back("one");
+  }
+  std::vector<Recording> recordings;
+  for (auto r : {reordered(o, "long files 0-248 (tuned on)", "redkitchen_long", range(0, 125)),
+                 reordered(o, "long files 250-498 (held out)", "redkitchen_long", range(125, 250)),
+                 reordered(o, "long all 250", "redkitchen_long", range(0, 250)),
+                 reordered(o, "long forth and back (500)", "redkitchen_long", forth_and_back),
+                 reordered(o, "long two cameras (0-198 a, 300-498 b)", "redkitchen_long", interleaved, two),
+                 reordered(o, "long the same sent as one camera", "redkitchen_long", interleaved, one)}) {
+    if (r) recordings.push_back(std::move(*r));
+  }
+  run_table(recordings, {
+      {"default", [](pipeline::Config&) {}},
+      {"no measured pose", [](pipeline::Config& c) { c.change.measure_pose = false; }},
+      {"every pixel evidence", [](pipeline::Config& c) { c.change.trusted_pixels_only = false; }},
+      {"no per-camera witness", [](pipeline::Config& c) { c.change.witness_per_camera = false; }},
+      {"none of these", [](pipeline::Config& c) {
+         c.change.measure_pose = false;
+         c.change.trusted_pixels_only = false;
+         c.change.witness_per_camera = false;
+       }},
+  });
+}
 
 }  // namespace
 
@@ -91,38 +191,8 @@ int run_stream(const Options& o) {
          c.fusion.persistence_frames = 1;
        }},
   };
-  std::printf("%-48s %-28s %6s %7s %8s  %s\n", "recording", "configuration", "frames", "events", "per 100", "by kind");
-  for (const auto& r : recordings) {
-    for (const auto& v : variants) {
-      pipeline::Config config;
-      if (r.z_up) config.segmentation.up = Eigen::Vector3d::UnitZ();
-      v.change(config);
-      pipeline::WorkingMemory memory(config);
-      std::map<std::string, int> by_kind;
-      std::size_t events = 0, frames = 0;
-      std::vector<double> ms;
-      for (std::size_t i = 0; i < r.frames; ++i) {
-        auto frame = r.frame(i);
-        if (!frame) break;
-        auto result = memory.process(*frame);
-        if (!result) {
-          std::printf("  %s frame %zu: %s\n", r.name.c_str(), i, result.error().message.c_str());
-          break;
-        }
-        ++frames;
-        ms.push_back(result->total_ms);
-        for (const auto& e : result->events) {
-          ++events;
-          ++by_kind[to_string(e.kind)];
-        }
-      }
-      std::string kinds;
-      for (const auto& [k, n] : by_kind) kinds += k + " " + std::to_string(n) + "  ";
-      std::printf("%-48s %-28s %6zu %7zu %8.1f  %s\n", r.name.c_str(), v.name, frames, events,
-                  frames ? 100.0 * events / frames : 0.0, kinds.c_str());
-      std::fflush(stdout);
-    }
-  }
+  run_table(recordings, variants);
+  run_sensor_model_table(o);
   return 0;
 }
 

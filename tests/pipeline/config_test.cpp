@@ -105,6 +105,20 @@ TEST_F(ConfigTest, ShippedConfigIsValid) {
   EXPECT_EQ(c.fusion.match_m, d.fusion.match_m);
   EXPECT_EQ(c.fusion.margin_m, d.fusion.margin_m);
   EXPECT_EQ(c.fusion.zone_frames, d.fusion.zone_frames);
+  EXPECT_EQ(c.sensor.profile, d.sensor.profile);
+  EXPECT_EQ(c.sensor.axial_base_m, d.sensor.axial_base_m);
+  EXPECT_EQ(c.sensor.axial_quad_per_m, d.sensor.axial_quad_per_m);
+  EXPECT_EQ(c.sensor.axial_offset_m, d.sensor.axial_offset_m);
+  EXPECT_EQ(c.sensor.lateral_px, d.sensor.lateral_px);
+  EXPECT_EQ(c.sensor.min_range_m, d.sensor.min_range_m);
+  EXPECT_EQ(c.sensor.max_range_m, d.sensor.max_range_m);
+  EXPECT_EQ(c.sensor.border_px, d.sensor.border_px);
+  EXPECT_EQ(c.sensor.registration_px, d.sensor.registration_px);
+  EXPECT_EQ(c.sensor.pose_sigma_m, d.sensor.pose_sigma_m);
+  EXPECT_EQ(c.sensor.pose_sigma_deg, d.sensor.pose_sigma_deg);
+  EXPECT_EQ(c.change.trusted_pixels_only, d.change.trusted_pixels_only);
+  EXPECT_EQ(c.change.measure_pose, d.change.measure_pose);
+  EXPECT_EQ(c.change.witness_per_camera, d.change.witness_per_camera);
 }
 
 TEST_F(ConfigTest, StreamKeysAreChecked) {

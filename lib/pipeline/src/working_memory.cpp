@@ -331,7 +331,8 @@ struct WorkingMemory::Impl {
     if (!K) return out;
     out.K = *K;
     std::shared_lock<std::shared_mutex> read(map_mutex);
-    auto mismatch = change::mismatch_against_map(map, *frame.cloud, T, *K, config, &map_grid, &witness, camera);
+    auto mismatch = change::mismatch_against_map(map, *frame.cloud, T, *K, config, &map_grid,
+                                                 config.witness_per_camera ? &witness : nullptr, camera);
     if (!mismatch) return out;
     change::ClusterInput input;
     input.after_camera = frame.cloud.get();

@@ -35,6 +35,10 @@ struct Config {
   /// larger of it and the declared one (sensor.pose_sigma_m, pose_sigma_deg) counts. false: the
   /// declared one alone.
   bool measure_pose = true;
+  /// Against a map that several cameras feed (WorkingMemory): a camera claims change only against
+  /// surfaces it saw itself (SurfaceWitness, surface_witness.h). false: against every surface of
+  /// the map, whoever saw it.
+  bool witness_per_camera = true;
   /// Only voxels the map holds occupied with at least this probability can be claimed removed:
   /// a surface seen once (a flying pixel at a silhouette) is no evidence of an object. A map
   /// built from one frame holds prob_hit (0.7); diff() lowers the threshold to it.
