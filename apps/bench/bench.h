@@ -44,6 +44,8 @@ int run_latency(const Options& o);
 int run_surprise(const Options& o);
 int run_change(const Options& o);
 int run_stream(const Options& o);
+/// Issue 28: redkitchen_long tuned on one half, reported on the other, each remedy off in turn.
+int run_sensor_model(const Options& o);
 int run_pipeline(const Options& o);
 int run_memory(const Options& o);
 int run_fit(const Options& o);
