@@ -4,6 +4,17 @@ function(scenewatch_target_properties target)
   target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wno-unused-parameter)
 endfunction()
 
+# scenewatch_app_properties(TARGET): a program of apps/. It knows the project's version and where
+# the shipped files are (apps/common/install_layout.h: installed beside it, else the source tree).
+function(scenewatch_app_properties target)
+  scenewatch_target_properties(${target})
+  target_include_directories(${target} PRIVATE ${PROJECT_SOURCE_DIR}/apps/common)
+  target_compile_definitions(${target} PRIVATE
+    SCENEWATCH_VERSION="${PROJECT_VERSION}"
+    SCENEWATCH_SOURCE_CONFIG_DIR="${PROJECT_SOURCE_DIR}/config"
+    SCENEWATCH_SOURCE_SCENARIOS_DIR="${PROJECT_SOURCE_DIR}/sample_clouds/scenarios")
+endfunction()
+
 # scenewatch_add_module(NAME SOURCES ... DEPS ... PRIVATE_DEPS ...)
 # Public headers live in lib/<name>/include/scenewatch/<name>/, sources in lib/<name>/src/.
 function(scenewatch_add_module name)
