@@ -78,3 +78,61 @@ install(FILES ${PROJECT_BINARY_DIR}/scenewatchConfig.cmake ${PROJECT_BINARY_DIR}
               ${PROJECT_SOURCE_DIR}/cmake/scenewatchDependencies.cmake
         DESTINATION ${scenewatch_cmake_dir} COMPONENT dev)
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/copyright DESTINATION share/doc/scenewatch-dev COMPONENT dev)
+
+# --- Debian packages (CPack DEB; scripts/package) ----------------------------------------------
+set(CPACK_GENERATOR DEB)
+set(CPACK_PACKAGE_NAME scenewatch)
+set(CPACK_PACKAGE_VERSION ${PROJECT_VERSION})
+set(CPACK_PACKAGE_VENDOR scenewatch)
+set(CPACK_PACKAGE_CONTACT "scenewatch maintainers <scenewatch@localhost>")
+set(CPACK_COMPONENTS_ALL runtime dev python)
+set(CPACK_DEB_COMPONENT_INSTALL ON)
+# The config and unit have absolute destinations when the prefix is /usr (above): CPack installs
+# with DESTDIR into its staging folder and the prefix /usr.
+set(CPACK_SET_DESTDIR ON)
+set(CPACK_INSTALL_PREFIX /usr)
+set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
+set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
+set(CPACK_DEBIAN_PACKAGE_SECTION science)
+set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
+
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_NAME scenewatch)
+# Descriptions: the synopsis, then the long description (CPack indents it).
+set(CPACK_DEBIAN_RUNTIME_DESCRIPTION "scenewatch perception service: scenewatchd, its CLI and the scene simulator
+scenewatchd keeps a working memory of a scene (an OctoMap background, supporting planes, the \
+objects on them, their appearance) and tells planners over TCP what was added, removed or moved. \
+It runs as the systemd service scenewatchd.service (user scenewatch, model in /var/lib/scenewatch). \
+scenewatchd and scenewatch link CGAL's Shape_detection: they are GPL-3.0-or-later.")
+# Depends: what dpkg-shlibdeps finds the programs linked against, and useradd for the user.
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_SHLIBDEPS ON)
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_DEPENDS "passwd")
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_RECOMMENDS "libjs-three")
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_SUGGESTS "python3-scenewatch")
+# The config files are conffiles: an upgrade keeps the administrator's edits, a purge removes them.
+set(scenewatch_conffiles "")
+foreach(file ${scenewatch_config_files})
+  get_filename_component(name ${file} NAME)
+  string(APPEND scenewatch_conffiles "/etc/scenewatch/${name}\n")
+endforeach()
+file(WRITE ${PROJECT_BINARY_DIR}/packaging/conffiles "${scenewatch_conffiles}")
+set(CPACK_DEBIAN_RUNTIME_PACKAGE_CONTROL_EXTRA
+    ${PROJECT_SOURCE_DIR}/packaging/debian/postinst ${PROJECT_SOURCE_DIR}/packaging/debian/prerm
+    ${PROJECT_SOURCE_DIR}/packaging/debian/postrm ${PROJECT_BINARY_DIR}/packaging/conffiles)
+
+set(CPACK_DEBIAN_DEV_PACKAGE_NAME scenewatch-dev)
+set(CPACK_DEBIAN_DEV_PACKAGE_SECTION libdevel)
+set(CPACK_DEBIAN_DEV_DESCRIPTION "scenewatch's libraries for C++: headers, static libraries, CMake package
+find_package(scenewatch) gives scenewatch::pipeline (WorkingMemory) and the other modules, with \
+their Debian dependencies found again. libscenewatch_ontology.a holds CGAL's Shape_detection: \
+what links it is GPL-3.0-or-later.")
+# The -dev packages of what the exported targets name (cmake/scenewatchDependencies.cmake).
+set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "cmake (>= 3.22), g++, gcc, libpcl-dev, liboctomap-dev, libopencv-dev, libeigen3-dev, libboost-dev, libcgal-dev, libprotobuf-dev, libyaml-cpp-dev, libsqlite3-dev, nlohmann-json3-dev, robin-map-dev, liblz4-dev")
+
+set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-scenewatch)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)
+set(CPACK_DEBIAN_PYTHON_PACKAGE_ARCHITECTURE all)
+set(CPACK_DEBIAN_PYTHON_DESCRIPTION "Python client of scenewatchd, the scenewatch perception service
+import scenewatch; scenewatch.Client(host, port): one method per call of the protocol, with the \
+messages of proto/scenewatch.proto generated at build time (scenewatch.pb).")
+set(CPACK_DEBIAN_PYTHON_PACKAGE_DEPENDS "python3, python3-protobuf")
+include(CPack)
