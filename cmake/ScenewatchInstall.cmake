@@ -47,8 +47,11 @@ install(CODE [[
   endif()
   file(INSTALL ${scenewatch_config_files} DESTINATION "${scenewatch_etc}")
   string(REGEX REPLACE "/$" "" scenewatch_bin "${CMAKE_INSTALL_PREFIX}/bin")
-  configure_file("${scenewatch_unit_template}" "${scenewatch_unit_staging}/scenewatchd.service" @ONLY)
-  file(INSTALL "${scenewatch_unit_staging}/scenewatchd.service" DESTINATION "${scenewatch_units}")
+  # One staging folder per destination: installs into two prefixes at once (a test and cpack) do
+  # not write each other's unit.
+  string(MD5 scenewatch_key "$ENV{DESTDIR}${CMAKE_INSTALL_PREFIX}")
+  configure_file("${scenewatch_unit_template}" "${scenewatch_unit_staging}/${scenewatch_key}/scenewatchd.service" @ONLY)
+  file(INSTALL "${scenewatch_unit_staging}/${scenewatch_key}/scenewatchd.service" DESTINATION "${scenewatch_units}")
 ]] COMPONENT runtime)
 
 # --- python ----------------------------------------------------------------------------------
