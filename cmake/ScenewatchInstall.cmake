@@ -59,7 +59,7 @@ install(CODE [[
 # the prefix /usr; for another prefix, PYTHONPATH=PREFIX/lib/python3/dist-packages (or pip install
 # build/clients/python, README "Install on a robot").
 install(DIRECTORY ${PROJECT_BINARY_DIR}/clients/python/scenewatch DESTINATION lib/python3/dist-packages
-        COMPONENT python FILES_MATCHING PATTERN "*.py")
+        COMPONENT python FILES_MATCHING PATTERN "*.py" PATTERN "__pycache__" EXCLUDE)
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/copyright DESTINATION share/doc/python3-scenewatch COMPONENT python)
 
 # --- dev -------------------------------------------------------------------------------------
