@@ -26,6 +26,7 @@ function(scenewatch_add_module name)
                                                       $<INSTALL_INTERFACE:include>)
   target_link_libraries(scenewatch_${name} PUBLIC ${ARG_DEPS} PRIVATE ${ARG_PRIVATE_DEPS})
   set_target_properties(scenewatch_${name} PROPERTIES POSITION_INDEPENDENT_CODE ON EXPORT_NAME ${name})
+  set_property(GLOBAL APPEND PROPERTY SCENEWATCH_MODULES ${name})
   scenewatch_target_properties(scenewatch_${name})
 endfunction()
 

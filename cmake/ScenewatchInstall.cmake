@@ -14,7 +14,8 @@ include(CMakePackageConfigHelpers)
 set(CMAKE_SKIP_INSTALL_ALL_DEPENDENCY ON)
 
 set(scenewatch_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/scenewatch)
-set(scenewatch_modules core io background segmentation ontology surprise change foreground sim pipeline service)
+# Every module scenewatch_add_module made (a new one is installed and exported without a word here).
+get_property(scenewatch_modules GLOBAL PROPERTY SCENEWATCH_MODULES)
 
 # --- runtime ---------------------------------------------------------------------------------
 install(TARGETS scenewatchd scenewatch scenewatch-sim RUNTIME DESTINATION bin COMPONENT runtime)
