@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "install_layout.h"
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/io/rgbd.h"
 #include "scenewatch/sim/scenario_yaml.h"
@@ -158,7 +159,8 @@ Result<BenchRow> bench_scenario(const fs::path& path, int frames, int width, int
 int main(int argc, char** argv) {
   CLI::App app{"scenewatch-sim: synthetic tabletop RGB-D sequences with exact ground truth"};
   app.require_subcommand(1);
-  std::string scenario_dir = SCENEWATCH_SCENARIO_DIR;
+  app.set_version_flag("--version", "scenewatch-sim " SCENEWATCH_VERSION);
+  std::string scenario_dir = scenewatch::apps::scenarios_dir().string();
   app.add_option("--scenarios", scenario_dir, "Folder of the shipped scenarios")->capture_default_str();
 
   // render

@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "config_file.h"
 #include "frame_spec.h"
+#include "install_layout.h"
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/ontology/describe.h"
 #include "scenewatch/segmentation/tabletop.h"
@@ -143,7 +144,7 @@ std::string write_completion(const std::string& dir, std::size_t id, const ontol
 int run_fit(const FitOptions& options) {
   auto loaded = read_config_file(options.config);
   if (!loaded) return fail(loaded.error().message);
-  const std::string classes_file = options.classes.empty() ? std::string(SCENEWATCH_CLASSES_FILE) : options.classes;
+  const std::string classes_file = options.classes.empty() ? (apps::config_dir() / "ontology.yaml").string() : options.classes;
   auto library = ontology::load_classes_file(classes_file);
   if (!library) return fail(library.error().message);
   if (!options.out_dir.empty()) {

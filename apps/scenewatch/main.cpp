@@ -38,6 +38,7 @@ void add_depth_scale_option(CLI::App* command, std::optional<double>& depth_scal
 int main(int argc, char** argv) {
   CLI::App app{"scenewatch - talk to the scenewatchd perception service, or work on cloud files offline.\n"
                "Exit codes: 0 ok, 1 error (message on stderr), 2 usage."};
+  app.set_version_flag("--version", "scenewatch " SCENEWATCH_VERSION);
   app.require_subcommand(1);
   RemoteOptions remote;
   // Accepted before the command too: `scenewatch --port 7879 health` as well as `scenewatch health --port 7879`.
@@ -186,7 +187,7 @@ int main(int argc, char** argv) {
   fit->add_option("file", fit_options.file, "cloud file or sequence frame")->required();
   fit->add_flag("--json", fit_options.json, "print JSON (each object's shapes, refined cylinder, class, candidates, grasps and timings)");
   fit->add_option("--config", fit_options.config, "YAML config (its segmentation section is used)");
-  fit->add_option("--classes", fit_options.classes, "object classes file (default: the shipped config/ontology.yaml)");
+  fit->add_option("--classes", fit_options.classes, "object classes file (default: the shipped ontology.yaml, in /etc/scenewatch when installed)");
   fit->add_option("--out", fit_options.out_dir,
                   "write each object's completed model (its class's primitive, whole surface) to DIR as object-N-CLASS.pcd and .ply");
   add_depth_scale_option(fit, fit_options.depth_scale_m);

@@ -12,6 +12,7 @@
 
 #include "commands.h"
 #include "frame_spec.h"
+#include "install_layout.h"
 #include "scenewatch/service/client.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"
@@ -108,7 +109,7 @@ Status for_each_script_frame(const Script& s, const std::function<Status(const F
     });
   }
   fs::path path = s.simulator;
-  if (path.extension() != ".yaml") path = fs::path(SCENEWATCH_SCENARIOS_DIR) / (s.simulator + ".yaml");
+  if (path.extension() != ".yaml") path = apps::scenarios_dir() / (s.simulator + ".yaml");
   auto scenario = sim::load_scenario(path);
   if (!scenario) return scenario.error();
   auto sized = sim::with_resolution(*scenario, s.width, s.height);

@@ -13,6 +13,7 @@
 #include <optional>
 #include <string>
 
+#include "install_layout.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/service/access_token.h"
 #include "scenewatch/ontology/class_catalog.h"
@@ -92,7 +93,10 @@ int main(int argc, char** argv) {
   std::optional<int> http_port;
   std::optional<std::string> http_bind;
   std::string log_level = "info";
-  app.add_option("--config", config_path, "YAML config file (see config/scenewatchd.yaml); default: built-in defaults");
+  app.set_version_flag("--version", "scenewatchd " SCENEWATCH_VERSION);
+  app.add_option("--config", config_path,
+                 "YAML config file (see config/scenewatchd.yaml); default: an installed daemon's "
+                 "scenewatchd.yaml (/etc/scenewatch/, or PREFIX/etc/scenewatch/), else built-in defaults");
   app.add_option("--port", port, "TCP port, 0 = pick a free one (overrides server.port)")->check(CLI::Range(0, 65535));
   app.add_option("--address", address, "listen address (overrides server.address)");
   app.add_option("--model-dir", model_dir, "model directory, '' = none (overrides server.model_dir)");
@@ -119,8 +123,20 @@ int main(int argc, char** argv) {
   StderrLog log(min_level);
   std::signal(SIGPIPE, SIG_IGN);
 
+  // An installed daemon reads the shipped config when given none; one run from the build tree
+  // keeps the built-in defaults (the same values), as before it could be installed.
+  const std::filesystem::path installed_config = scenewatch::apps::config_dir() / "scenewatchd.yaml";
+  if (config_path.empty() && !scenewatch::apps::installed_prefix().empty()) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(installed_config, ec)) {
+      config_path = installed_config.string();
+    } else {
+      log(LogLevel::kWarning, "config: no " + installed_config.string() + " (was it removed?); using the built-in defaults");
+    }
+  }
   scenewatch::service::DaemonConfig config;
   if (!config_path.empty()) {
+    log(LogLevel::kInfo, "config: " + config_path);
     auto loaded = scenewatch::service::load_daemon_config(config_path);
     if (!loaded) {
       log(LogLevel::kError, "config: " + loaded.error().message);
@@ -194,7 +210,7 @@ int main(int argc, char** argv) {
   // The object classes: the classes file, overlaid by those defined through DefineClass, which
   // ontology.sqlite in the model directory keeps.
   const std::filesystem::path classes_file =
-      config.ontology.classes_file.empty() ? std::filesystem::path(SCENEWATCH_CLASSES_FILE) : config.ontology.classes_file;
+      config.ontology.classes_file.empty() ? scenewatch::apps::config_dir() / "ontology.yaml" : config.ontology.classes_file;
   std::filesystem::path class_store;
   if (!model.empty()) {
     std::error_code ec;
