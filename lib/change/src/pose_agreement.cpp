@@ -10,7 +10,6 @@ namespace scenewatch::change {
 namespace {
 
 constexpr std::size_t kMinSamples = 100;
-constexpr double kPi = 3.14159265358979323846;
 // Residuals beyond this many metres are occlusions or changes, not misalignment.
 constexpr double kWindowM = 0.15;
 // Surfaces seen more obliquely than this give no normal worth fitting to (cos 75 degrees).
@@ -165,7 +164,7 @@ PoseAgreement pose_agreement(const background::DenseGrid& grid, const Cloud& clo
   // The misalignment: the motion that takes the frame from its given pose to the corrected one.
   out.correction = corrected * T.inverse();
   out.translation_m = (T.translation() - corrected.translation()).norm();
-  out.rotation_deg = Eigen::AngleAxisd(out.correction.linear()).angle() * 180.0 / kPi;
+  out.rotation_deg = Eigen::AngleAxisd(out.correction.linear()).angle() * 180.0 / M_PI;
   double sum = 0;
   for (const Sample& s : first) sum += std::pow(out.shift_at(s.world), 2);
   out.rms_shift_m = std::sqrt(sum / static_cast<double>(first.size()));

@@ -6,14 +6,13 @@
 namespace scenewatch {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Incidence is capped here: the angle terms of Nguyen's model diverge at 90 degrees.
-constexpr double kMaxIncidenceRad = 89.0 * kPi / 180.0;
+constexpr double kMaxIncidenceRad = 89.0 * M_PI / 180.0;
 
 // Nguyen, Izadi & Lovell 2012, eq. (2): the Kinect's axial noise, head-on, and its angle term.
 double nguyen_axial_m(double z) { return 0.0012 + 0.0019 * (z - 0.4) * (z - 0.4); }
 double nguyen_angle_term_m(double z, double theta) {
-  const double t = theta / (kPi / 2 - theta);
+  const double t = theta / (M_PI / 2 - theta);
   return 0.0001 / std::sqrt(std::max(z, 0.1)) * t * t;
 }
 
@@ -33,13 +32,13 @@ double SensorModel::sigma_z(double z, double incidence_rad) const {
 double SensorModel::lateral_sigma_px(double incidence_rad) const {
   const double theta = std::clamp(incidence_rad, 0.0, kMaxIncidenceRad);
   // Nguyen 2012, eq. (3): 0.8 + 0.035 theta / (pi/2 - theta) px, scaled to this profile.
-  return lateral_px * (1.0 + 0.035 / 0.8 * theta / (kPi / 2 - theta));
+  return lateral_px * (1.0 + 0.035 / 0.8 * theta / (M_PI / 2 - theta));
 }
 
 int SensorModel::edge_band_px(double sigma_factor) const { return static_cast<int>(std::ceil(sigma_factor * lateral_px - 1e-9)); }
 
 double SensorModel::pose_sigma_at(double range_m) const {
-  const double arc = range_m * pose_sigma_deg * kPi / 180.0;
+  const double arc = range_m * pose_sigma_deg * M_PI / 180.0;
   return std::sqrt(pose_sigma_m * pose_sigma_m + arc * arc);
 }
 
