@@ -23,23 +23,6 @@ struct Recording {
   bool z_up = false;  ///< the simulator's world has z up
 };
 
-/// A real recording; `forth_and_back` plays it forwards, then backwards (every view revisited).
-std::optional<Recording> real(const Options& o, const std::string& name, const std::string& folder,
-                              bool forth_and_back = false) {
-  auto seq = io::open_sequence(o.data_dir / folder);
-  if (!seq) {
-    std::printf("  (skipped %s: %s)\n", name.c_str(), seq.error().message.c_str());
-    return std::nullopt;
-  }
-  auto shared = std::make_shared<io::Sequence>(std::move(*seq));
-  const std::size_t n = shared->frames.size();
-  return Recording{name, forth_and_back ? 2 * n : n, [shared, n](std::size_t i) -> std::optional<Frame> {
-                     auto f = io::load_sequence_frame(*shared, i < n ? i : 2 * n - 1 - i);
-                     if (!f) return std::nullopt;
-                     return std::move(*f);
-                   }};
-}
-
 std::optional<Recording> simulated(const std::string& scenario, int width, int height) {
   auto loaded = sim::load_scenario(std::filesystem::path(SCENEWATCH_SOURCE_DIR) / "sample_clouds/scenarios" / (scenario + ".yaml"));
   if (!loaded) return std::nullopt;
@@ -61,16 +44,26 @@ std::optional<Recording> simulated(const std::string& scenario, int width, int h
   return r;
 }
 
-/// Frames of one real recording in a given order, each with the camera it is sent as (empty: the
-/// frame's own, unnamed).
-std::optional<Recording> reordered(const Options& o, const std::string& name, const std::string& folder,
-                                   std::vector<std::size_t> order, std::vector<std::string> cameras = {}) {
+std::vector<std::size_t> range(std::size_t from, std::size_t to) {  // [from, to)
+  std::vector<std::size_t> v;
+  for (std::size_t i = from; i < to; ++i) v.push_back(i);
+  return v;
+}
+
+/// Which frames of a recording of `frames` frames to play, in what order.
+using Order = std::function<std::vector<std::size_t>(std::size_t frames)>;
+
+/// Frames of one real recording in the given order, each with the camera it is sent as (empty:
+/// the frame's own, unnamed).
+std::optional<Recording> reordered(const Options& o, const std::string& name, const std::string& folder, const Order& order_of,
+                                   std::vector<std::string> cameras = {}) {
   auto seq = io::open_sequence(o.data_dir / folder);
   if (!seq) {
     std::printf("  (skipped %s: %s)\n", name.c_str(), seq.error().message.c_str());
     return std::nullopt;
   }
   auto shared = std::make_shared<io::Sequence>(std::move(*seq));
+  std::vector<std::size_t> order = order_of(shared->frames.size());
   for (std::size_t i : order) {
     if (i >= shared->frames.size()) {
       std::printf("  (skipped %s: %s has %zu frames)\n", name.c_str(), folder.c_str(), shared->frames.size());
@@ -86,10 +79,19 @@ std::optional<Recording> reordered(const Options& o, const std::string& name, co
                    }};
 }
 
-std::vector<std::size_t> range(std::size_t from, std::size_t to) {  // [from, to)
-  std::vector<std::size_t> v;
-  for (std::size_t i = from; i < to; ++i) v.push_back(i);
-  return v;
+/// Every frame in order, or forwards then backwards (every view revisited).
+Order every_frame(bool forth_and_back = false) {
+  return [forth_and_back](std::size_t n) {
+    std::vector<std::size_t> order = range(0, n);
+    if (forth_and_back)
+      for (std::size_t i = n; i-- > 0;) order.push_back(i);
+    return order;
+  };
+}
+
+/// A fixed list of frames.
+Order these_frames(std::vector<std::size_t> order) {
+  return [order = std::move(order)](std::size_t) { return order; };
 }
 
 struct Variant {
@@ -136,8 +138,6 @@ void run_table(const std::vector<Recording>& recordings, const std::vector<Varia
 int run_sensor_model(const Options& o) {
   std::printf("\n== The calm stream on the kitchen it was not tuned on (issue 28): redkitchen_long, 250 frames (files 0-498,\n"
               "   every second); remedies tuned on files 0-248 only\n");
-  std::vector<std::size_t> forth_and_back = range(0, 250);
-  for (std::size_t i = 250; i-- > 0;) forth_and_back.push_back(i);
   std::vector<std::size_t> interleaved;
   std::vector<std::string> two, one;
   for (std::size_t i = 0; i < 100; ++i) {
@@ -145,12 +145,12 @@ int run_sensor_model(const Options& o) {
     interleaved.push_back(150 + i), two.push_back("b"), one.push_back("one");
   }
   std::vector<Recording> recordings;
-  for (auto r : {reordered(o, "long files 0-248 (tuned on)", "redkitchen_long", range(0, 125)),
-                 reordered(o, "long files 250-498 (held out)", "redkitchen_long", range(125, 250)),
-                 reordered(o, "long all 250", "redkitchen_long", range(0, 250)),
-                 reordered(o, "long forth and back (500)", "redkitchen_long", forth_and_back),
-                 reordered(o, "long two cameras (0-198 a, 300-498 b)", "redkitchen_long", interleaved, two),
-                 reordered(o, "long the same sent as one camera", "redkitchen_long", interleaved, one)}) {
+  for (auto r : {reordered(o, "long files 0-248 (tuned on)", "redkitchen_long", these_frames(range(0, 125))),
+                 reordered(o, "long files 250-498 (held out)", "redkitchen_long", these_frames(range(125, 250))),
+                 reordered(o, "long all 250", "redkitchen_long", every_frame()),
+                 reordered(o, "long forth and back (500)", "redkitchen_long", every_frame(true)),
+                 reordered(o, "long two cameras (0-198 a, 300-498 b)", "redkitchen_long", these_frames(interleaved), two),
+                 reordered(o, "long the same sent as one camera", "redkitchen_long", these_frames(interleaved), one)}) {
     if (r) recordings.push_back(std::move(*r));
   }
   run_table(recordings, {
@@ -170,10 +170,10 @@ int run_sensor_model(const Options& o) {
 int run_stream(const Options& o) {
   std::printf("\n== The event stream: events per 100 frames through WorkingMemory (every kind counted)\n");
   std::vector<Recording> recordings;
-  for (auto r : {real(o, "redkitchen (7-Scenes, unchanged room, hand-held)", "redkitchen"),
-                 real(o, "redkitchen forth and back (views revisited)", "redkitchen", true),
-                 real(o, "hrt1 pick_toy_1 (a person picks a toy)", "hrt1/pick_toy_1"),
-                 real(o, "hrt1 pick_toy_2 (the person stays in view)", "hrt1/pick_toy_2"),
+  for (auto r : {reordered(o, "redkitchen (7-Scenes, unchanged room, hand-held)", "redkitchen", every_frame()),
+                 reordered(o, "redkitchen forth and back (views revisited)", "redkitchen", every_frame(true)),
+                 reordered(o, "hrt1 pick_toy_1 (a person picks a toy)", "hrt1/pick_toy_1", every_frame()),
+                 reordered(o, "hrt1 pick_toy_2 (the person stays in view)", "hrt1/pick_toy_2", every_frame()),
                  simulated("clutter", 320, 240), simulated("cup_added", 320, 240), simulated("object_moved", 320, 240)}) {
     if (r) recordings.push_back(std::move(*r));
   }
