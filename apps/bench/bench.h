@@ -50,5 +50,7 @@ int run_pipeline(const Options& o);
 int run_memory(const Options& o);
 int run_fit(const Options& o);
 int run_foreground(const Options& o);
+/// Issue 29: the camera placed against the memory, each mode; dense alignment against OpenCV and PCL.
+int run_localization(const Options& o);
 
 }  // namespace scenewatch::bench

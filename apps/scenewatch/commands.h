@@ -134,6 +134,8 @@ struct ReplayOptions {
   bool progress = true;             ///< a progress line on stderr every 25 frames
   std::string heatmap_dir;          ///< when set: surprise-NNNNNN.png per frame with a surprise map
   std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
+  std::string localization;         ///< overrides localization.mode: given, refine or track (empty: the config's)
+  std::string trajectory;           ///< when set: the poses the memory used, as a TUM trajectory
 };
 /// Offline: recordings through the working memory as the daemon would run them; prints the
 /// event stream and a summary (events per 100 frames, time per frame and per stage).

@@ -239,6 +239,12 @@ int main(int argc, char** argv) {
                      "write each frame's image surprise over its colour image as DIR/surprise-NNNNNN.png");
   replay->add_flag("--json", replay_options.json, "one JSON object per event (with its frame), then a summary object");
   add_depth_scale_option(replay, replay_options.depth_scale_m);
+  replay->add_option("--localization", replay_options.localization,
+                     "where frames were taken: given (trust their poses), refine (align the given pose to the memory; "
+                     "the default), track (no poses needed); overrides localization.mode")
+      ->check(CLI::IsMember({"given", "refine", "track"}));
+  replay->add_option("--trajectory", replay_options.trajectory,
+                     "write the poses the memory used (aligned frames) as a TUM trajectory: t tx ty tz qx qy qz qw");
   bool scenario_check = false;
   RemoteOptions scenario_remote;
   replay->add_flag("--check", scenario_check, "scenario scripts: exit 1 when an expectation is not met");

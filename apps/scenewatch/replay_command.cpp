@@ -16,6 +16,7 @@
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/core/event_json.h"
 #include "scenewatch/io/image_io.h"
+#include "scenewatch/io/rgbd.h"
 #include "scenewatch/pipeline/working_memory.h"
 
 namespace scenewatch::cli {
@@ -50,11 +51,50 @@ std::string event_line(std::size_t frame, const Event& e, double range_m) {
   return line;
 }
 
+// What localization made of the frames: states, corrections of the given poses, its time.
+struct LocalizationSummary {
+  std::map<std::string, std::size_t> states;
+  std::vector<double> correction_mm, correction_deg, ms;
+  std::vector<io::StampedPose> trajectory;
+
+  void add(const Frame& frame, const localization::Localization& l) {
+    ++states[localization::state_name(l.state)];
+    if (l.placed()) trajectory.push_back({frame.stamp_s, l.T_world_camera});
+    if (l.state == localization::State::kGiven) return;
+    ms.push_back(l.ms);
+    if (l.given && l.mode == LocalizationMode::kRefine && l.state == localization::State::kTracking) {
+      correction_mm.push_back(1000 * l.correction_m);
+      correction_deg.push_back(l.correction_deg);
+    }
+  }
+  std::string line() const {
+    std::string out = "localization:";
+    for (const auto& [state, n] : states) out += " " + state + " " + std::to_string(n);
+    char buf[200];
+    if (!correction_mm.empty()) {
+      std::snprintf(buf, sizeof buf, "; correction of the given poses median %.1f mm %.2f deg, p95 %.1f mm", percentile(correction_mm, 0.5),
+                    percentile(correction_deg, 0.5), percentile(correction_mm, 0.95));
+      out += buf;
+    }
+    if (!ms.empty()) {
+      std::snprintf(buf, sizeof buf, "; median %.1f ms", percentile(ms, 0.5));
+      out += buf;
+    }
+    return out;
+  }
+};
+
 }  // namespace
 
 int run_replay(const ReplayOptions& options) {
   auto config = read_config_file(options.config);
   if (!config) return fail(config.error().message);
+  if (!options.localization.empty()) {
+    auto mode = localization::parse_mode(options.localization);
+    if (!mode) return fail("--localization: " + mode.error().message);
+    config->localization.mode = *mode;
+  }
+  LocalizationSummary located;
   if (!options.heatmap_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(options.heatmap_dir, ec);
@@ -77,6 +117,11 @@ int run_replay(const ReplayOptions& options) {
       auto result = memory.process(frame);
       if (!result) return Error{result.error().code, frame.source + ": " + result.error().message};
       frame_ms.push_back(result->total_ms);
+      located.add(frame, result->localization);
+      if (options.json && !result->localization.placed()) {
+        std::cout << nlohmann::json{{"frame", frames}, {"source", frame.source}, {"localization", "lost"},
+                                    {"reason", result->localization.reason}}.dump() << "\n";
+      }
       stage_ms["segmentation"].push_back(result->segment_ms);
       stage_ms["change"].push_back(result->change_ms);
       stage_ms["surprise"].push_back(result->surprise_ms);
@@ -116,6 +161,9 @@ int run_replay(const ReplayOptions& options) {
     if (!st) return fail(st.error().message);
   }
   const double wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  if (!options.trajectory.empty()) {
+    if (auto st = io::write_tum(options.trajectory, located.trajectory); !st) return fail("--trajectory: " + st.error().message);
+  }
   const double per100 = frames ? 100.0 * total_events / frames : 0.0;
   const auto stats = memory.stats();
   if (options.json) {
@@ -128,7 +176,11 @@ int run_replay(const ReplayOptions& options) {
                               {"p90_frame_ms", percentile(frame_ms, 0.9)},
                               {"tracked_objects", stats.tracked_objects},
                               {"frames_with_hands", frames_with_hands},
-                              {"keyframes", stats.keyframes}};
+                              {"keyframes", stats.keyframes},
+                              {"localization", {{"states", located.states},
+                                                {"median_correction_mm", percentile(located.correction_mm, 0.5)},
+                                                {"median_correction_deg", percentile(located.correction_deg, 0.5)},
+                                                {"median_ms", percentile(located.ms, 0.5)}}}};
     for (const auto& [stage, v] : stage_ms) summary["median_stage_ms"][stage] = percentile(v, 0.5);
     std::cout << summary.dump() << "\n";
     return kExitOk;
@@ -141,6 +193,7 @@ int run_replay(const ReplayOptions& options) {
   for (const auto& [stage, v] : stage_ms) std::printf("  %s %.1f ms", stage.c_str(), percentile(v, 0.5));
   std::printf("\nmodel: %zu tracked objects, %zu keyframes, %zu occupied voxels; hands seen in %zu frames\n",
               stats.tracked_objects, stats.keyframes, stats.map_occupied_leaves, frames_with_hands);
+  std::printf("%s\n", located.line().c_str());
   return kExitOk;
 }
 

@@ -161,6 +161,11 @@ void AppearanceStage::reset() {
   added_at_.clear();
 }
 
+std::vector<std::shared_ptr<const background::Keyframe>> AppearanceStage::nearest(const Pose& T_world_camera, std::size_t n) const {
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  return memory_.nearest(T_world_camera, n);
+}
+
 std::size_t AppearanceStage::keyframes() const {
   std::shared_lock<std::shared_mutex> read(mutex_);
   return memory_.size();

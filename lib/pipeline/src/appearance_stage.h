@@ -26,6 +26,8 @@ class AppearanceStage {
   std::shared_ptr<const SurpriseResult> process(const Frame& frame,
                                                 const std::vector<std::shared_ptr<const surprise::KnownSurface>>& known = {},
                                                 std::uint32_t camera = 0);
+  /// Up to n keyframes seeing towards a pose, nearest first (for localization).
+  std::vector<std::shared_ptr<const background::Keyframe>> nearest(const Pose& T_world_camera, std::size_t n) const;
   /// Forgets what is kept of a camera that is no longer followed.
   void forget_camera(std::uint32_t camera);
 

@@ -35,7 +35,8 @@ Status YamlSection::finish() const {
 
 const std::vector<std::string>& pipeline_sections() {
   static const std::vector<std::string> kSections = {"sensor",     "background", "segmentation", "tracking", "change",
-                                                     "appearance", "surprise",   "events",       "foreground", "workspace"};
+                                                     "appearance", "surprise",   "events",       "foreground", "workspace",
+                                                     "localization"};
   return kSections;
 }
 
@@ -71,6 +72,30 @@ Status read_sensor(const YAML::Node& node, SensorModel& sensor) {
                          [&] { return s.read("pose_sigma_deg", sensor.pose_sigma_deg); });
       !st)
     return st;
+  return s.finish();
+}
+
+// The `localization:` section (issue 29).
+Status read_localization(const YAML::Node& node, localization::Config& l) {
+  YamlSection s(node, "localization");
+  if (auto st = s.check_is_map(); !st) return st;
+  std::string mode = localization::mode_name(l.mode);
+  if (auto st = read_all([&] { return s.read("mode", mode); }, [&] { return s.read("levels", l.pyramid.levels); },
+                         [&] { return s.read("finest_halvings", l.pyramid.finest_halvings); },
+                         [&] { return s.read("iterations", l.alignment.iterations); },
+                         [&] { return s.read("max_correspondence_m", l.alignment.max_correspondence_m); },
+                         [&] { return s.read("photometric_weight", l.alignment.photometric_weight); },
+                         [&] { return s.read("min_gradient", l.alignment.min_gradient); },
+                         [&] { return s.read("min_inlier_fraction", l.min_inlier_fraction); },
+                         [&] { return s.read("min_conditioning", l.min_conditioning); },
+                         [&] { return s.read("max_correction_m", l.max_correction_m); },
+                         [&] { return s.read("max_correction_deg", l.max_correction_deg); },
+                         [&] { return s.read("reference_keyframes", l.reference_keyframes); });
+      !st)
+    return st;
+  auto parsed = localization::parse_mode(mode);
+  if (!parsed) return invalid_argument("localization.mode: " + parsed.error().message);
+  l.mode = *parsed;
   return s.finish();
 }
 
@@ -248,6 +273,7 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
       return st;
     if (auto st = s.finish(); !st) return st;
   }
+  if (auto st = read_localization(root["localization"], c.localization); !st) return st;
   {
     YamlSection s(root["workspace"], "workspace");
     if (auto st = s.check_is_map(); !st) return st;

@@ -232,7 +232,8 @@ struct ChangeOutcome {
 
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
-      : map(c.background), witness(c.background.resolution_m), appearance(c.appearance, c.surprise), changes(c.change),
+      : map(c.background), witness(c.background.resolution_m), appearance(c.appearance, c.surprise),
+        localizer(c.localization, c.sensor), changes(c.change),
         tracker(c.tracking), fusion(c.fusion),
         foreground(c.foreground), snapshot(std::make_shared<SceneSnapshot>()), up(c.segmentation.up) {}
 
@@ -244,6 +245,7 @@ struct WorkingMemory::Impl {
   background::DenseGrid map_grid;  // the change detector's dense copy of the map, its buffers kept between frames
   change::SurfaceWitness witness;  // which cameras saw each surface of the map (guarded with it)
   AppearanceStage appearance;  // keyframes, mesh and image surprise; locks itself for readers
+  localization::Localizer localizer;  // where each camera is, against the keyframes (writer only)
 
   // Owned by the writer.
   change::PersistenceFilter changes;
@@ -450,6 +452,7 @@ struct WorkingMemory::Impl {
       fusion.forget_camera(*forgotten);
       foreground.forget_camera(*forgotten);
       appearance.forget_camera(*forgotten);
+      localizer.forget_camera(*forgotten);
       planes_by_camera.erase(*forgotten);
     }
     return id;
@@ -494,10 +497,19 @@ Status validate(const Config& c) {
   if (auto st = surprise::validate(c.surprise); !st) return st;
   if (auto st = change::validate(c.change); !st) return st;
   if (auto st = foreground::validate(c.foreground); !st) return st;
+  if (auto st = localization::validate(c.localization); !st) return st;
   return {};
 }
 
 namespace {
+// The frame at the pose localization found (unchanged when its pose was taken as given).
+Frame placed(const Frame& frame, const localization::Localization& where) {
+  if (where.state == localization::State::kGiven) return frame;
+  Frame out = frame;
+  out.T_world_camera = where.T_world_camera;
+  return out;
+}
+
 // The one sensor model, handed to every stage that weighs evidence.
 Config with_sensor(Config c) {
   c.change.sensor = c.sensor;
@@ -508,18 +520,27 @@ Config with_sensor(Config c) {
 WorkingMemory::WorkingMemory(Config config) : config_(with_sensor(std::move(config))), impl_(std::make_unique<Impl>(config_)) {}
 WorkingMemory::~WorkingMemory() = default;
 
-Result<FrameResult> WorkingMemory::process(const Frame& frame) {
-  const auto valid_points = validate_frame(frame, config_.workspace_radius_m);
+Result<FrameResult> WorkingMemory::process(const Frame& original) {
+  const auto valid_points = validate_frame(original, config_.workspace_radius_m);
   if (!valid_points) return valid_points.error();
   const auto t0 = Clock::now();
   std::lock_guard<std::mutex> lock(impl_->writer);
   Impl& m = *impl_;
-  const Pose T = frame.pose_or_identity();
   FrameResult result;
   result.frame_index = m.frames;
   result.points = *valid_points;
+  const std::uint32_t camera_id = m.camera_of(original);
+  // Where the frame was taken, against the memory; a camera that is lost changes nothing.
+  result.localization =
+      m.localizer.localize(original, camera_id, [&](const Pose& p, std::size_t n) { return m.appearance.nearest(p, n); });
+  if (!result.localization.placed()) {
+    ++m.frames;
+    result.total_ms = ms_since(t0);
+    return result;
+  }
+  const Frame frame = placed(original, result.localization);
+  const Pose T = frame.pose_or_identity();
   // Hands, the person and the foreground objects are blanked out of what the background sees.
-  const std::uint32_t camera_id = m.camera_of(frame);
   // The planes this camera saw last (world frame); a camera's first frame starts from the model's.
   const auto own_planes = m.planes_by_camera.find(camera_id);
   const Frame seen = m.foreground.prepare(frame, m.frames, own_planes != m.planes_by_camera.end() ? own_planes->second : m.planes,
@@ -657,6 +678,7 @@ void WorkingMemory::reset() {
     impl_->witness.reset();
   }
   impl_->appearance.reset();
+  impl_->localizer.reset();
   {
     std::lock_guard<std::mutex> known_lock(impl_->known_mutex);
     impl_->known.clear();
@@ -875,6 +897,7 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
   Impl& m = *impl_;
   // Keyframes last among the reads: AppearanceStage::load changes nothing when it fails.
   if (auto st = m.appearance.load(dir); !st) return st;
+  m.localizer.reset();
   {
     std::unique_lock<std::shared_mutex> write(m.map_mutex);
     m.map = std::move(map);

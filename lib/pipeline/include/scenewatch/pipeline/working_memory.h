@@ -23,6 +23,7 @@
 #include "scenewatch/core/scene.h"
 #include "scenewatch/core/sensor_model.h"
 #include "scenewatch/foreground/foreground_tracker.h"
+#include "scenewatch/localization/localizer.h"
 #include "scenewatch/pipeline/event_fusion.h"
 #include "scenewatch/pipeline/object_tracker.h"
 #include "scenewatch/segmentation/tabletop.h"
@@ -35,6 +36,9 @@ struct Config {
   /// The depth camera and the pose source (the `sensor:` section): every stage that weighs
   /// evidence takes it from here (WorkingMemory copies it into change.sensor).
   SensorModel sensor;
+  /// Where each frame was taken: its given pose trusted, refined against the memory (default),
+  /// or tracked without poses (the `localization:` section, issue 29).
+  localization::Config localization;
   background::Config background;
   segmentation::Config segmentation;
   TrackingConfig tracking;
@@ -77,6 +81,9 @@ Status validate(const Config& config);
 struct FrameResult {
   std::uint64_t frame_index = 0;
   std::size_t points = 0;               ///< valid points in the frame (all of them, whatever was inserted)
+  /// The pose the memory used and how it was found. A frame whose camera is lost changed nothing
+  /// and raised no event.
+  localization::Localization localization;
   std::vector<Plane> planes;            ///< world frame
   std::vector<ObjectCluster> objects;   ///< world frame, indices into the frame's cloud
   std::vector<Event> events;

@@ -1,0 +1,272 @@
+// Localization (issue 29): the camera placed against the memory on the real 7-Scenes kitchen
+// (redkitchen_long, 250 frames), in each mode, against the recording's own poses; then dense
+// frame-to-frame alignment side by side with OpenCV's RgbdICPOdometry and PCL's GICP on the same
+// pairs, on accuracy and time.
+#include <cstdio>
+#include <optional>
+#include <random>
+
+#include <pcl/filters/voxel_grid.h>
+#include <pcl/registration/gicp.h>
+
+#ifdef SCENEWATCH_BENCH_HAS_OPENCV_RGBD
+#include <opencv2/rgbd.hpp>
+#endif
+
+#include "bench.h"
+#include "scenewatch/background/appearance.h"
+#include "scenewatch/io/sequence.h"
+#include "scenewatch/localization/localizer.h"
+
+namespace scenewatch::bench {
+namespace {
+
+
+struct Errors {
+  std::vector<double> m, deg;
+};
+
+void add_error(Errors& e, const Pose& estimate, const Pose& truth) {
+  const auto d = background::view_distance(estimate, truth);
+  e.m.push_back(d.translation_m);
+  e.deg.push_back(d.rotation_deg);
+}
+
+// Odometry as a robot has it: the recording's relative motions, each with a random error
+// (translation N(0, s_t^2 / 3) per axis, so a step's RMS error is s_t; rotation likewise), integrated.
+std::vector<Pose> with_drift(const std::vector<Pose>& truth, double step_m, double step_deg, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> t(0.0, step_m / std::sqrt(3.0)), r(0.0, step_deg * M_PI / 180.0 / std::sqrt(3.0));
+  std::vector<Pose> out{truth.front()};
+  for (std::size_t i = 1; i < truth.size(); ++i) {
+    Eigen::Matrix<double, 6, 1> xi;
+    xi << t(rng), t(rng), t(rng), r(rng), r(rng), r(rng);
+    out.push_back(Pose(out.back() * truth[i - 1].inverse() * truth[i] * localization::twist_exp(xi)));
+  }
+  return out;
+}
+
+struct Trajectory {
+  std::vector<Pose> used;
+  std::size_t lost = 0;
+  std::vector<double> ms;
+};
+
+// Runs the localizer over the recording as the pipeline does: each placed frame may become a
+// keyframe of the memory (AppearanceMemory's default spacing) at the pose it was placed at.
+Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& given, LocalizationMode mode,
+               localization::Config lc = {}) {
+  background::AppearanceMemory memory;
+  localization::Localizer localizer(lc);
+  Trajectory out;
+  for (std::size_t i = 0; i < seq.frames.size(); ++i) {
+    auto frame = io::load_sequence_frame(seq, i);
+    if (!frame) {
+      std::fprintf(stderr, "  %s\n", frame.error().message.c_str());
+      out.used.push_back(Pose::Identity());
+      continue;
+    }
+    frame->T_world_camera = given[i];
+    frame->localization = mode;
+    const auto r = localizer.localize(*frame, 0, [&](const Pose& p, std::size_t n) { return memory.nearest(p, n); });
+    out.used.push_back(r.T_world_camera);
+    out.ms.push_back(r.ms);
+    if (!r.placed()) {
+      ++out.lost;
+      continue;
+    }
+    frame->T_world_camera = r.T_world_camera;
+    if (auto kf = background::keyframe_from_frame(*frame)) (void)memory.consider(std::move(*kf));
+  }
+  return out;
+}
+
+void print_errors(const char* what, const Errors& e, const Trajectory& t) {
+  std::printf("  %-58s median %5.1f mm %5.2f deg | p95 %5.1f mm %5.2f deg | max %6.1f mm | lost %3zu | %5.1f ms/frame\n", what,
+              1000 * median(e.m), median(e.deg), 1000 * quantile(e.m, 0.95), quantile(e.deg, 0.95),
+              1000 * quantile(e.m, 1.0), t.lost, median(t.ms));
+}
+
+// Both trajectories relative to their own first pose; RMS of the translation differences.
+double relative_rmse(const std::vector<Pose>& estimate, const std::vector<Pose>& truth) {
+  double sum = 0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    const Pose e = estimate.front().inverse() * estimate[i];
+    const Pose g = truth.front().inverse() * truth[i];
+    sum += (e.translation() - g.translation()).squaredNorm();
+  }
+  return std::sqrt(sum / truth.size());
+}
+
+int run_trajectories(const io::Sequence& seq, const std::vector<Pose>& truth) {
+  std::printf("\nlocalization: the 250 frames of redkitchen_long (every second frame of the recording), errors against its poses\n");
+  {
+    std::vector<std::optional<Pose>> given(truth.begin(), truth.end());
+    const Trajectory t = run(seq, given, LocalizationMode::kRefine);
+    Errors e;
+    for (std::size_t i = 0; i < truth.size(); ++i) add_error(e, t.used[i], truth[i]);
+    print_errors("refine, the recording's own poses (correction)", e, t);
+  }
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const auto drifted = with_drift(truth, 0.003, 0.15, seed);
+    std::vector<std::optional<Pose>> given(drifted.begin(), drifted.end());
+    Errors before;
+    for (std::size_t i = 0; i < truth.size(); ++i) add_error(before, drifted[i], truth[i]);
+    const Trajectory none{drifted, 0, {0.0}};
+    const std::string label = "drift 3 mm + 0.15 deg/frame, seed " + std::to_string(seed);
+    print_errors(("given: " + label).c_str(), before, none);
+    for (const bool told : {false, true}) {
+      localization::Config lc;
+      if (told) {  // the odometry's drift rate, as a user who knows it would configure it
+        lc.drift_m_per_frame = 0.003;
+        lc.drift_deg_per_frame = 0.15;
+      }
+      const Trajectory t = run(seq, given, LocalizationMode::kRefine, lc);
+      Errors e;
+      for (std::size_t i = 0; i < truth.size(); ++i) add_error(e, t.used[i], truth[i]);
+      print_errors(((told ? "refine, drift configured: " : "refine, default drift: ") + label).c_str(), e, t);
+    }
+  }
+  {
+    std::vector<std::optional<Pose>> none(truth.size());
+    const Trajectory t = run(seq, none, LocalizationMode::kTrack);
+    std::printf("  %-58s RMSE %5.1f mm over %zu frames (both relative to their first pose) | lost %3zu | %5.1f ms/frame\n",
+                "track, no poses, from an empty memory", 1000 * relative_rmse(t.used, truth), truth.size(), t.lost, median(t.ms));
+  }
+  return 0;
+}
+
+// ---- pairs: ours against OpenCV and PCL ----
+
+struct PairResult {
+  Errors errors;
+  std::vector<double> ms;
+  std::size_t failed = 0;
+};
+
+void print_pair(const char* what, const PairResult& r) {
+  std::printf("  %-34s median %5.1f mm %5.2f deg | p95 %6.1f mm %5.2f deg | failed %2zu | median %6.1f ms\n", what,
+              1000 * median(r.errors.m), median(r.errors.deg), 1000 * quantile(r.errors.m, 0.95), quantile(r.errors.deg, 0.95),
+              r.failed, median(r.ms));
+}
+
+pcl::PointCloud<pcl::PointXYZ>::Ptr thinned(const Cloud& c, float leaf) {
+  pcl::PointCloud<pcl::PointXYZ>::Ptr xyz(new pcl::PointCloud<pcl::PointXYZ>);
+  for (const auto& p : c.points)
+    if (is_valid(p) && p.z > 0.4f && p.z < 4.5f) xyz->push_back({p.x, p.y, p.z});
+  pcl::VoxelGrid<pcl::PointXYZ> grid;
+  grid.setLeafSize(leaf, leaf, leaf);
+  grid.setInputCloud(xyz);
+  pcl::PointCloud<pcl::PointXYZ>::Ptr out(new pcl::PointCloud<pcl::PointXYZ>);
+  grid.filter(*out);
+  return out;
+}
+
+#ifdef SCENEWATCH_BENCH_HAS_OPENCV_RGBD
+struct CvImages {
+  cv::Mat gray, depth, mask;
+};
+CvImages cv_images(const Cloud& c) {
+  CvImages m{cv::Mat(c.height, c.width, CV_8UC1), cv::Mat(c.height, c.width, CV_32FC1), cv::Mat(c.height, c.width, CV_8UC1)};
+  for (std::uint32_t v = 0; v < c.height; ++v)
+    for (std::uint32_t u = 0; u < c.width; ++u) {
+      const auto& p = c.at(u, v);
+      m.gray.at<std::uint8_t>(v, u) = static_cast<std::uint8_t>((p.r + p.g + p.b) / 3);
+      const bool ok = is_valid(p) && p.z > 0.4f && p.z < 4.5f;
+      m.depth.at<float>(v, u) = ok ? p.z : std::numeric_limits<float>::quiet_NaN();
+      m.mask.at<std::uint8_t>(v, u) = ok ? 255 : 0;
+    }
+  return m;
+}
+#endif
+
+int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
+  // Pairs 3 list entries apart (6 frames of the 30 Hz recording, 0.2 s), every 5th entry.
+  const std::size_t gap = 3;
+  std::printf("\nlocalization: frame-to-frame alignment, %zu pairs 0.2 s apart, from the identity, errors against the recording's relative poses\n",
+              (seq.frames.size() - gap + 4) / 5);
+  PairResult ours, ours_geometric, opencv, gicp, none;
+  localization::AlignmentConfig geometric;
+  geometric.photometric_weight = 0;
+  const localization::Config defaults;
+  const SensorModel sensor;
+  for (std::size_t i = 0; i + gap < seq.frames.size(); i += 5) {
+    auto a = io::load_sequence_frame(seq, i);
+    auto b = io::load_sequence_frame(seq, i + gap);
+    if (!a || !b) continue;
+    const Pose truth_ab = truth[i].inverse() * truth[i + gap];  // T_a_b: b's camera in a's
+    add_error(none.errors, Pose::Identity(), truth_ab);
+    localization::RgbdPyramid ref, cur;
+    const Intrinsics& Kf = *a->intrinsics;
+    ours.ms.push_back(time_ms([&] {
+      ref = localization::build_pyramid(*a->cloud, Kf, sensor, defaults.pyramid, true);
+      cur = localization::build_pyramid(*b->cloud, Kf, sensor, defaults.pyramid, false);
+    }));
+    localization::Alignment r;
+    ours.ms.back() += time_ms([&] { r = localization::align(ref, cur, Pose::Identity(), sensor, defaults.alignment); });
+    add_error(ours.errors, r.T_reference_current, truth_ab);
+    ours_geometric.ms.push_back(time_ms([&] { r = localization::align(ref, cur, Pose::Identity(), sensor, geometric); }));
+    add_error(ours_geometric.errors, r.T_reference_current, truth_ab);
+#ifdef SCENEWATCH_BENCH_HAS_OPENCV_RGBD
+    {
+      const CvImages ca = cv_images(*a->cloud), cb = cv_images(*b->cloud);
+      const Intrinsics& K = *a->intrinsics;
+      const cv::Mat camera = (cv::Mat_<float>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+      cv::Mat Rt;
+      bool ok = false;
+      opencv.ms.push_back(time_ms([&] {
+        auto odometry = cv::rgbd::RgbdICPOdometry::create(camera);
+        // src = b, dst = a: Rt maps b's points into a's frame, as T_a_b.
+        ok = odometry->compute(cb.gray, cb.depth, cb.mask, ca.gray, ca.depth, ca.mask, Rt);
+      }));
+      if (!ok) {
+        ++opencv.failed;
+      } else {
+        Eigen::Matrix4d m;
+        for (int r0 = 0; r0 < 4; ++r0)
+          for (int c0 = 0; c0 < 4; ++c0) m(r0, c0) = Rt.at<double>(r0, c0);
+        add_error(opencv.errors, pose_from_matrix(m), truth_ab);
+      }
+    }
+#endif
+    {
+      pcl::GeneralizedIterativeClosestPoint<pcl::PointXYZ, pcl::PointXYZ> g;
+      pcl::PointCloud<pcl::PointXYZ> aligned;
+      gicp.ms.push_back(time_ms([&] {
+        g.setInputSource(thinned(*b->cloud, 0.02f));
+        g.setInputTarget(thinned(*a->cloud, 0.02f));
+        g.align(aligned);
+      }));
+      if (!g.hasConverged()) ++gicp.failed;
+      add_error(gicp.errors, Pose(g.getFinalTransformation().cast<double>()), truth_ab);
+    }
+  }
+  print_pair("no alignment (identity)", none);
+  print_pair("scenewatch dense RGB-D (default)", ours);
+  print_pair("scenewatch dense, geometry only", ours_geometric);
+#ifdef SCENEWATCH_BENCH_HAS_OPENCV_RGBD
+  print_pair("OpenCV rgbd::RgbdICPOdometry", opencv);
+#else
+  std::printf("  OpenCV rgbd::RgbdICPOdometry: not built (libopencv-contrib-dev missing)\n");
+#endif
+  print_pair("PCL GICP (2 cm voxels)", gicp);
+  std::printf("  (ours: pyramids of both frames plus alignment; OpenCV: its pyramids plus alignment; GICP: thinning plus alignment)\n");
+  return 0;
+}
+
+}  // namespace
+
+int run_localization(const Options& o) {
+  auto seq = io::open_sequence(o.data_dir / "redkitchen_long");
+  if (!seq) {
+    std::printf("\nlocalization: skipped (%s)\n", seq.error().message.c_str());
+    return 0;
+  }
+  std::vector<Pose> truth;
+  for (const auto& f : seq->frames) truth.push_back(f.T_world_camera.value_or(Pose::Identity()));
+  int rc = run_pairs(*seq, truth);
+  rc |= run_trajectories(*seq, truth);
+  return rc;
+}
+
+}  // namespace scenewatch::bench

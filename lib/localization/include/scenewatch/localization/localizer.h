@@ -1,0 +1,119 @@
+#pragma once
+/// Where each frame was taken, against the memory (issue 29; DESIGN.md's `localization`). Per
+/// camera, a frame is aligned to the memory's nearest keyframe from a prior: in `refine` mode the
+/// given pose carried by the camera's running correction (T_world_odom: the given poses' frame
+/// and drift undone), in `track` mode (or a frame without a pose) the last pose moved on by the
+/// camera's last motion. A poor alignment leaves the camera `lost`: its frame must change nothing.
+#include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "scenewatch/background/appearance.h"
+#include "scenewatch/core/frame.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/core/sensor_model.h"
+#include "scenewatch/localization/dense_alignment.h"
+#include "scenewatch/localization/rgbd_pyramid.h"
+
+namespace scenewatch::localization {
+
+struct Config {
+  /// `given` by default: `refine` and `track` do not yet meet their accuracy on real data (README).
+  LocalizationMode mode = LocalizationMode::kGiven;
+  PyramidConfig pyramid;
+  AlignmentConfig alignment;
+  /// An alignment whose inliers (three noise sigmas) are fewer than this fraction of the frame's
+  /// depth pixels does not place the frame: the view is not the memory's, or the prior too far.
+  double min_inlier_fraction = 0.3;
+  /// ... nor one the scene does not constrain in every direction (a wall alone): the smallest
+  /// eigenvalue of the normalised information against the largest.
+  double min_conditioning = 1e-3;
+  /// In `refine` mode, a correction of the given pose larger than this is not believed: the
+  /// frame is lost (a jump of the pose source or a wrong alignment; drift is far smaller).
+  double max_correction_m = 0.3;
+  double max_correction_deg = 15.0;
+  /// Keyframes tried in turn, nearest to the prior first, until one aligns.
+  std::size_t reference_keyframes = 2;
+  /// In `refine` mode, how far the given poses may drift from frame to frame, 1 sigma: the pose
+  /// source's drift per frame (an arm's kinematics or motion capture: well under a millimetre; a
+  /// robot's odometry: a few). The refined pose weighs the alignment against the given pose by
+  /// this drift and the alignment's own error (its point-to-plane residual), as a Kalman filter
+  /// of the camera's offset from its given pose; an alignment that disagrees with it by more than
+  /// three sigmas is not believed (the prior is used).
+  double drift_m_per_frame = 0.001;
+  double drift_deg_per_frame = 0.05;
+};
+
+Status validate(const Config& config);
+/// "given", "refine", "track"; an error naming them for anything else.
+Result<LocalizationMode> parse_mode(const std::string& name);
+const char* mode_name(LocalizationMode mode);
+
+enum class State {
+  kGiven,     ///< mode `given`: the pose as it came
+  kStarting,  ///< nothing in the memory to align with yet: the prior is used
+  kTracking,  ///< aligned to the memory
+  kLost,      ///< the last alignment failed: the frame must change nothing
+};
+const char* state_name(State state);
+
+/// Where one frame was placed, and how well.
+struct Localization {
+  LocalizationMode mode = LocalizationMode::kGiven;
+  State state = State::kGiven;
+  Pose T_world_camera = Pose::Identity();  ///< the pose the memory uses (the prior when lost)
+  std::optional<Pose> given;               ///< the frame's own pose, if it had one
+  /// In `refine` mode, how far the used pose lies from the given one.
+  double correction_m = 0.0, correction_deg = 0.0;
+  /// The camera's running correction of its given poses' frame: T_world_camera = T_world_odom x given.
+  Pose T_world_odom = Pose::Identity();
+  double inlier_fraction = 0.0, residual_m = 0.0, conditioning = 0.0;
+  /// In `refine` mode: the alignment disagreed with the given pose beyond its drift, and the
+  /// frame was placed at the prior instead.
+  bool alignment_rejected = false;
+  /// Covariance of the pose's error as a twist in the world frame (translation, rotation).
+  Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
+  std::uint64_t reference_keyframe = 0;  ///< the keyframe it was aligned to (0: none)
+  std::string reason;                    ///< why it is lost, or starting
+  double ms = 0.0;
+  /// True when the frame may change the memory.
+  bool placed() const { return state != State::kLost; }
+};
+
+/// Up to n keyframes near a pose, nearest first (AppearanceMemory::nearest).
+using KeyframeSource = std::function<std::vector<std::shared_ptr<const background::Keyframe>>(const Pose&, std::size_t)>;
+
+/// NOT thread safe: one writer (the pipeline's frame loop).
+class Localizer {
+ public:
+  explicit Localizer(Config config = {}, SensorModel sensor = {});
+
+  /// Places a frame of `camera`. Frames that cannot be aligned (no intrinsics, not organized)
+  /// keep their given pose (state kGiven, with the reason).
+  Localization localize(const Frame& frame, std::uint32_t camera, const KeyframeSource& keyframes);
+  /// The last result of a camera, if it sent a frame.
+  std::optional<Localization> last(std::uint32_t camera) const;
+  void forget_camera(std::uint32_t camera);
+  void reset();
+  const Config& config() const { return config_; }
+
+ private:
+  struct Track;
+  std::shared_ptr<const RgbdPyramid> reference(const background::Keyframe& keyframe);
+  Pose fuse_with_prior(Track& track, const Pose& prior, const Pose& measured, const Alignment& alignment, bool& rejected) const;
+
+  Config config_;
+  SensorModel sensor_;
+  std::map<std::uint32_t, std::shared_ptr<Track>> tracks_;
+  /// Pyramids of recently used keyframes by id, with the use counter of each.
+  std::map<std::uint64_t, std::pair<std::shared_ptr<const RgbdPyramid>, std::uint64_t>> references_;
+  std::uint64_t uses_ = 0;
+};
+
+}  // namespace scenewatch::localization

@@ -1,0 +1,216 @@
+// Dense RGB-D alignment: point-to-plane plus photometric Gauss-Newton, coarse to fine.
+#include "scenewatch/localization/dense_alignment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+
+namespace scenewatch::localization {
+namespace {
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+constexpr double kHuber = 1.345;      // 95 % efficiency on Gaussian residuals
+constexpr double kInlierSigmas = 3.0;
+constexpr double kGateSigmas = 4.0;
+
+double huber_weight(double e) {
+  const double a = std::abs(e);
+  return a <= kHuber ? 1.0 : kHuber / a;
+}
+
+// Adds w * J^T J and w * J^T r.
+void accumulate(Mat6& H, Vec6& b, const Vec6& J, double r, double w) {
+  H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
+  b += w * r * J;
+}
+
+float bilinear(const std::vector<float>& img, int width, float x, float y) {
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const float ax = x - x0, ay = y - y0;
+  const std::size_t i = static_cast<std::size_t>(y0) * width + x0;
+  return (1 - ay) * ((1 - ax) * img[i] + ax * img[i + 1]) + ay * ((1 - ax) * img[i + width] + ax * img[i + width + 1]);
+}
+
+struct Pass {
+  Mat6 H = Mat6::Zero();      // geometric and photometric
+  Vec6 b = Vec6::Zero();
+  Mat6 H_geometric = Mat6::Zero();  // unweighted by Huber, 1 / sigma^2: the information
+  std::size_t valid = 0, correspondences = 0, inliers = 0;
+  double inlier_sq = 0.0, depth_sum = 0.0;
+  std::vector<float> photometric_abs;  // |r| of the photometric terms, for their robust spread
+};
+
+struct LevelInput {
+  const RgbdLevel& ref;
+  const RgbdLevel& cur;
+  double gate_m;
+  double photometric_sigma;
+};
+
+// One pass over the current level's pixels at the pose T_rc.
+Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor, const AlignmentConfig& config) {
+  Pass p;
+  const RgbdLevel& ref = in.ref;
+  const RgbdLevel& cur = in.cur;
+  const Eigen::Matrix3f R = T_rc.linear().cast<float>();
+  const Eigen::Vector3f t = T_rc.translation().cast<float>();
+  const float fx = static_cast<float>(ref.intrinsics.fx), fy = static_cast<float>(ref.intrinsics.fy);
+  const float cx = static_cast<float>(ref.intrinsics.cx), cy = static_cast<float>(ref.intrinsics.cy);
+  const double wphoto = config.photometric_weight;
+  const float min_grad = static_cast<float>(config.min_gradient);
+  for (int v = 0; v < cur.height; ++v) {
+    for (int u = 0; u < cur.width; ++u) {
+      const std::size_t ic = static_cast<std::size_t>(v) * cur.width + u;
+      const float zc = cur.depth_m[ic];
+      if (zc <= 0) continue;
+      ++p.valid;
+      const Eigen::Vector3f q = R * cur.point(u, v, zc) + t;
+      if (q.z() <= 0) continue;
+      const float x = fx * q.x() / q.z() + cx, y = fy * q.y() / q.z() + cy;
+      if (!(x >= 0 && y >= 0 && x < ref.width - 1 && y < ref.height - 1)) continue;
+      const Eigen::Vector3d qd = q.cast<double>();
+      // Geometric: the reference surface at the nearest pixel, its plane.
+      const int iu = static_cast<int>(x + 0.5f), iv = static_cast<int>(y + 0.5f);
+      const std::size_t ir = static_cast<std::size_t>(iv) * ref.width + iu;
+      const float zr = ref.depth_m[ir];
+      if (zr > 0 && std::isfinite(ref.normals[ir].x())) {
+        const Eigen::Vector3f d = q - ref.point(iu, iv, zr);
+        const double sigma = std::hypot(sensor.sigma_z(zc), sensor.sigma_z(zr));
+        if (d.norm() <= std::max(in.gate_m, kGateSigmas * sigma)) {
+          const Eigen::Vector3d n = ref.normals[ir].cast<double>();
+          const double r = n.dot(d.cast<double>());
+          Vec6 J;
+          J << n, qd.cross(n);
+          const double info = 1.0 / (sigma * sigma);
+          accumulate(p.H, p.b, J, r, info * huber_weight(r / sigma));
+          ++p.correspondences;
+          p.depth_sum += zr;
+          if (std::abs(r) <= kInlierSigmas * sigma) {
+            ++p.inliers;
+            p.inlier_sq += r * r;
+            p.H_geometric.selfadjointView<Eigen::Upper>().rankUpdate(J, info);
+          }
+        }
+      }
+      // Photometric: the reference intensity where the point projects, where it has texture.
+      if (wphoto <= 0) continue;
+      const float gx = ref.grad_x[ir], gy = ref.grad_y[ir];
+      if (std::abs(gx) < min_grad && std::abs(gy) < min_grad) continue;
+      const double r = bilinear(ref.intensity, ref.width, x, y) - cur.intensity[ic];
+      const double bgx = bilinear(ref.grad_x, ref.width, x, y), bgy = bilinear(ref.grad_y, ref.width, x, y);
+      const double iz = 1.0 / qd.z();
+      // Gradient through the projection: a = dpi/dq^T grad.
+      const Eigen::Vector3d a(bgx * fx * iz, bgy * fy * iz, -(bgx * fx * qd.x() + bgy * fy * qd.y()) * iz * iz);
+      Vec6 J;
+      J << a, qd.cross(a);
+      const double s = in.photometric_sigma;
+      accumulate(p.H, p.b, J, r, wphoto * huber_weight(r / s) / (s * s));
+      p.photometric_abs.push_back(static_cast<float>(std::abs(r)));
+    }
+  }
+  return p;
+}
+
+double robust_spread(std::vector<float>& abs_residuals, double fallback) {
+  if (abs_residuals.size() < 100) return fallback;
+  auto mid = abs_residuals.begin() + abs_residuals.size() / 2;
+  std::nth_element(abs_residuals.begin(), mid, abs_residuals.end());
+  // 1.4826 x MAD; at least one grey level of an 8-bit image.
+  return std::max(1.4826 * *mid, 1.0 / 255.0);
+}
+
+Mat6 full(const Mat6& upper) {
+  Mat6 m = upper.selfadjointView<Eigen::Upper>();
+  return m;
+}
+
+}  // namespace
+
+Pose twist_exp(const Vec6& xi) {
+  const Eigen::Vector3d v = xi.head<3>(), w = xi.tail<3>();
+  const double theta = w.norm();
+  Pose T = Pose::Identity();
+  if (theta < 1e-12) {
+    T.translation() = v;
+    return T;
+  }
+  const Eigen::Vector3d axis = w / theta;
+  T.linear() = Eigen::AngleAxisd(theta, axis).toRotationMatrix();
+  Eigen::Matrix3d K;
+  K << 0, -axis.z(), axis.y(), axis.z(), 0, -axis.x(), -axis.y(), axis.x(), 0;
+  const Eigen::Matrix3d V = Eigen::Matrix3d::Identity() + (1 - std::cos(theta)) / theta * K +
+                            (theta - std::sin(theta)) / theta * K * K;
+  T.translation() = V * v;
+  return T;
+}
+
+Status validate(const AlignmentConfig& c) {
+  if (c.iterations.empty() || c.iterations.size() > 6)
+    return invalid_argument("localization.iterations: one to six levels, got " + std::to_string(c.iterations.size()));
+  for (int it : c.iterations)
+    if (it < 0 || it > 100) return invalid_argument("localization.iterations: each in [0, 100], got " + std::to_string(it));
+  if (!(c.max_correspondence_m > 0 && c.max_correspondence_m <= 1.0))
+    return invalid_argument("localization.max_correspondence_m: must be in (0, 1] m");
+  if (!(c.photometric_weight >= 0 && c.photometric_weight <= 100))
+    return invalid_argument("localization.photometric_weight: must be in [0, 100]");
+  if (!(c.min_gradient >= 0 && c.min_gradient < 1)) return invalid_argument("localization.min_gradient: must be in [0, 1)");
+  if (!(c.converged_m > 0) || !(c.converged_deg > 0))
+    return invalid_argument("localization.converged_m / converged_deg: must be > 0");
+  return {};
+}
+
+Alignment align(const RgbdPyramid& reference, const RgbdPyramid& current, const Pose& prior, const SensorModel& sensor,
+                const AlignmentConfig& config) {
+  Alignment out;
+  out.T_reference_current = prior;
+  const int levels = static_cast<int>(std::min({reference.levels.size(), current.levels.size(), config.iterations.size()}));
+  if (levels == 0) return out;
+  Pose T = prior;
+  const double converged_rad = config.converged_deg * M_PI / 180.0;
+  for (int l = levels - 1; l >= 0; --l) {
+    LevelInput in{reference.levels[l], current.levels[l], config.max_correspondence_m * std::pow(0.5, levels - 1 - l), 0.1};
+    const int iterations = config.iterations[config.iterations.size() - 1 - l];
+    for (int it = 0; it < iterations; ++it) {
+      Pass pass = linearise(in, T, sensor, config);
+      ++out.iterations;
+      in.photometric_sigma = robust_spread(pass.photometric_abs, in.photometric_sigma);
+      if (pass.correspondences < 60) break;
+      const Mat6 H = full(pass.H);
+      const Vec6 delta = H.ldlt().solve(-pass.b);
+      if (!delta.allFinite()) break;
+      T = twist_exp(delta) * T;
+      if (delta.head<3>().norm() < config.converged_m && delta.tail<3>().norm() < converged_rad) break;
+    }
+  }
+  // Quality at the final pose, on the finest level.
+  LevelInput fine{reference.levels[0], current.levels[0], config.max_correspondence_m * std::pow(0.5, levels - 1), 0.1};
+  AlignmentConfig geometric = config;
+  geometric.photometric_weight = 0;
+  const Pass last = linearise(fine, T, sensor, geometric);
+  out.T_reference_current = T;
+  out.valid_pixels = last.valid;
+  out.inliers = last.inliers;
+  out.inlier_fraction = last.valid ? static_cast<double>(last.inliers) / last.valid : 0.0;
+  out.residual_m = last.inliers ? std::sqrt(last.inlier_sq / last.inliers) : 0.0;
+  if (last.inliers >= 6) {
+    const Mat6 info = full(last.H_geometric);
+    // Information per motion, rotation scaled by the mean depth so both are metres.
+    const double depth = last.correspondences ? last.depth_sum / last.correspondences : 1.0;
+    out.mean_depth_m = depth;
+    Mat6 S = Mat6::Identity();
+    S.bottomRightCorner<3, 3>() *= 1.0 / depth;
+    const Mat6 normalised = S * info * S / static_cast<double>(last.inliers);
+    Eigen::SelfAdjointEigenSolver<Mat6> eig(normalised);
+    out.conditioning = eig.eigenvalues()(0) / std::max(eig.eigenvalues()(5), 1e-30);
+    Eigen::FullPivLU<Mat6> lu(info);
+    if (lu.isInvertible()) out.covariance = lu.inverse();
+  }
+  return out;
+}
+
+}  // namespace scenewatch::localization

@@ -1,0 +1,252 @@
+// Per-camera localization against the memory's keyframes: priors, alignment, lost and found.
+#include "scenewatch/localization/localizer.h"
+
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+namespace scenewatch::localization {
+namespace {
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+constexpr std::size_t kCachedReferences = 16;
+
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+// The adjoint of T for twists (translation, rotation) applied on the left.
+Mat6 adjoint(const Pose& T) {
+  Mat6 A = Mat6::Zero();
+  const Eigen::Matrix3d R = T.linear();
+  A.topLeftCorner<3, 3>() = R;
+  A.topRightCorner<3, 3>() = skew(T.translation()) * R;
+  A.bottomRightCorner<3, 3>() = R;
+  return A;
+}
+
+bool organized_with_intrinsics(const Frame& f) {
+  return f.cloud && f.intrinsics && f.intrinsics->valid() && f.cloud->height > 1 &&
+         f.cloud->width == static_cast<std::uint32_t>(f.intrinsics->width) &&
+         f.cloud->height == static_cast<std::uint32_t>(f.intrinsics->height);
+}
+
+}  // namespace
+
+struct Localizer::Track {
+  bool started = false;
+  Pose last = Pose::Identity();      ///< the last placed pose
+  Pose motion = Pose::Identity();    ///< last^-1 x the one before's successor: the camera's last step
+  Pose T_world_odom = Pose::Identity();
+  /// Variance of the camera's placement relative to the memory (refine mode): m^2, rad^2.
+  double var_m2 = 0.0, var_rad2 = 0.0;
+  Localization result;
+};
+
+Status validate(const Config& c) {
+  if (auto st = validate(c.alignment); !st) return st;
+  if (c.pyramid.levels != static_cast<int>(c.alignment.iterations.size()))
+    return invalid_argument("localization.levels: " + std::to_string(c.pyramid.levels) + " levels but " +
+                            std::to_string(c.alignment.iterations.size()) + " entries in localization.iterations");
+  if (c.pyramid.finest_halvings < 0 || c.pyramid.finest_halvings > 3)
+    return invalid_argument("localization.finest_halvings: must be in [0, 3]");
+  if (!(c.min_inlier_fraction >= 0 && c.min_inlier_fraction <= 1))
+    return invalid_argument("localization.min_inlier_fraction: must be in [0, 1]");
+  if (!(c.min_conditioning >= 0 && c.min_conditioning < 1)) return invalid_argument("localization.min_conditioning: must be in [0, 1)");
+  if (!(c.max_correction_m > 0) || !(c.max_correction_deg > 0 && c.max_correction_deg <= 180))
+    return invalid_argument("localization.max_correction_m / max_correction_deg: must be > 0 (degrees at most 180)");
+  if (c.reference_keyframes < 1 || c.reference_keyframes > 8)
+    return invalid_argument("localization.reference_keyframes: must be in [1, 8]");
+  return {};
+}
+
+Result<LocalizationMode> parse_mode(const std::string& name) {
+  if (name == "given") return LocalizationMode::kGiven;
+  if (name == "refine") return LocalizationMode::kRefine;
+  if (name == "track") return LocalizationMode::kTrack;
+  return invalid_argument("localization mode '" + name + "': expected given, refine or track");
+}
+
+const char* mode_name(LocalizationMode mode) {
+  switch (mode) {
+    case LocalizationMode::kGiven: return "given";
+    case LocalizationMode::kRefine: return "refine";
+    case LocalizationMode::kTrack: return "track";
+  }
+  return "?";
+}
+
+const char* state_name(State state) {
+  switch (state) {
+    case State::kGiven: return "given";
+    case State::kStarting: return "starting";
+    case State::kTracking: return "tracking";
+    case State::kLost: return "lost";
+  }
+  return "?";
+}
+
+Localizer::Localizer(Config config, SensorModel sensor) : config_(std::move(config)), sensor_(std::move(sensor)) {}
+
+std::shared_ptr<const RgbdPyramid> Localizer::reference(const background::Keyframe& keyframe) {
+  ++uses_;
+  if (auto it = references_.find(keyframe.id); it != references_.end()) {
+    it->second.second = uses_;
+    return it->second.first;
+  }
+  auto pyramid = std::make_shared<const RgbdPyramid>(
+      build_pyramid(keyframe.depth, keyframe.color, keyframe.intrinsics, sensor_, config_.pyramid, true));
+  if (references_.size() >= kCachedReferences) {
+    auto oldest = references_.begin();
+    for (auto it = references_.begin(); it != references_.end(); ++it)
+      if (it->second.second < oldest->second.second) oldest = it;
+    references_.erase(oldest);
+  }
+  references_[keyframe.id] = {pyramid, uses_};
+  return pyramid;
+}
+
+Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const KeyframeSource& keyframes) {
+  const auto t0 = std::chrono::steady_clock::now();
+  auto& slot = tracks_[camera];
+  if (!slot) slot = std::make_shared<Track>();
+  Track& track = *slot;
+  Localization out;
+  out.mode = frame.localization.value_or(config_.mode);
+  out.given = frame.T_world_camera;
+  const bool use_given = out.mode != LocalizationMode::kTrack && frame.T_world_camera.has_value();
+  // The prior: the given pose in the memory's frame, else the last pose moved on by the last step.
+  const Pose prior = use_given ? track.T_world_odom * *frame.T_world_camera
+                               : (track.started ? Pose(track.last * track.motion) : Pose::Identity());
+  out.T_world_camera = prior;
+  out.T_world_odom = track.T_world_odom;
+  auto finish = [&](Localization r) {
+    r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (r.placed()) {
+      if (track.started) track.motion = track.last.inverse() * r.T_world_camera;
+      track.last = r.T_world_camera;
+      track.started = true;
+      if (use_given) track.T_world_odom = r.T_world_camera * frame.T_world_camera->inverse();
+      r.T_world_odom = track.T_world_odom;
+    }
+    track.result = r;
+    return r;
+  };
+  if (out.mode == LocalizationMode::kGiven) {
+    out.state = State::kGiven;
+    out.T_world_camera = frame.pose_or_identity();
+    return finish(out);
+  }
+  if (!organized_with_intrinsics(frame)) {
+    out.state = State::kGiven;
+    out.reason = "not an organized frame with intrinsics: its pose is used as given";
+    out.T_world_camera = frame.pose_or_identity();
+    return finish(out);
+  }
+  const auto candidates = keyframes ? keyframes(prior, config_.reference_keyframes) : decltype(keyframes(prior, 1)){};
+  if (candidates.empty()) {
+    out.state = State::kStarting;
+    out.reason = "no keyframe near the prior to align with";
+    // A camera that had been placed and now finds no keyframe near its prior has left the
+    // memory's views: that is lost unless the memory is still empty (the first frames).
+    if (track.started && track.result.state == State::kTracking) {
+      out.state = State::kLost;
+      out.reason = "no keyframe of the memory sees towards the prior";
+    }
+    return finish(out);
+  }
+  const RgbdPyramid current = build_pyramid(*frame.cloud, *frame.intrinsics, sensor_, config_.pyramid, false);
+  Localization best = out;
+  best.state = State::kLost;
+  std::optional<Alignment> aligned;
+  for (const auto& keyframe : candidates) {
+    const auto ref = reference(*keyframe);
+    const Alignment a = align(*ref, current, keyframe->T_world_camera.inverse() * prior, sensor_, config_.alignment);
+    Localization r = out;
+    r.T_world_camera = keyframe->T_world_camera * a.T_reference_current;
+    r.inlier_fraction = a.inlier_fraction;
+    r.residual_m = a.residual_m;
+    r.conditioning = a.conditioning;
+    const Mat6 A = adjoint(keyframe->T_world_camera);
+    r.covariance = A * a.covariance * A.transpose();
+    r.reference_keyframe = keyframe->id;
+    if (a.inlier_fraction < config_.min_inlier_fraction) {
+      r.reason = "alignment with keyframe " + std::to_string(keyframe->id) + " poor: " +
+                 std::to_string(static_cast<int>(std::lround(100 * a.inlier_fraction))) + " % of the depth pixels agree";
+    } else if (a.conditioning < config_.min_conditioning) {
+      r.reason = "the view does not constrain every motion (conditioning " + std::to_string(a.conditioning) + ")";
+    } else {
+      r.state = State::kTracking;
+      r.reason.clear();
+      best = r;
+      aligned = a;
+      break;
+    }
+    if (best.reference_keyframe == 0 || r.inlier_fraction > best.inlier_fraction) best = r;
+  }
+  if (!aligned) {
+    best.state = State::kLost;
+    best.T_world_camera = prior;  // a lost frame is placed nowhere new
+    return finish(best);
+  }
+  if (use_given) {
+    best.T_world_camera = fuse_with_prior(track, prior, best.T_world_camera, *aligned, best.alignment_rejected);
+    const auto from_given = background::view_distance(best.T_world_camera, *frame.T_world_camera);
+    best.correction_m = from_given.translation_m;
+    best.correction_deg = from_given.rotation_deg;
+    const auto moved = background::view_distance(best.T_world_camera, prior);
+    if (moved.translation_m > config_.max_correction_m || moved.rotation_deg > config_.max_correction_deg) {
+      best.state = State::kLost;
+      best.reason = "the alignment moved the given pose too far (" + std::to_string(moved.translation_m) + " m, " +
+                    std::to_string(moved.rotation_deg) + " deg)";
+      best.T_world_camera = prior;
+    }
+  }
+  return finish(best);
+}
+
+// Refine mode: the camera's placement relative to the memory is a random walk (the pose source's
+// drift per frame) measured by each alignment, whose error is taken as its residual (a point's
+// noise: the covariance of the least-squares fit is far smaller than its real error, which
+// correlated noise, depth distortion and the keyframe's own error make). Translation and rotation
+// are filtered apart, each with a scalar Kalman gain; a measurement more than three sigmas from
+// the prediction is not believed.
+Pose Localizer::fuse_with_prior(Track& track, const Pose& prior, const Pose& measured, const Alignment& a, bool& rejected) const {
+  const double drift_rad = config_.drift_deg_per_frame * M_PI / 180.0;
+  track.var_m2 += config_.drift_m_per_frame * config_.drift_m_per_frame;
+  track.var_rad2 += drift_rad * drift_rad;
+  const double r_m2 = a.residual_m * a.residual_m;
+  const double depth = a.mean_depth_m > 0 ? a.mean_depth_m : 1.0;
+  const double r_rad2 = r_m2 / (depth * depth);
+  const Eigen::Vector3d dt = measured.translation() - prior.translation();
+  const Eigen::Quaterniond qp(prior.linear()), qm(measured.linear());
+  const double dr = qp.angularDistance(qm);
+  rejected = dt.norm() > 3.0 * std::sqrt(track.var_m2 + r_m2) || dr > 3.0 * std::sqrt(track.var_rad2 + r_rad2);
+  if (rejected) return prior;
+  const double k_t = track.var_m2 / (track.var_m2 + r_m2), k_r = track.var_rad2 / (track.var_rad2 + r_rad2);
+  track.var_m2 *= 1.0 - k_t;
+  track.var_rad2 *= 1.0 - k_r;
+  Pose fused = Pose::Identity();
+  fused.linear() = qp.slerp(k_r, qm).normalized().toRotationMatrix();
+  fused.translation() = prior.translation() + k_t * dt;
+  return fused;
+}
+
+std::optional<Localization> Localizer::last(std::uint32_t camera) const {
+  auto it = tracks_.find(camera);
+  if (it == tracks_.end() || !it->second) return std::nullopt;
+  return it->second->result;
+}
+
+void Localizer::forget_camera(std::uint32_t camera) { tracks_.erase(camera); }
+
+void Localizer::reset() {
+  tracks_.clear();
+  references_.clear();
+}
+
+}  // namespace scenewatch::localization
