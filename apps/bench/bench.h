@@ -50,5 +50,7 @@ int run_pipeline(const Options& o);
 int run_memory(const Options& o);
 int run_fit(const Options& o);
 int run_foreground(const Options& o);
+/// Where to look next (issue 31): scoring speed against OctoMap, the seed's experiment, the closed loop.
+int run_nbv(const Options& o);
 
 }  // namespace scenewatch::bench
