@@ -52,5 +52,7 @@ int run_fit(const Options& o);
 int run_foreground(const Options& o);
 /// Issue 29: the camera placed against the memory, each mode; dense alignment against OpenCV and PCL.
 int run_localization(const Options& o);
+/// Where to look next (issue 31): scoring speed against OctoMap, the seed's experiment, the closed loop.
+int run_nbv(const Options& o);
 
 }  // namespace scenewatch::bench

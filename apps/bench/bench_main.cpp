@@ -12,8 +12,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> only;
   app.add_option("--data", o.data_dir, "Folder of the real recordings (../shared/data)")->capture_default_str();
   app.add_option("--repetitions,-n", o.repetitions, "Timed runs per case; medians are reported")->capture_default_str()->check(CLI::Range(1, 1000));
-  app.add_option("--only", only, "Run only these sections: octomap, segmentation, latency, surprise, change, stream, sensor, pipeline, foreground, fit, localization, memory (memory runs only when named: 1000 frames; sensor, 7000 kitchen frames, only when named)")
-      ->check(CLI::IsMember({"octomap", "segmentation", "latency", "surprise", "change", "stream", "sensor", "pipeline", "foreground", "fit", "localization", "memory"}));
+  app.add_option("--only", only, "Run only these sections: octomap, segmentation, latency, surprise, change, stream, sensor, pipeline, foreground, fit, localization, nbv, memory (memory runs only when named: 1000 frames; sensor, 7000 kitchen frames, only when named)")
+      ->check(CLI::IsMember({"octomap", "segmentation", "latency", "surprise", "change", "stream", "sensor", "pipeline", "foreground", "fit", "localization", "nbv", "memory"}));
   CLI11_PARSE(app, argc, argv);
   if (!std::filesystem::exists(o.data_dir)) {
     std::fprintf(stderr, "scenewatch-bench: data folder '%s' not found (pass --data DIR)\n", o.data_dir.c_str());
@@ -32,6 +32,7 @@ int main(int argc, char** argv) {
   if (want("foreground")) rc |= scenewatch::bench::run_foreground(o);
   if (want("fit")) rc |= scenewatch::bench::run_fit(o);
   if (want("localization")) rc |= scenewatch::bench::run_localization(o);
+  if (want("nbv")) rc |= scenewatch::bench::run_nbv(o);
   // A long run: only when asked for by name.
   if (std::find(only.begin(), only.end(), "memory") != only.end()) rc |= scenewatch::bench::run_memory(o);
   return rc;

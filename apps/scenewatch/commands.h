@@ -64,6 +64,17 @@ int run_define_class(const RemoteOptions& options, const std::string& yaml_file)
 int run_events(const RemoteOptions& options, std::uint64_t since, std::uint32_t max_count);
 int run_watch(const RemoteOptions& options);
 
+/// Where to look next (NextBestView): exactly one target of object, event, box or workspace.
+struct NextViewOptions {
+  std::optional<std::uint64_t> object_id, event_id;
+  std::vector<double> box;  ///< MINX MINY MINZ MAXX MAXY MAXZ, or empty
+  bool workspace = false;
+  std::string measure;      ///< empty: the daemon's default for the target
+  std::uint32_t n = 5;
+  double radius_m = 0.0;    ///< 0: the daemon's default
+};
+int run_next_view(const RemoteOptions& options, const NextViewOptions& next);
+
 struct SurpriseOptions {
   std::string observed;                 ///< frame spec (see frame_spec.h); empty: the daemon's last map
   std::vector<std::string> references;  ///< frame specs; empty: ask the daemon

@@ -163,6 +163,30 @@ int main(int argc, char** argv) {
   add_remote_options(watch, remote);
   watch->callback([&] { action = [&] { return run_watch(remote); }; });
 
+  NextViewOptions next_view;
+  std::uint64_t next_object = 0, next_event = 0;
+  auto* next = app.add_subcommand("next-view", "where to look next: camera poses that would see most of a target's unknown side");
+  auto* next_object_opt = next->add_option("--object", next_object, "a tracked object's id (complete its model)");
+  auto* next_event_opt = next->add_option("--event", next_event, "an event's id (confirm or dismiss it)");
+  auto* next_box_opt = next->add_option("--box", next_view.box, "MINX MINY MINZ MAXX MAXY MAXZ (world)")->expected(6);
+  auto* next_ws_opt = next->add_flag("--workspace", next_view.workspace, "every tracked object");
+  next->add_option("--measure", next_view.measure, "unobserved, rear_side, rear_side_entropy, occlusion_aware, visible");
+  next->add_option("-n", next_view.n, "views to return")->capture_default_str()->check(CLI::Range(1, 1000));
+  next->add_option("--radius", next_view.radius_m, "distance from the target's centre, m (0: the daemon's 0.7)");
+  add_remote_options(next, remote);
+  next->callback([&, next_object_opt, next_event_opt, next_box_opt, next_ws_opt] {
+    action = [&, next_object_opt, next_event_opt, next_box_opt, next_ws_opt] {
+      const std::size_t targets = next_object_opt->count() + next_event_opt->count() + next_box_opt->count() + next_ws_opt->count();
+      if (targets != 1) {
+        std::cerr << "scenewatch next-view: give exactly one of --object, --event, --box, --workspace\n";
+        return kExitUsage;
+      }
+      if (next_object_opt->count()) next_view.object_id = next_object;
+      if (next_event_opt->count()) next_view.event_id = next_event;
+      return run_next_view(remote, next_view);
+    };
+  });
+
   SegmentOptions segment_options;
   auto* segment = app.add_subcommand(
       "segment", "offline: find supporting planes and the objects on them in a cloud file (no daemon)");

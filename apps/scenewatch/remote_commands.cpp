@@ -636,3 +636,58 @@ int run_watch(const RemoteOptions& options) {
 }
 
 }  // namespace scenewatch::cli
+
+namespace scenewatch::cli {
+
+int run_next_view(const RemoteOptions& options, const NextViewOptions& next) {
+  proto::Request request;
+  auto* q = request.mutable_next_best_view();
+  if (next.object_id) q->set_object_id(*next.object_id);
+  if (next.event_id) q->set_event_id(*next.event_id);
+  if (next.box.size() == 6) {
+    auto* b = q->mutable_box();
+    b->mutable_min()->set_x(next.box[0]);
+    b->mutable_min()->set_y(next.box[1]);
+    b->mutable_min()->set_z(next.box[2]);
+    b->mutable_max()->set_x(next.box[3]);
+    b->mutable_max()->set_y(next.box[4]);
+    b->mutable_max()->set_z(next.box[5]);
+  }
+  if (next.workspace) q->set_workspace(true);
+  q->set_measure(next.measure);
+  q->set_n(next.n);
+  q->set_radius_m(next.radius_m);
+  return simple_call(options, request, [&](const proto::Response& r) {
+    const auto& reply = r.next_best_view();
+    if (options.json) {
+      json views = json::array();
+      for (const auto& v : reply.views()) {
+        views.push_back({{"pose", std::vector<double>(v.pose().matrix().begin(), v.pose().matrix().end())},
+                         {"score", v.score()},
+                         {"expected_coverage", v.expected_coverage()},
+                         {"unknown_voxels", v.unknown_voxels()},
+                         {"rear_side_voxels", v.rear_side_voxels()},
+                         {"motion_m", v.motion_m()},
+                         {"why", v.why()}});
+      }
+      return print_json({{"views", std::move(views)},
+                         {"target", to_json(reply.target())},
+                         {"measure", reply.measure()},
+                         {"coverage", reply.coverage()},
+                         {"target_voxels", reply.target_voxels()},
+                         {"candidates", reply.candidates()}});
+    }
+    std::cout << "target " << text(reply.target().min()) << " .. " << text(reply.target().max()) << ", " << reply.target_voxels()
+              << " voxels, coverage " << reply.coverage() << "; " << reply.candidates() << " candidates by " << reply.measure()
+              << "\n";
+    for (int i = 0; i < reply.views_size(); ++i) {
+      const auto& v = reply.views(i);
+      const auto& m = v.pose().matrix();
+      std::cout << i + 1 << ". camera at (" << m[3] << ", " << m[7] << ", " << m[11] << ") score " << v.score()
+                << ", expected coverage " << v.expected_coverage() << "\n   " << v.why() << "\n";
+    }
+    std::cout << std::flush;
+  });
+}
+
+}  // namespace scenewatch::cli

@@ -203,6 +203,29 @@ class Client:
             message.box.CopyFrom(_box(*box))
         return self._call("query_occupancy", message, result="occupancy")
 
+    def next_best_view(self, object_id=None, box=None, event_id=None, workspace=False, measure="", n=5,
+                       radius_m=0.0, current_pose=None):
+        """Where to look next: give exactly one target (an object id, a box ((min xyz), (max xyz)),
+        an event id, or workspace=True). pb.NextBestViewReply: ``views`` best first, each with
+        ``pose.matrix`` (16 numbers, row-major T_world_camera), ``score``, ``expected_coverage``
+        and ``why``. ``current_pose`` (16 numbers) adds the cost of moving there."""
+        message = pb.NextBestView(measure=measure, n=n, radius_m=radius_m)
+        given = [object_id is not None, box is not None, event_id is not None, bool(workspace)]
+        if sum(given) != 1:
+            raise ValueError("next_best_view: give exactly one of object_id, box, event_id, workspace")
+        if object_id is not None:
+            message.object_id = object_id
+        elif box is not None:
+            message.box.CopyFrom(_box(*box))
+        elif event_id is not None:
+            message.event_id = event_id
+        else:
+            message.workspace = True
+        if current_pose is not None:
+            message.current_pose.matrix.extend(float(v) for v in current_pose)
+            message.motion_cost_per_m = 0.5
+        return self._call("next_best_view", message)
+
     def clear_box(self, minimum, maximum):
         """Marks the known voxels in a world box free: pb.ClearBoxReply (voxels_changed)."""
         return self._call("clear_box", pb.ClearBox(box=_box(minimum, maximum)))

@@ -103,6 +103,17 @@ class ClientTest(unittest.TestCase):
         self.assertTrue(occupancy.HasField("box"))
         self.assertGreater(occupancy.box.occupied_voxels + occupancy.box.free_voxels, 0)
 
+        # NextBestView: seen from one camera, the object's back is unknown; the best view reaches
+        # some of it, so its expected coverage is above the coverage now.
+        nbv = self.client.next_best_view(object_id=top.id, n=3)
+        self.assertIsInstance(nbv, pb.NextBestViewReply)
+        self.assertEqual(len(nbv.views), 3)
+        self.assertEqual(len(nbv.views[0].pose.matrix), 16)
+        self.assertGreaterEqual(nbv.views[0].score, nbv.views[1].score)
+        self.assertGreater(nbv.views[0].expected_coverage, nbv.coverage)
+        with self.assertRaises(ValueError):
+            self.client.next_best_view(object_id=top.id, workspace=True)
+
         # ClearBox around the first object frees its voxels.
         e = top.box.extents
         lo = (top.centroid.x - e.x, top.centroid.y - e.y, top.centroid.z - e.z)

@@ -664,6 +664,11 @@ background::BoxOccupancy WorkingMemory::query_box(const Aabb& box) const {
   return impl_->map.query_box(box);
 }
 
+Result<background::DenseGrid> WorkingMemory::dense_grid(const Aabb& box, std::size_t max_voxels) const {
+  std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
+  return impl_->map.dense_grid(box, max_voxels);
+}
+
 std::size_t WorkingMemory::clear_box(const Aabb& box) {
   std::lock_guard<std::mutex> lock(impl_->writer);
   std::unique_lock<std::shared_mutex> write(impl_->map_mutex);

@@ -12,6 +12,7 @@
 #include <google/protobuf/util/json_util.h>
 
 #include "live_frame.h"
+#include "next_best_view_call.h"
 #include "ontology_convert.h"
 #include "scenewatch/ontology/describe.h"
 #include "proto_convert.h"
@@ -43,6 +44,7 @@ Route route_of(proto::Request::CallCase call) {
     case proto::Request::kQueryOccupancy:
     case proto::Request::kStats:
     case proto::Request::kGetSurpriseMap:
+    case proto::Request::kNextBestView:
       return Route::kQuery;
     case proto::Request::kIngestFrame:
     case proto::Request::kIngestFile:
@@ -216,6 +218,8 @@ struct RequestHandler::Impl {
       case proto::Request::kGetSurpriseMap: return get_surprise_map(request.get_surprise_map(), response);
       case proto::Request::kDefineClass: return define_class(request.define_class(), response);
       case proto::Request::kListClasses: return list_classes(response);
+      case proto::Request::kNextBestView:
+        return service::next_best_view(memory, request.next_best_view(), response.mutable_next_best_view());
       case proto::Request::CALL_NOT_SET: break;
     }
     // Not reached for a known call: the empty oneof is answered by the caller.

@@ -177,6 +177,9 @@ class WorkingMemory {
   /// The occupied voxels' centres (finest resolution); when there are more than `max_count`,
   /// every k-th of them in the map's order, k the smallest stride that fits.
   OccupiedVoxels occupied_voxels(std::size_t max_count) const;
+  /// A dense copy of the map in a box (background::OccupancyMap::dense_grid), for the view
+  /// planner. Thread safe: a consistent copy while frames go on being processed.
+  Result<background::DenseGrid> dense_grid(const Aabb& box_world, std::size_t max_voxels) const;
   std::size_t clear_box(const Aabb& box_world);
   void reset();
 

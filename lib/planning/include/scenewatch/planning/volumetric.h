@@ -1,0 +1,71 @@
+#pragma once
+/// Volumetric information gain of a view on the memory's map: rays through the camera's image cast
+/// through a dense copy of the map (background::DenseGrid), stopped at occupied voxels, and what
+/// they reach in the target box counted by one of the measures of Isler, Sabzevari, Delmerico and
+/// Scaramuzza, "An information gain formulation for active volumetric 3D reconstruction" (ICRA
+/// 2016).
+#include <cstdint>
+#include <vector>
+
+#include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/core/geometry.h"
+#include "scenewatch/core/result.h"
+
+namespace scenewatch::planning {
+
+enum class Measure {
+  kUnobserved,       ///< Isler's unobserved voxel: distinct unknown target voxels the rays reach
+  kRearSide,         ///< Isler's rear side voxel: unknown target voxels met just before an occupied one
+  kRearSideEntropy,  ///< Isler's rear side entropy: the entropy of the unknown target voxels on rays that end
+                     ///< on an occupied voxel after unknown space (the back of what has been seen)
+  kOcclusionAware,   ///< Isler's occlusion aware: sum of entropy times visibility (prod of 1 - p before)
+  kVisible,          ///< target voxels the rays reach whatever their state (to confirm or dismiss an event)
+};
+const char* to_string(Measure measure);
+/// Parses the name to_string gives; an error listing the names otherwise.
+Result<Measure> parse_measure(const std::string& name);
+
+struct VolumetricConfig {
+  int rays_x = 80;            ///< rays across the image (evenly spaced pixel centres)
+  int rays_y = 60;            ///< rays down the image
+  double max_range_m = 4.5;   ///< depth (z) at which rays end (the sensor's range)
+};
+
+/// Checks the numbers; the message names the key.
+Status validate(const VolumetricConfig& config);
+
+/// What one candidate view would see of the target.
+struct ViewGain {
+  double gain = 0.0;                ///< the measure's value
+  std::size_t unknown_reached = 0;  ///< distinct unknown target voxels on the rays
+  std::size_t rear_side = 0;        ///< distinct unknown target voxels just before an occupied voxel
+  std::size_t target_reached = 0;   ///< distinct target voxels on the rays, any state
+  double entropy_bits = 0.0;        ///< summed entropy of the distinct target voxels reached
+  double expected_coverage = 0.0;   ///< fraction of the target's voxels known after the view
+  std::size_t steps = 0;            ///< voxels walked, all rays
+};
+
+/// Scores views against one grid and one target box. Keeps per-voxel marks between calls: NOT
+/// thread safe (one scorer per thread); the grid must outlive it and not change.
+class ViewScorer {
+ public:
+  /// `grid` should hold the target and every camera position (rays leaving it stop there).
+  ViewScorer(const background::DenseGrid& grid, const Aabb& target_world, VolumetricConfig config = {});
+  ViewGain score(const Pose& T_world_camera, const Intrinsics& K, Measure measure);
+  std::size_t target_voxels() const { return target_voxels_; }
+  std::size_t target_known() const { return target_known_; }
+  /// Fraction of the target's voxels known (free or occupied) now.
+  double coverage() const { return target_voxels_ ? static_cast<double>(target_known_) / target_voxels_ : 0.0; }
+
+ private:
+  double occupied_probability(long index) const;
+  const background::DenseGrid& grid_;
+  VolumetricConfig config_;
+  long lo_[3] = {0, 0, 0}, hi_[3] = {-1, -1, -1};  ///< the target's voxel index range, inclusive
+  std::size_t target_voxels_ = 0, target_known_ = 0;
+  std::vector<std::uint32_t> reached_, rear_;       ///< marks: == stamp_ when counted in this call
+  std::uint32_t stamp_ = 0;
+  std::vector<long> ray_unknown_;                   ///< scratch: one ray's unknown target voxels
+};
+
+}  // namespace scenewatch::planning

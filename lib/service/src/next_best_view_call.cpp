@@ -1,0 +1,114 @@
+#include "next_best_view_call.h"
+
+#include "proto_convert.h"
+#include "scenewatch/planning/next_best_view.h"
+
+namespace scenewatch::service {
+
+namespace {
+
+// Largest dense copy of the map one call may ask for: 2^24 voxels (16 MB), a 5 m cube at 2 cm.
+constexpr std::size_t kMaxPlanningVoxels = std::size_t{1} << 24;
+
+Result<planning::NextBestViewRequest> to_request(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg) {
+  planning::NextBestViewRequest r;
+  switch (msg.target_case()) {
+    case proto::NextBestView::kObjectId: {
+      const auto snapshot = memory.snapshot();
+      const auto it = std::find_if(snapshot->objects.begin(), snapshot->objects.end(),
+                                   [&](const TrackedObject& o) { return o.id == msg.object_id(); });
+      if (it == snapshot->objects.end()) return not_found("object_id: no tracked object " + std::to_string(msg.object_id()));
+      r = planning::complete_object_request(it->cluster.box.aabb());
+      break;
+    }
+    case proto::NextBestView::kEventId: {
+      const auto events = memory.events_since(msg.event_id() == 0 ? 0 : msg.event_id() - 1, 1);
+      if (events.empty() || events.front().id != msg.event_id()) {
+        return not_found("event_id: no event " + std::to_string(msg.event_id()) + " in the log");
+      }
+      r = planning::confirm_event_request(events.front().box_world);
+      break;
+    }
+    case proto::NextBestView::kBox: {
+      auto box = convert::decode_box(msg.box(), "box");
+      if (!box) return box.error();
+      r = planning::complete_object_request(*box, 0.0);
+      break;
+    }
+    case proto::NextBestView::kWorkspace: {
+      const auto snapshot = memory.snapshot();
+      if (snapshot->objects.empty()) return not_found("workspace: no tracked objects yet");
+      Aabb all = snapshot->objects.front().cluster.box.aabb();
+      for (const auto& o : snapshot->objects) all = all.united(o.cluster.box.aabb());
+      r = planning::complete_object_request(all);
+      break;
+    }
+    case proto::NextBestView::TARGET_NOT_SET: return invalid_argument("target: give object_id, box, event_id or workspace");
+  }
+  switch (msg.constraint()) {
+    case proto::NextBestView::CONSTRAINT_SPHERE: r.constraint.kind = planning::ConstraintKind::kSphere; break;
+    case proto::NextBestView::CONSTRAINT_SHELL: r.constraint.kind = planning::ConstraintKind::kShell; break;
+    case proto::NextBestView::CONSTRAINT_LIST: r.constraint.kind = planning::ConstraintKind::kList; break;
+    default: r.constraint.kind = planning::ConstraintKind::kCap; break;
+  }
+  r.constraint.radius_max_m = msg.radius_m() > 0.0 ? msg.radius_m() : 0.7;
+  if (msg.radius_min_m() > 0.0) r.constraint.radius_min_m = msg.radius_min_m();
+  if (msg.max_polar_deg() > 0.0) r.constraint.max_polar_deg = msg.max_polar_deg();
+  if (msg.samples() > 0) r.constraint.samples = static_cast<int>(std::min<std::uint32_t>(msg.samples(), 100001));
+  r.constraint.up_world = memory.snapshot()->up_world;
+  for (int i = 0; i < msg.poses_size(); ++i) {
+    auto pose = convert::decode_pose(msg.poses(i), "poses[" + std::to_string(i) + "]");
+    if (!pose) return pose.error();
+    r.constraint.poses.push_back(*pose);
+  }
+  if (!msg.measure().empty()) {
+    auto m = planning::parse_measure(msg.measure());
+    if (!m) return m.error();
+    r.measure = *m;
+  }
+  if (msg.n() > 0) r.n = static_cast<int>(std::min<std::uint32_t>(msg.n(), 1001));
+  if (msg.has_intrinsics()) {
+    auto K = convert::decode_intrinsics(msg.intrinsics(), "intrinsics");
+    if (!K) return K.error();
+    r.intrinsics = *K;
+  }
+  if (msg.has_current_pose()) {
+    auto pose = convert::decode_pose(msg.current_pose(), "current_pose");
+    if (!pose) return pose.error();
+    r.current_T_world_camera = *pose;
+    r.motion_cost_per_m = msg.motion_cost_per_m();
+  }
+  return r;
+}
+
+}  // namespace
+
+Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, proto::NextBestViewReply* out) {
+  auto request = to_request(memory, msg);
+  if (!request) return request.error();
+  auto region = planning::planning_region(*request);
+  if (!region) return region.error();
+  auto grid = memory.dense_grid(*region, kMaxPlanningVoxels);
+  if (!grid) return grid.error();
+  auto answer = planning::next_best_views(*grid, *request);
+  if (!answer) return answer.error();
+  convert::to_proto(request->target_world, out->mutable_target());
+  out->set_measure(planning::to_string(answer->measure));
+  out->set_coverage(answer->coverage_now);
+  out->set_target_voxels(answer->target_voxels);
+  out->set_candidates(static_cast<std::uint32_t>(answer->candidates));
+  for (const auto& v : answer->views) {
+    auto* o = out->add_views();
+    convert::to_proto(v.T_world_camera, o->mutable_pose());
+    o->set_score(v.score);
+    o->set_gain(v.gain.gain);
+    o->set_expected_coverage(v.gain.expected_coverage);
+    o->set_unknown_voxels(v.gain.unknown_reached);
+    o->set_rear_side_voxels(v.gain.rear_side);
+    o->set_motion_m(v.motion_m);
+    o->set_why(convert::valid_utf8(v.why));
+  }
+  return {};
+}
+
+}  // namespace scenewatch::service

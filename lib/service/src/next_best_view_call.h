@@ -1,0 +1,14 @@
+#pragma once
+// The NextBestView call (issue 31): the target resolved from the memory (an object's or an event's
+// box, a box, the workspace), the request checked and handed to the planning module.
+#include "scenewatch.pb.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/pipeline/working_memory.h"
+
+namespace scenewatch::service {
+
+/// Answers one NextBestView from the memory's map. Bad requests (unknown object or event, bad
+/// numbers) are errors naming the field. Thread safe as the memory's queries are.
+Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, proto::NextBestViewReply* out);
+
+}  // namespace scenewatch::service

@@ -1,0 +1,57 @@
+// The closed loop on the simulator (issue 31): planned views against random ones from the same
+// candidates, on the clutter scenario, coverage measured against the simulator's true surfaces.
+// The full comparison (10 seeds, every measure, 10 views) is scenewatch-bench --only nbv.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+
+#include "closed_loop.h"
+#include "scenewatch/sim/scenario_yaml.h"
+
+namespace scenewatch::planning::eval {
+namespace {
+
+sim::Scenario clutter() {
+  auto s = sim::load_scenario(std::string(SCENEWATCH_SOURCE_DIR) + "/sample_clouds/scenarios/clutter.yaml");
+  EXPECT_TRUE(s) << s.error().message;
+  return *s;
+}
+
+// Mean coverage per view over seeds 1..seeds.
+std::vector<double> mean_curve(const sim::Scenario& scenario, ClosedLoopSetup setup, bool random, int seeds) {
+  setup.random = random;
+  std::vector<double> mean(static_cast<std::size_t>(setup.views + 1), 0.0);
+  for (int seed = 1; seed <= seeds; ++seed) {
+    auto c = run_closed_loop(scenario, setup, static_cast<std::uint64_t>(seed));
+    EXPECT_TRUE(c) << c.error().message;
+    if (!c) return mean;
+    EXPECT_GT(c->surface_samples, 100u);
+    for (std::size_t i = 0; i < mean.size(); ++i) mean[i] += c->coverage[i] / seeds;
+  }
+  return mean;
+}
+
+void print(const char* name, const std::vector<double>& curve) {
+  std::printf("%-8s", name);
+  for (double c : curve) std::printf(" %.3f", c);
+  std::printf("\n");
+}
+
+TEST(ClosedLoop, PlannedViewsCoverOneObjectFasterThanRandom) {
+  const sim::Scenario scenario = clutter();
+  ClosedLoopSetup setup;
+  setup.target_ids = {1};  // the cereal box, in the middle of the clutter
+  setup.views = 3;
+  const std::vector<double> planned = mean_curve(scenario, setup, false, 3);
+  const std::vector<double> random = mean_curve(scenario, setup, true, 3);
+  print("planned", planned);
+  print("random", random);
+  EXPECT_DOUBLE_EQ(planned[0], random[0]);  // the same first view per seed
+  for (std::size_t i = 1; i < planned.size(); ++i) EXPECT_GE(planned[i], planned[i - 1]);
+  // Measured (3 seeds): planned 0.978 after 3 views, random 0.854.
+  EXPECT_GE(planned[3], 0.95);
+  EXPECT_GT(planned[3], random[3] + 0.08);
+}
+
+}  // namespace
+}  // namespace scenewatch::planning::eval
