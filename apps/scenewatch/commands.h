@@ -32,6 +32,8 @@ struct RemoteOptions {
   /// ingest: the name of the camera the frames come from (empty: one name per run, from the first
   /// path's folder and this process's id; see camera_name()).
   std::string camera;
+  /// ingest: how the daemon finds each frame's pose (unset: its localization.mode).
+  std::optional<LocalizationMode> localization;
 };
 
 /// The camera name an ingest run gives its frames: `given`, else "<folder>#<pid>" from the first

@@ -139,6 +139,20 @@ nlohmann::json to_json(const proto::StatsReply& s) {
           {"appearance_memory_bytes", s.appearance_memory_bytes()}};
 }
 
+nlohmann::json to_json(const proto::LocalizationResult& l) {
+  std::vector<double> pose(l.pose().matrix().begin(), l.pose().matrix().end());
+  return {{"mode", l.mode()},
+          {"state", l.state()},
+          {"pose", pose},
+          {"correction_m", l.correction_m()},
+          {"correction_deg", l.correction_deg()},
+          {"inlier_fraction", l.inlier_fraction()},
+          {"residual_m", l.residual_m()},
+          {"reference_keyframe", l.reference_keyframe()},
+          {"reason", l.reason()},
+          {"compute_ms", l.compute_ms()}};
+}
+
 nlohmann::json to_json(const proto::IngestReply& ingest) {
   nlohmann::json planes = nlohmann::json::array(), clusters = nlohmann::json::array(),
                  events = nlohmann::json::array();
@@ -154,7 +168,8 @@ nlohmann::json to_json(const proto::IngestReply& ingest) {
           {"insert_ms", ingest.insert_ms()},
           {"total_ms", ingest.total_ms()},
           {"skipped", ingest.skipped()},
-          {"frames_skipped", ingest.frames_skipped()}};
+          {"frames_skipped", ingest.frames_skipped()},
+          {"localization", to_json(ingest.localization())}};
 }
 
 std::string occupancy_name(proto::OccupancyState state) {

@@ -18,6 +18,7 @@ nlohmann::json to_json(const proto::Object& object);
 nlohmann::json to_json(const proto::Event& event);
 nlohmann::json to_json(const proto::HealthReply& health);
 nlohmann::json to_json(const proto::StatsReply& stats);
+nlohmann::json to_json(const proto::LocalizationResult& localization);
 nlohmann::json to_json(const proto::IngestReply& ingest);
 nlohmann::json to_json(const proto::BoxOccupancy& box);
 /// Name of an occupancy state ("free", "occupied", "unknown").

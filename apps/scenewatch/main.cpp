@@ -76,6 +76,14 @@ int main(int argc, char** argv) {
                      "the name of the camera the frames come from; frames of several cameras may feed one daemon at "
                      "once, each run its own camera (default: the first path's folder and this process's id, "
                      "e.g. redkitchen#4242)");
+  std::string ingest_localization;
+  ingest->add_option("--localization", ingest_localization,
+                     "how the daemon finds each frame's pose: given, refine or track (no poses needed); "
+                     "overrides its localization.mode for these frames")
+      ->check(CLI::IsMember({"given", "refine", "track"}))
+      ->each([&](const std::string& m) {
+        remote.localization = m == "given" ? scenewatch::LocalizationMode::kGiven : m == "refine" ? scenewatch::LocalizationMode::kRefine : scenewatch::LocalizationMode::kTrack;
+      });
   add_depth_scale_option(ingest, ingest_depth_scale);
   add_remote_options(ingest, remote);
   ingest->callback([&] {
@@ -176,7 +184,8 @@ int main(int argc, char** argv) {
   add_remote_options(next, remote);
   next->callback([&, next_object_opt, next_event_opt, next_box_opt, next_ws_opt] {
     action = [&, next_object_opt, next_event_opt, next_box_opt, next_ws_opt] {
-      const std::size_t targets = next_object_opt->count() + next_event_opt->count() + next_box_opt->count() + next_ws_opt->count();
+      // count() is the number of values given (six for --box), not of times the option was named.
+      const int targets = (next_object_opt->count() > 0) + (next_event_opt->count() > 0) + (next_box_opt->count() > 0) + (next_ws_opt->count() > 0);
       if (targets != 1) {
         std::cerr << "scenewatch next-view: give exactly one of --object, --event, --box, --workspace\n";
         return kExitUsage;

@@ -99,7 +99,11 @@ void print_ingest(const RemoteOptions& options, const std::string& source, const
   }
   std::cout << "frame " << reply.frame_index() << " " << source << ": " << plural(reply.planes_size(), "plane") << ", "
             << plural(reply.clusters_size(), "object") << ", " << plural(reply.events_size(), "event") << " ("
-            << reply.points() << " points, " << static_cast<long>(reply.total_ms()) << " ms)\n";
+            << reply.points() << " points, " << static_cast<long>(reply.total_ms()) << " ms)";
+  const auto& where = reply.localization();
+  if (!where.state().empty() && where.state() != "given")
+    std::cout << ", " << where.mode() << ": " << where.state() << (where.reason().empty() ? "" : " (" + where.reason() + ")");
+  std::cout << "\n";
   for (const auto& event : reply.events()) std::cout << text(event) << "\n";
   std::cout << std::flush;
 }
@@ -265,6 +269,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
         }
         frame->source = source;
         frame->camera = camera;
+        frame->localization = options.localization;
         proto::Request request;
         *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
         auto id = client->start(std::move(request));
@@ -285,6 +290,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
     }
     frame->source = path;
     frame->camera = camera;
+    frame->localization = options.localization;
     proto::Request request;
     *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
     if (!send(std::move(request), path, nullptr)) return kExitError;
@@ -335,6 +341,7 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
       }
       std::this_thread::sleep_until(start + std::chrono::duration<double>(sent / fps));
       frame->camera = camera;
+    frame->localization = options.localization;
       proto::Request request;
       *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
       request.mutable_ingest_frame()->set_live(true);

@@ -68,7 +68,7 @@ TEST_F(NextViewTest, ObjectsAndEventsGetViewsOfWhatIsUnseen) {
   const Eigen::Vector3d box_truth = scenario.objects[0].T_world_object.translation();
   const proto::Object* box = nullptr;
   for (const auto& o : objects.objects().objects()) {
-    const Eigen::Vector2d c(o.cluster().centroid().x(), o.cluster().centroid().y());
+    const Eigen::Vector2d c(o.centroid().x(), o.centroid().y());
     if ((c - box_truth.head<2>()).norm() < 0.08) box = &o;
   }
   ASSERT_NE(box, nullptr);

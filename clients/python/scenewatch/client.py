@@ -164,12 +164,19 @@ class Client:
 
     def ingest_frame(self, frame=None, **fields):
         """Processes one frame: a pb.IngestFrame, or its fields as keywords (cloud=pb.Cloud,
-        pose=4x4 matrix or pb.Pose, intrinsics=pb.Intrinsics, stamp_s, source). pb.IngestReply."""
+        pose=4x4 matrix or pb.Pose, intrinsics=pb.Intrinsics, stamp_s, source, camera,
+        localization="given" | "refine" | "track"). pb.IngestReply; its ``localization`` says
+        where the memory placed the frame (``state`` "lost": the frame changed nothing)."""
         if frame is not None and fields:
             raise TypeError("ingest_frame takes a pb.IngestFrame or its fields as keywords, not both")
         if frame is None:
             if "pose" in fields:
                 fields["pose"] = pose_message(fields["pose"])
+            if isinstance(fields.get("localization"), str):
+                modes = {"given": pb.LOCALIZATION_GIVEN, "refine": pb.LOCALIZATION_REFINE, "track": pb.LOCALIZATION_TRACK}
+                if fields["localization"] not in modes:
+                    raise ValueError("localization must be given, refine or track, not %r" % fields["localization"])
+                fields["localization"] = modes[fields["localization"]]
             frame = pb.IngestFrame(**{k: v for k, v in fields.items() if v is not None})
         return self._call("ingest_frame", frame, result="ingest")
 

@@ -62,6 +62,11 @@ class ClientTest(unittest.TestCase):
         self.assertIsInstance(reply, pb.IngestReply)
         self.assertGreater(reply.points, 50000)
         self.assertEqual(len(reply.clusters), 4)
+        self.assertEqual(reply.localization.state, "given", "the daemon's default: poses as they come")
+        for used, given in zip(reply.localization.pose.matrix, [x for row in tabletop_pose() for x in row]):
+            self.assertAlmostEqual(used, given, places=6)
+        with self.assertRaisesRegex(ValueError, "given, refine or track"):
+            self.client.ingest_frame(localization="fly")
 
         stats = self.client.stats()
         self.assertEqual(stats.frames_processed, 1)

@@ -5,6 +5,7 @@
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/geometry.h"
+#include "scenewatch/core/look_at.h"
 #include "scenewatch/core/mesh.h"
 #include "scenewatch/core/result.h"
 
@@ -67,6 +68,24 @@ Pose pose_from_matrix(const Eigen::Matrix4d& m) {
   pose.linear() = Eigen::Quaterniond(m.topLeftCorner<3, 3>()).normalized().toRotationMatrix();
   pose.translation() = m.topRightCorner<3, 1>();
   return pose;
+}
+
+Pose look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, const Eigen::Vector3d& up_world) {
+  Eigen::Vector3d z = target - eye;
+  if (z.norm() < 1e-12) z = Eigen::Vector3d::UnitX();
+  z.normalize();
+  // Image y points down: x = z x up keeps the world's up at the image's top.
+  Eigen::Vector3d x = z.cross(up_world);
+  if (x.norm() < 1e-9) x = z.cross(Eigen::Vector3d::UnitY());  // looking straight along up
+  if (x.norm() < 1e-9) x = z.cross(Eigen::Vector3d::UnitX());
+  x.normalize();
+  const Eigen::Vector3d y = z.cross(x);
+  Pose T = Pose::Identity();
+  T.linear().col(0) = x;
+  T.linear().col(1) = y;
+  T.linear().col(2) = z;
+  T.translation() = eye;
+  return T;
 }
 
 Aabb OrientedBox::aabb() const {

@@ -25,8 +25,9 @@ double huber_weight(double e) {
 
 // Adds w * J^T J and w * J^T r.
 void accumulate(Mat6& H, Vec6& b, const Vec6& J, double r, double w) {
-  H.selfadjointView<Eigen::Upper>().rankUpdate(J, w);
-  b += w * r * J;
+  const Vec6 wJ = w * J;
+  H.noalias() += wJ * J.transpose();
+  b.noalias() += r * wJ;
 }
 
 float bilinear(const std::vector<float>& img, int width, float x, float y) {
@@ -93,7 +94,7 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
           if (std::abs(r) <= kInlierSigmas * sigma) {
             ++p.inliers;
             p.inlier_sq += r * r;
-            p.H_geometric.selfadjointView<Eigen::Upper>().rankUpdate(J, info);
+            p.H_geometric.noalias() += (info * J) * J.transpose();
           }
         }
       }
@@ -124,10 +125,7 @@ double robust_spread(std::vector<float>& abs_residuals, double fallback) {
   return std::max(1.4826 * *mid, 1.0 / 255.0);
 }
 
-Mat6 full(const Mat6& upper) {
-  Mat6 m = upper.selfadjointView<Eigen::Upper>();
-  return m;
-}
+Mat6 full(const Mat6& m) { return 0.5 * (m + m.transpose()); }
 
 }  // namespace
 

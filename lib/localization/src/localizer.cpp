@@ -59,6 +59,8 @@ Status validate(const Config& c) {
   if (!(c.min_conditioning >= 0 && c.min_conditioning < 1)) return invalid_argument("localization.min_conditioning: must be in [0, 1)");
   if (!(c.max_correction_m > 0) || !(c.max_correction_deg > 0 && c.max_correction_deg <= 180))
     return invalid_argument("localization.max_correction_m / max_correction_deg: must be > 0 (degrees at most 180)");
+  if (!(c.drift_m_per_frame >= 0 && c.drift_m_per_frame <= 1) || !(c.drift_deg_per_frame >= 0 && c.drift_deg_per_frame <= 90))
+    return invalid_argument("localization.drift_m_per_frame / drift_deg_per_frame: must be in [0, 1] m and [0, 90] degrees");
   if (c.reference_keyframes < 1 || c.reference_keyframes > 8)
     return invalid_argument("localization.reference_keyframes: must be in [1, 8]");
   return {};
@@ -165,7 +167,14 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
   std::optional<Alignment> aligned;
   for (const auto& keyframe : candidates) {
     const auto ref = reference(*keyframe);
-    const Alignment a = align(*ref, current, keyframe->T_world_camera.inverse() * prior, sensor_, config_.alignment);
+    Alignment a = align(*ref, current, keyframe->T_world_camera.inverse() * prior, sensor_, config_.alignment);
+    if (!use_given && track.started) {
+      // Without a given pose the prior assumes the camera kept its last motion; when it stopped
+      // or turned back, that prior lies twice as far off as the last pose. Both are tried; the
+      // one more of the frame agrees with wins.
+      Alignment still = align(*ref, current, keyframe->T_world_camera.inverse() * track.last, sensor_, config_.alignment);
+      if (still.inlier_fraction > a.inlier_fraction) a = std::move(still);
+    }
     Localization r = out;
     r.T_world_camera = keyframe->T_world_camera * a.T_reference_current;
     r.inlier_fraction = a.inlier_fraction;

@@ -90,7 +90,9 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
                          [&] { return s.read("min_conditioning", l.min_conditioning); },
                          [&] { return s.read("max_correction_m", l.max_correction_m); },
                          [&] { return s.read("max_correction_deg", l.max_correction_deg); },
-                         [&] { return s.read("reference_keyframes", l.reference_keyframes); });
+                         [&] { return s.read("reference_keyframes", l.reference_keyframes); },
+                         [&] { return s.read("drift_m_per_frame", l.drift_m_per_frame); },
+                         [&] { return s.read("drift_deg_per_frame", l.drift_deg_per_frame); });
       !st)
     return st;
   auto parsed = localization::parse_mode(mode);

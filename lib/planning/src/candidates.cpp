@@ -58,24 +58,6 @@ Status validate(const ViewConstraint& c) {
   return {};
 }
 
-Pose look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, const Eigen::Vector3d& up_world) {
-  Eigen::Vector3d z = target - eye;
-  if (z.norm() < 1e-12) z = Eigen::Vector3d::UnitX();
-  z.normalize();
-  // Image y points down: x = z x up keeps the world's up at the image's top. Looking straight
-  // along up, any x perpendicular to z will do.
-  Eigen::Vector3d x = z.cross(up_world);
-  if (x.norm() < 1e-9) x = z.cross(std::abs(z.x()) < 0.9 ? Eigen::Vector3d::UnitX() : Eigen::Vector3d::UnitY());
-  x.normalize();
-  const Eigen::Vector3d y = z.cross(x);
-  Pose T = Pose::Identity();
-  T.linear().col(0) = x;
-  T.linear().col(1) = y;
-  T.linear().col(2) = z;
-  T.translation() = eye;
-  return T;
-}
-
 std::vector<Eigen::Vector3d> fibonacci_directions(int count) { return fibonacci_band(count, -1.0, Eigen::Vector3d::UnitZ()); }
 
 Result<std::vector<Pose>> candidate_poses(const ViewConstraint& c, const Eigen::Vector3d& target) {

@@ -204,6 +204,19 @@ void to_proto(const Pose& pose, proto::Pose* out) {
   }
 }
 
+void to_proto(const localization::Localization& where, proto::LocalizationResult* out) {
+  out->set_mode(localization::mode_name(where.mode));
+  out->set_state(localization::state_name(where.state));
+  to_proto(where.T_world_camera, out->mutable_pose());
+  out->set_correction_m(where.correction_m);
+  out->set_correction_deg(where.correction_deg);
+  out->set_inlier_fraction(where.inlier_fraction);
+  out->set_residual_m(where.residual_m);
+  out->set_reference_keyframe(where.reference_keyframe);
+  out->set_reason(where.reason);
+  out->set_compute_ms(where.ms);
+}
+
 void to_proto(const Intrinsics& intrinsics, proto::Intrinsics* out) {
   out->set_fx(intrinsics.fx);
   out->set_fy(intrinsics.fy);

@@ -10,6 +10,7 @@
 #include "scenewatch/core/geometry.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
+#include "scenewatch/localization/localizer.h"
 
 namespace scenewatch::service::convert {
 
@@ -25,6 +26,7 @@ void to_proto(const ObjectCluster& cluster, proto::Cluster* out);
 void to_proto(const TrackedObject& object, proto::Object* out);
 void to_proto(const Event& event, proto::Event* out);
 void to_proto(const Pose& pose, proto::Pose* out);
+void to_proto(const localization::Localization& where, proto::LocalizationResult* out);
 void to_proto(const Intrinsics& intrinsics, proto::Intrinsics* out);
 
 /// Floats as little-endian float32 bytes, and back (error when the size is not a multiple of 4).

@@ -283,6 +283,13 @@ struct RequestHandler::Impl {
     frame.stamp_s = msg.stamp_s();
     frame.source = convert::source_label(msg.source());
     frame.camera = msg.camera();  // checked by the working memory with the rest of the frame
+    switch (msg.localization()) {
+      case proto::LOCALIZATION_CONFIGURED: break;
+      case proto::LOCALIZATION_GIVEN: frame.localization = LocalizationMode::kGiven; break;
+      case proto::LOCALIZATION_REFINE: frame.localization = LocalizationMode::kRefine; break;
+      case proto::LOCALIZATION_TRACK: frame.localization = LocalizationMode::kTrack; break;
+      default: return invalid_argument("localization: unknown mode " + std::to_string(msg.localization()));
+    }
     return frame;
   }
 
@@ -395,6 +402,7 @@ struct RequestHandler::Impl {
     out->set_insert_ms(result->insert_ms);
     out->set_total_ms(result->total_ms);
     out->set_frames_skipped(frames_skipped.load());
+    convert::to_proto(result->localization, out->mutable_localization());
     return {};
   }
 

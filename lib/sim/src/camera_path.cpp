@@ -37,20 +37,6 @@ const char* to_string(CameraPathKind kind) {
   return "unknown";
 }
 
-Pose look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target, const Eigen::Vector3d& up_world) {
-  const Eigen::Vector3d z = (target - eye).normalized();
-  Eigen::Vector3d x = z.cross(up_world);
-  if (x.norm() < 1e-9) x = z.cross(Eigen::Vector3d::UnitY());  // looking straight up or down
-  x.normalize();
-  const Eigen::Vector3d y = z.cross(x);
-  Pose T = Pose::Identity();
-  T.linear().col(0) = x;
-  T.linear().col(1) = y;
-  T.linear().col(2) = z;
-  T.translation() = eye;
-  return T;
-}
-
 Pose camera_pose(const CameraPath& path, double frame, int frame_count, std::uint64_t seed) {
   const double u = frame_count > 1 ? frame / (frame_count - 1) : 0.0;
   switch (path.kind) {

@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "scenewatch/core/geometry.h"
+#include "scenewatch/core/look_at.h"
 #include "scenewatch/core/result.h"
 
 namespace scenewatch::planning {
@@ -32,10 +33,6 @@ struct ViewConstraint {
 /// Checks the numbers; the message names the field.
 Status validate(const ViewConstraint& constraint);
 
-/// T_world_camera of a camera at `eye` looking at `target` (x right, y down, z forward, as the
-/// simulator's and the sensor's frames), with the image's up as close to `up_world` as it gets.
-Pose look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
-             const Eigen::Vector3d& up_world = Eigen::Vector3d::UnitZ());
 
 /// `count` nearly uniform unit directions (a Fibonacci sphere), deterministic.
 std::vector<Eigen::Vector3d> fibonacci_directions(int count);

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "scenewatch/core/geometry.h"
+#include "scenewatch/core/look_at.h"
 
 namespace scenewatch::sim {
 
@@ -41,9 +42,6 @@ struct CameraPath {
   std::vector<CameraKey> keys;
 };
 
-/// The camera pose looking from `eye` at `target`, with `up_world` pointing up in the image.
-Pose look_at(const Eigen::Vector3d& eye, const Eigen::Vector3d& target,
-             const Eigen::Vector3d& up_world = Eigen::Vector3d::UnitZ());
 
 /// T_world_camera at time `frame` (in frames of a phase of `frame_count` frames; fractional
 /// times allowed). `seed` drives the hand-held shake.
