@@ -144,6 +144,27 @@ TEST(Localizer, AFrameTheKeyframeDoesNotExplainIsLostAndPlacedAtItsPrior) {
   EXPECT_EQ(back.state, State::kTracking) << back.reason;
 }
 
+TEST(Localizer, RefineTakesTheGivenPoseWhereTheMemoryHasNoViewYet) {
+  SCENEWATCH_REQUIRE_DATA("redkitchen_long");
+  const auto seq = kitchen();
+  background::AppearanceMemory memory;
+  Config config;
+  config.mode = LocalizationMode::kRefine;
+  Localizer localizer(config);
+  const KeyframeSource nearest = [&](const Pose& p, std::size_t n) { return memory.nearest(p, n); };
+  Frame first = load(seq, 0);
+  ASSERT_EQ(localizer.localize(first, 0, nearest).state, State::kStarting);
+  ASSERT_TRUE(memory.add(*background::keyframe_from_frame(first)).ok());
+  ASSERT_EQ(localizer.localize(load(seq, 1), 0, nearest).state, State::kTracking);
+  // The camera turned round: no keyframe looks that way. The given pose places the frame, so
+  // that the memory can grow there (before, it was lost, and the memory never grew).
+  Frame turned = load(seq, 2);
+  turned.T_world_camera->linear() = turned.T_world_camera->linear() * Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitY());
+  const auto r = localizer.localize(turned, 0, nearest);
+  EXPECT_EQ(r.state, State::kStarting) << r.reason;
+  EXPECT_TRUE(r.placed());
+}
+
 TEST(Localizer, TrackModeFollowsTheKitchenWithoutPoses) {
   SCENEWATCH_REQUIRE_DATA("redkitchen_long");
   const auto seq = kitchen();

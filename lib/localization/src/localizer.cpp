@@ -153,9 +153,10 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
   if (candidates.empty()) {
     out.state = State::kStarting;
     out.reason = "no keyframe near the prior to align with";
-    // A camera that had been placed and now finds no keyframe near its prior has left the
-    // memory's views: that is lost unless the memory is still empty (the first frames).
-    if (track.started && track.result.state == State::kTracking) {
+    // With a given pose, a view the memory has no keyframe of is new ground: the prior places
+    // it, so that the memory grows there. Without one, a camera that had been placed and now
+    // finds no keyframe near its prior has left the memory's views: that is lost.
+    if (!use_given && track.started && track.result.state == State::kTracking) {
       out.state = State::kLost;
       out.reason = "no keyframe of the memory sees towards the prior";
     }

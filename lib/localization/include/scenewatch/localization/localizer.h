@@ -57,7 +57,7 @@ const char* mode_name(LocalizationMode mode);
 
 enum class State {
   kGiven,     ///< mode `given`: the pose as it came
-  kStarting,  ///< nothing in the memory to align with yet: the prior is used
+  kStarting,  ///< no keyframe of the memory sees towards the prior (a new view, or the first frames): the prior is used
   kTracking,  ///< aligned to the memory
   kLost,      ///< the last alignment failed: the frame must change nothing
 };
