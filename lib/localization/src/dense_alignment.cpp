@@ -129,6 +129,21 @@ Mat6 full(const Mat6& m) { return 0.5 * (m + m.transpose()); }
 
 }  // namespace
 
+Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
+  Eigen::Matrix3d m;
+  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
+  return m;
+}
+
+Mat6 twist_adjoint(const Pose& T) {
+  Mat6 A = Mat6::Zero();
+  const Eigen::Matrix3d R = T.linear();
+  A.topLeftCorner<3, 3>() = R;
+  A.topRightCorner<3, 3>() = skew(T.translation()) * R;
+  A.bottomRightCorner<3, 3>() = R;
+  return A;
+}
+
 Pose twist_exp(const Vec6& xi) {
   const Eigen::Vector3d v = xi.head<3>(), w = xi.tail<3>();
   const double theta = w.norm();
@@ -139,8 +154,7 @@ Pose twist_exp(const Vec6& xi) {
   }
   const Eigen::Vector3d axis = w / theta;
   T.linear() = Eigen::AngleAxisd(theta, axis).toRotationMatrix();
-  Eigen::Matrix3d K;
-  K << 0, -axis.z(), axis.y(), axis.z(), 0, -axis.x(), -axis.y(), axis.x(), 0;
+  const Eigen::Matrix3d K = skew(axis);
   const Eigen::Matrix3d V = Eigen::Matrix3d::Identity() + (1 - std::cos(theta)) / theta * K +
                             (theta - std::sin(theta)) / theta * K * K;
   T.translation() = V * v;

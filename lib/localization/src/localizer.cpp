@@ -13,22 +13,6 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 constexpr std::size_t kCachedReferences = 16;
 
-Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
-  Eigen::Matrix3d m;
-  m << 0, -v.z(), v.y(), v.z(), 0, -v.x(), -v.y(), v.x(), 0;
-  return m;
-}
-
-// The adjoint of T for twists (translation, rotation) applied on the left.
-Mat6 adjoint(const Pose& T) {
-  Mat6 A = Mat6::Zero();
-  const Eigen::Matrix3d R = T.linear();
-  A.topLeftCorner<3, 3>() = R;
-  A.topRightCorner<3, 3>() = skew(T.translation()) * R;
-  A.bottomRightCorner<3, 3>() = R;
-  return A;
-}
-
 bool organized_with_intrinsics(const Frame& f) {
   return f.cloud && f.intrinsics && f.intrinsics->valid() && f.cloud->height > 1 &&
          f.cloud->width == static_cast<std::uint32_t>(f.intrinsics->width) &&
@@ -181,7 +165,7 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
     r.inlier_fraction = a.inlier_fraction;
     r.residual_m = a.residual_m;
     r.conditioning = a.conditioning;
-    const Mat6 A = adjoint(keyframe->T_world_camera);
+    const Mat6 A = twist_adjoint(keyframe->T_world_camera);
     r.covariance = A * a.covariance * A.transpose();
     r.reference_keyframe = keyframe->id;
     if (a.inlier_fraction < config_.min_inlier_fraction) {

@@ -276,13 +276,7 @@ proto::IngestFrame make_ingest_frame(const Frame& frame) {
   msg.set_stamp_s(frame.stamp_s);
   msg.set_source(frame.source);
   msg.set_camera(frame.camera);
-  if (frame.localization) {
-    switch (*frame.localization) {
-      case LocalizationMode::kGiven: msg.set_localization(proto::LOCALIZATION_GIVEN); break;
-      case LocalizationMode::kRefine: msg.set_localization(proto::LOCALIZATION_REFINE); break;
-      case LocalizationMode::kTrack: msg.set_localization(proto::LOCALIZATION_TRACK); break;
-    }
-  }
+  msg.set_localization(convert::to_proto(frame.localization));
   return msg;
 }
 

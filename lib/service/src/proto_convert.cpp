@@ -217,6 +217,26 @@ void to_proto(const localization::Localization& where, proto::LocalizationResult
   out->set_compute_ms(where.ms);
 }
 
+proto::LocalizationMode to_proto(const std::optional<LocalizationMode>& mode) {
+  if (!mode) return proto::LOCALIZATION_CONFIGURED;
+  switch (*mode) {
+    case LocalizationMode::kGiven: return proto::LOCALIZATION_GIVEN;
+    case LocalizationMode::kRefine: return proto::LOCALIZATION_REFINE;
+    case LocalizationMode::kTrack: return proto::LOCALIZATION_TRACK;
+  }
+  return proto::LOCALIZATION_CONFIGURED;
+}
+
+Result<std::optional<LocalizationMode>> decode_localization_mode(int value) {
+  switch (value) {
+    case proto::LOCALIZATION_CONFIGURED: return std::optional<LocalizationMode>{};
+    case proto::LOCALIZATION_GIVEN: return std::optional<LocalizationMode>{LocalizationMode::kGiven};
+    case proto::LOCALIZATION_REFINE: return std::optional<LocalizationMode>{LocalizationMode::kRefine};
+    case proto::LOCALIZATION_TRACK: return std::optional<LocalizationMode>{LocalizationMode::kTrack};
+  }
+  return invalid_argument("localization: unknown mode " + std::to_string(value));
+}
+
 void to_proto(const Intrinsics& intrinsics, proto::Intrinsics* out) {
   out->set_fx(intrinsics.fx);
   out->set_fy(intrinsics.fy);

@@ -1,6 +1,7 @@
 #pragma once
 // Conversions between core types and the wire protocol's messages. Private to the service module
 // (the client header re-exports only what the CLI needs).
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -27,6 +28,10 @@ void to_proto(const TrackedObject& object, proto::Object* out);
 void to_proto(const Event& event, proto::Event* out);
 void to_proto(const Pose& pose, proto::Pose* out);
 void to_proto(const localization::Localization& where, proto::LocalizationResult* out);
+/// A frame's localization mode on the wire; unset is LOCALIZATION_CONFIGURED (the daemon's own).
+proto::LocalizationMode to_proto(const std::optional<LocalizationMode>& mode);
+/// ... and back; an unknown number is an error naming it.
+Result<std::optional<LocalizationMode>> decode_localization_mode(int value);
 void to_proto(const Intrinsics& intrinsics, proto::Intrinsics* out);
 
 /// Floats as little-endian float32 bytes, and back (error when the size is not a multiple of 4).

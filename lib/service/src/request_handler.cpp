@@ -283,13 +283,9 @@ struct RequestHandler::Impl {
     frame.stamp_s = msg.stamp_s();
     frame.source = convert::source_label(msg.source());
     frame.camera = msg.camera();  // checked by the working memory with the rest of the frame
-    switch (msg.localization()) {
-      case proto::LOCALIZATION_CONFIGURED: break;
-      case proto::LOCALIZATION_GIVEN: frame.localization = LocalizationMode::kGiven; break;
-      case proto::LOCALIZATION_REFINE: frame.localization = LocalizationMode::kRefine; break;
-      case proto::LOCALIZATION_TRACK: frame.localization = LocalizationMode::kTrack; break;
-      default: return invalid_argument("localization: unknown mode " + std::to_string(msg.localization()));
-    }
+    auto mode = convert::decode_localization_mode(msg.localization());
+    if (!mode) return mode.error();
+    frame.localization = *mode;
     return frame;
   }
 

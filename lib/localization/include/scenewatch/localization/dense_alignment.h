@@ -57,5 +57,10 @@ Alignment align(const RgbdPyramid& reference, const RgbdPyramid& current, const 
 
 /// The exponential of a twist (translation, rotation), as a rigid motion.
 Pose twist_exp(const Eigen::Matrix<double, 6, 1>& xi);
+/// The cross-product matrix of v: skew(v) x = v x x.
+Eigen::Matrix3d skew(const Eigen::Vector3d& v);
+/// The adjoint of T for twists (translation, rotation) applied on the left: exp(Ad_T xi) T =
+/// T exp(xi). Moves a twist's covariance from T's frame into the frame T maps to.
+Eigen::Matrix<double, 6, 6> twist_adjoint(const Pose& T);
 
 }  // namespace scenewatch::localization
