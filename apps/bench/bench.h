@@ -40,6 +40,8 @@ inline double time_ms(const std::function<void()>& f) {
 
 int run_octomap(const Options& o);
 int run_segmentation(const Options& o);
+/// Issue 30: every labelled mOSD scene, as recorded and as an unorganized copy, tuning and held-out apart.
+int run_clutter(const Options& o);
 int run_latency(const Options& o);
 int run_surprise(const Options& o);
 int run_change(const Options& o);

@@ -12,8 +12,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> only;
   app.add_option("--data", o.data_dir, "Folder of the real recordings (../shared/data)")->capture_default_str();
   app.add_option("--repetitions,-n", o.repetitions, "Timed runs per case; medians are reported")->capture_default_str()->check(CLI::Range(1, 1000));
-  app.add_option("--only", only, "Run only these sections: octomap, segmentation, latency, surprise, change, stream, sensor, pipeline, foreground, fit, localization, nbv, memory (memory runs only when named: 1000 frames; sensor, 7000 kitchen frames, only when named)")
-      ->check(CLI::IsMember({"octomap", "segmentation", "latency", "surprise", "change", "stream", "sensor", "pipeline", "foreground", "fit", "localization", "nbv", "memory"}));
+  app.add_option("--only", only, "Run only these sections: octomap, segmentation, clutter, latency, surprise, change, stream, sensor, pipeline, foreground, fit, localization, nbv, memory (memory runs only when named: 1000 frames; sensor, 7000 kitchen frames, only when named)")
+      ->check(CLI::IsMember({"octomap", "segmentation", "clutter", "latency", "surprise", "change", "stream", "sensor", "pipeline", "foreground", "fit", "localization", "nbv", "memory"}));
   CLI11_PARSE(app, argc, argv);
   if (!std::filesystem::exists(o.data_dir)) {
     std::fprintf(stderr, "scenewatch-bench: data folder '%s' not found (pass --data DIR)\n", o.data_dir.c_str());
@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   int rc = 0;
   if (want("octomap")) rc |= scenewatch::bench::run_octomap(o);
   if (want("segmentation")) rc |= scenewatch::bench::run_segmentation(o);
+  if (want("clutter")) rc |= scenewatch::bench::run_clutter(o);
   if (want("latency")) rc |= scenewatch::bench::run_latency(o);
   if (want("surprise")) rc |= scenewatch::bench::run_surprise(o);
   if (want("change")) rc |= scenewatch::bench::run_change(o);
