@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <random>
 
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/segmentation/evaluation.h"
@@ -17,31 +18,62 @@ struct SceneFigures {
   double table_iou = 0;
 };
 
-SceneFigures run_scene(const std::filesystem::path& path, bool print, int stride = 1) {
+struct Labelled {
+  Cloud cloud;
+  std::vector<std::uint32_t> labels;
+};
+
+Labelled load(const std::filesystem::path& path) {
   auto file = io::read_cloud(path);
   EXPECT_TRUE(file.ok()) << (file.ok() ? "" : file.error().message);
-  if (!file.ok()) return {};
   auto labels = io::read_pcd_labels(path);
   EXPECT_TRUE(labels.ok());
-  const Segmentation seg = stride > 1 ? segment_strided(*file->cloud, Config{}, Eigen::Vector3d::Zero(), stride)
-                                      : segment(*file->cloud, Config{});
+  if (!file.ok() || !labels.ok()) return {};
+  return {*file->cloud, std::move(*labels)};
+}
+
+// The valid points of a scene in a seeded random order with their labels, height 1: the scene as
+// a converter that drops NaNs, or a merge, hands it over.
+Labelled unorganized_copy(const Labelled& in, std::uint32_t seed) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < in.cloud.size(); ++i)
+    if (is_valid(in.cloud[i])) order.push_back(i);
+  std::mt19937 rng(seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  Labelled out;
+  for (std::size_t i : order) {
+    out.cloud.push_back(in.cloud[i]);
+    out.labels.push_back(in.labels[i]);
+  }
+  out.cloud.width = static_cast<std::uint32_t>(out.cloud.size());
+  out.cloud.height = 1;
+  return out;
+}
+
+SceneFigures figures(const Labelled& scene, const std::string& name, bool print, int stride = 1) {
+  const Segmentation seg = stride > 1 ? segment_strided(scene.cloud, Config{}, Eigen::Vector3d::Zero(), stride)
+                                      : segment(scene.cloud, Config{});
   std::vector<std::vector<int>> clusters;
   for (const auto& o : seg.objects) {
-    EXPECT_TRUE(std::is_sorted(o.indices.begin(), o.indices.end())) << path;
-    EXPECT_EQ(std::adjacent_find(o.indices.begin(), o.indices.end()), o.indices.end()) << path;
+    EXPECT_TRUE(std::is_sorted(o.indices.begin(), o.indices.end())) << name;
+    EXPECT_EQ(std::adjacent_find(o.indices.begin(), o.indices.end()), o.indices.end()) << name;
     EXPECT_EQ(o.point_count, o.indices.size());
     clusters.push_back(o.indices);
   }
   const std::vector<int> none;
-  const LabelScore score = score_against_labels(clusters, seg.planes.empty() ? none : seg.planes[0].indices, *labels);
+  const LabelScore score = score_against_labels(clusters, seg.planes.empty() ? none : seg.planes[0].indices, scene.labels);
   if (print) {
-    std::printf("  %-12s planes %zu clusters %2zu correct %2zu | table IoU %.3f | objects %zu matched %zu |",
-                path.filename().c_str(), seg.planes.size(), seg.objects.size(), score.correct_clusters(), score.table_iou,
-                score.objects.size(), score.matched());
+    std::printf("  %-12s planes %zu clusters %2zu correct %2zu | table IoU %.3f | objects %zu matched %zu |", name.c_str(),
+                seg.planes.size(), seg.objects.size(), score.correct_clusters(), score.table_iou, score.objects.size(),
+                score.matched());
     for (const auto& o : score.objects) std::printf(" %u:%.2f", o.object_id, o.best_iou);
     std::printf("\n");
   }
   return {score.objects.size(), score.matched(), seg.objects.size(), score.correct_clusters(), score.table_iou};
+}
+
+SceneFigures run_scene(const std::filesystem::path& path, bool print, int stride = 1) {
+  return figures(load(path), path.filename().string(), print, stride);
 }
 
 // Every learn scene: the table plane is found (IoU with the table label), and each labelled object
@@ -141,6 +173,33 @@ TEST(Mosd, EverySecondPixelFindsTheSameObjects) {
   EXPECT_GE(matched, 109u);  // measured 109 of 112 (every pixel: 111)
   EXPECT_GE(correct, 109u);  // of 113 clusters (every pixel: 111 of 112)
   EXPECT_LE(clusters, 113u);
+}
+
+// An unorganized copy of a scene (its valid points shuffled, height 1) is segmented through its
+// recovered image: the same objects, the same clusters, the same table as the organized scene,
+// on every learn scene and every test_dev scene recorded organized.
+TEST(Mosd, UnorganizedCopiesGiveTheSameObjects) {
+  SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
+  std::vector<std::filesystem::path> paths;
+  for (int i = 0; i <= 44; ++i) paths.push_back(test::data_dir() / "mosd/learn" / ("learn" + std::to_string(i) + ".pcd"));
+  for (int i = 44; i <= 59; ++i)
+    if (i != 56 && i != 58) paths.push_back(test::data_dir() / "mosd/test_dev" / ("test" + std::to_string(i) + ".pcd"));
+  std::size_t matched[2] = {0, 0}, correct[2] = {0, 0}, objects = 0;
+  for (std::size_t k = 0; k < paths.size(); ++k) {
+    if (!std::filesystem::exists(paths[k])) continue;
+    const Labelled scene = load(paths[k]);
+    ASSERT_GT(scene.cloud.height, 1u) << paths[k];
+    const SceneFigures a = figures(scene, paths[k].filename().string(), false);
+    const SceneFigures b = figures(unorganized_copy(scene, 100 + static_cast<std::uint32_t>(k)), "shuffled", false);
+    EXPECT_EQ(a.objects, b.objects) << paths[k];
+    EXPECT_EQ(a.matched, b.matched) << paths[k];
+    EXPECT_EQ(a.clusters, b.clusters) << paths[k];
+    EXPECT_EQ(a.correct, b.correct) << paths[k];
+    EXPECT_NEAR(a.table_iou, b.table_iou, 1e-9) << paths[k];
+    matched[0] += a.matched, matched[1] += b.matched, correct[0] += a.correct, correct[1] += b.correct, objects += a.objects;
+  }
+  std::printf("mOSD organized vs unorganized copies, %zu scenes, %zu objects: matched %zu / %zu, clusters right %zu / %zu\n",
+              paths.size(), objects, matched[0], matched[1], correct[0], correct[1]);
 }
 
 }  // namespace

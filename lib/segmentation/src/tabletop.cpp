@@ -20,6 +20,7 @@
 #include "hull2d.h"
 #include "occlusion_join.h"
 #include "support.h"
+#include "through_image.h"
 #include "union_find.h"
 #include "voxel_columns.h"
 #include "voxel_index.h"
@@ -497,6 +498,11 @@ std::vector<Piece> euclidean_clusters(const Cloud& cloud, const VoxelIndex& grid
 }  // namespace
 
 Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3d& sensor_origin) {
+  if (cloud.height <= 1 && cfg.recover_image_grid) {
+    if (const auto grid = recover_image_grid(cloud, sensor_origin, cloud.sensor_orientation_)) {
+      return to_cloud_indices(cloud, *grid, segment(organized_cloud(cloud, *grid), cfg, sensor_origin), cfg.voxel_size_m);
+    }
+  }
   Segmentation out;
   const VoxelIndex grid(cloud, cfg.voxel_size_m);
   if (grid.centroids.size() < 3) return out;

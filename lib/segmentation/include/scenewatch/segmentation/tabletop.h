@@ -36,7 +36,9 @@ struct Config {
   int max_cluster_points = 500000;
   /// Touching and stacked objects are one Euclidean cluster; split each cluster at its concave
   /// creases (local convexity over patches, Stein et al. CVPR 2014). Organized clouds only (one
-  /// view, whose sensor orients the normals); unorganized ones keep their Euclidean clusters.
+  /// view, whose sensor orients the normals), and unorganized clouds of one view through their
+  /// recovered image (recover_image_grid); clouds merged from several views keep their Euclidean
+  /// clusters.
   bool split_concave = true;
   double patch_size_m = 0.02;            ///< patch (voxel) edge for the convexity test
   /// Neighbouring patches whose normals differ by less than this are one smooth surface even
@@ -51,6 +53,10 @@ struct Config {
   /// between them is covered by something nearer and the surface continues across (organized
   /// clouds only).
   bool join_occluded = true;
+  /// An unorganized cloud of one view (NaNs dropped, points reordered, a converter's output) is
+  /// segmented through the image it was taken as (core/image_grid.h), so the cuts and joins above
+  /// that need an image apply to it too. A cloud merged from several views keeps the voxel path.
+  bool recover_image_grid = true;
 };
 
 /// Validates ranges; the message names the key (e.g. "segmentation.voxel_size_m").
