@@ -149,6 +149,7 @@ struct ReplayOptions {
   std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
   std::string localization;         ///< overrides localization.mode: given, refine or track (empty: the config's)
   std::string trajectory;           ///< when set: the poses the memory used, as a TUM trajectory
+  bool objects = false;             ///< after each frame, the object list a planner would get
 };
 /// Offline: recordings through the working memory as the daemon would run them; prints the
 /// event stream and a summary (events per 100 frames, time per frame and per stage).

@@ -278,6 +278,8 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"given", "refine", "track"}));
   replay->add_option("--trajectory", replay_options.trajectory,
                      "write the poses the memory used (aligned frames) as a TUM trajectory: t tx ty tz qx qy qz qw");
+  replay->add_flag("--objects", replay_options.objects,
+                   "after each frame, the object list a planner would get (GetObjects): id, size, points, sightings");
   bool scenario_check = false;
   RemoteOptions scenario_remote;
   replay->add_flag("--check", scenario_check, "scenario scripts: exit 1 when an expectation is not met");

@@ -51,6 +51,29 @@ std::string event_line(std::size_t frame, const Event& e, double range_m) {
   return line;
 }
 
+// The object list after a frame, as GetObjects gives it: one line, or one JSON object.
+void print_objects(std::size_t frame, const pipeline::SceneSnapshot& snapshot, bool json) {
+  if (json) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& o : snapshot.objects) {
+      const Eigen::Vector3d& c = o.cluster.centroid;
+      const Eigen::Vector3d& e = o.cluster.box.extents;
+      list.push_back({{"id", o.id}, {"centroid", {c.x(), c.y(), c.z()}}, {"extents", {e.x(), e.y(), e.z()}},
+                      {"points", o.cluster.point_count}, {"observations", o.observations}, {"plane", o.cluster.plane_id},
+                      {"foreground", o.foreground.has_value()}});
+    }
+    std::cout << nlohmann::json{{"frame", frame}, {"objects", list}}.dump() << "\n";
+    return;
+  }
+  std::printf("frame %4zu  %zu objects:", frame, snapshot.objects.size());
+  for (const auto& o : snapshot.objects) {
+    const Eigen::Vector3d& e = o.cluster.box.extents;
+    std::printf("  #%llu %.0fx%.0fx%.0f cm %zu pts %d seen%s", static_cast<unsigned long long>(o.id), 100 * e.x(), 100 * e.y(),
+                100 * e.z(), o.cluster.point_count, o.observations, o.foreground ? " fg" : "");
+  }
+  std::printf("\n");
+}
+
 // What localization made of the frames: states, corrections of the given poses, its time.
 struct LocalizationSummary {
   std::map<std::string, std::size_t> states;
@@ -152,6 +175,7 @@ int run_replay(const ReplayOptions& options) {
           std::cout << event_line(frames, e, range_from_camera(frame, e)) << "\n";
         }
       }
+      if (options.objects) print_objects(frames, *memory.snapshot(), options.json);
       ++frames;
       if (options.progress && !options.json && frames % 25 == 0) {
         std::cerr << "  " << frames << " frames, " << total_events << " events\n";

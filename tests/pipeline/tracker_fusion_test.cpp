@@ -66,6 +66,50 @@ TEST(ObjectTracker, FarClustersAreNotObjectsAndIdsSurviveARestore) {
   EXPECT_GT(restored.objects()[1].id, saved[0].id) << "a new id, never one given before";
 }
 
+// A strip one resolution cell wide (a rim, an edge's fringe) is a fragment, not an object; an
+// object 2 cm wide at 1 m (resolution: the 1 cm voxel) is listed.
+TEST(ObjectTracker, StripsNarrowerThanTheSensorResolvesAreNotObjects) {
+  ObjectTracker tracker(TrackingConfig{});
+  TrackerObservation strip = seen_at(0, 0), thin = seen_at(0.3, 0);
+  strip.cluster.box.extents = Eigen::Vector3d(0.15, 0.012, 0.04);
+  thin.cluster.box.extents = Eigen::Vector3d(0.10, 0.021, 0.04);
+  strip.resolution_m = thin.resolution_m = 0.01;
+  tracker.update({strip, thin}, 1, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 1u);
+  EXPECT_NEAR(tracker.objects()[0].cluster.centroid.x(), 0.3, 1e-9);
+  // Farther away the noise sets the cell (2 sigma_z above the voxel): with a 2 cm cell, the same
+  // 2.1 cm is not resolved.
+  thin.resolution_m = 0.02;
+  ObjectTracker far(TrackingConfig{});
+  far.update({thin}, 1, kOccluded);
+  EXPECT_TRUE(far.objects().empty());
+}
+
+// An object whose surface is seen where it was, with no cluster of its own there (a piece of a
+// larger object, a fragment), leaves silently after half its sightings, at least gone_frames; an
+// object merely hidden or out of view keeps its place.
+TEST(ObjectTracker, SeenInPlaceWithoutAClusterLeavesAfterHalfItsSightings) {
+  TrackingConfig config;
+  config.gone_frames = 2;
+  const ObjectTracker::SeenFraction seen = [](const std::vector<Eigen::Vector3d>&) { return 1.0; };
+  const ObjectTracker::SeenFraction hidden = [](const std::vector<Eigen::Vector3d>&) { return 0.0; };
+  ObjectTracker tracker(config);
+  for (int i = 0; i < 10; ++i) tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, i, kOccluded, seen);
+  tracker.update({seen_at(0.3, 0), seen_at(0.6, 0)}, 10, kOccluded, seen);  // a fragment at 0.6, once
+  ASSERT_EQ(tracker.objects().size(), 3u);
+  for (int i = 11; i < 30; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded, hidden);
+  EXPECT_EQ(tracker.objects().size(), 3u) << "hidden: nothing leaves";
+  tracker.update({seen_at(0.3, 0)}, 30, kOccluded, seen);
+  EXPECT_EQ(tracker.objects().size(), 3u) << "one frame is not enough";
+  tracker.update({seen_at(0.3, 0)}, 31, kOccluded, seen);
+  ASSERT_EQ(tracker.objects().size(), 2u) << "the fragment seen once leaves after gone_frames";
+  for (int i = 32; i < 34; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded, seen);
+  EXPECT_EQ(tracker.objects().size(), 2u) << "the object seen 10 times stays for 5 frames";
+  tracker.update({seen_at(0.3, 0)}, 34, kOccluded, seen);
+  ASSERT_EQ(tracker.objects().size(), 1u);
+  EXPECT_NEAR(tracker.objects()[0].cluster.centroid.x(), 0.3, 1e-9);
+}
+
 Event region_at(double x, double y, double kl = 15.0) {
   Event e;
   e.kind = EventKind::kAppearanceChange;

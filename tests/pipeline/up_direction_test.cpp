@@ -16,9 +16,11 @@ namespace scenewatch::pipeline {
 namespace {
 
 // Also the object list: what stands on the wall (the relief of a whiteboard, posters) is not an
-// object. Measured at the end: pick_toy_1 18 objects, pick_toy_2 25-26 (41 and 60 when the wall's
-// pieces were listed; the rest are the person's arm and clothes on the table's plane, flat things
-// on the table and single sightings, as confirm_frames is 1).
+// object. Two objects stand on the table (a bin and a toy). The most listed in any frame from the
+// fifth on, measured: pick_toy_1 8, pick_toy_2 11 (at the end 18 and 25-26 before strips narrower
+// than the sensor resolves and pieces seen in place without a cluster of their own were dropped;
+// 41 and 60 when the wall's pieces were listed). What remains: two pieces of the chair beside
+// the table, which stand inside the table's hull, and the person's arm.
 void expect_table_up_on_every_frame(const std::string& name, std::size_t max_objects) {
   std::vector<std::string> sections = pipeline_sections();
   sections.push_back("server");  // the daemon's own sections
@@ -34,11 +36,13 @@ void expect_table_up_on_every_frame(const std::string& name, std::size_t max_obj
   int wall_frames = 0;
   double worst_deg = 0;
   std::size_t on_wall = 0;  // sightings of listed objects whose support faces sideways
+  std::size_t most_listed = 0;  // from the fifth frame on
   for (std::size_t i = 0; i < seq->frames.size(); ++i) {
     auto frame = io::load_sequence_frame(*seq, i);
     ASSERT_TRUE(frame) << frame.error().message;
     ASSERT_TRUE(memory.process(*frame));
     const auto snapshot = memory.snapshot();
+    if (i >= 4) most_listed = std::max(most_listed, snapshot->objects.size());
     for (const auto& o : snapshot->objects) {
       if (o.foreground || o.last_seen_s != frame->stamp_s) continue;
       for (const auto& p : snapshot->planes)
@@ -51,10 +55,10 @@ void expect_table_up_on_every_frame(const std::string& name, std::size_t max_obj
   }
   const std::size_t listed = memory.snapshot()->objects.size();
   std::printf("%s: up within %.1f deg of the base's z on every frame with planes; %d frames took the wall; "
-              "%zu objects listed at the end, %zu sightings of objects on the wall\n",
-              name.c_str(), worst_deg, wall_frames, listed, on_wall);
+              "%zu objects listed at the end, at most %zu in a frame from the fifth on, %zu sightings of objects on the wall\n",
+              name.c_str(), worst_deg, wall_frames, listed, most_listed, on_wall);
   EXPECT_EQ(on_wall, 0u);
-  EXPECT_LE(listed, max_objects);
+  EXPECT_LE(most_listed, max_objects);
   EXPECT_EQ(wall_frames, 0);
   // The table's fitted normal: within 0.4 degrees of the base's z on every frame of both (3.0
   // degrees on pick_toy_1's frame 35 when it was first measured, with every pixel segmented).
@@ -63,12 +67,12 @@ void expect_table_up_on_every_frame(const std::string& name, std::size_t max_obj
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy1AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_1");
-  expect_table_up_on_every_frame("pick_toy_1", 20);
+  expect_table_up_on_every_frame("pick_toy_1", 8);
 }
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy2AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_2");
-  expect_table_up_on_every_frame("pick_toy_2", 28);
+  expect_table_up_on_every_frame("pick_toy_2", 11);
 }
 
 }  // namespace

@@ -158,6 +158,7 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
     if (auto st = read_all([&] { return s.read("match_distance_m", c.tracking.match_distance_m); },
                            [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); },
                            [&] { return s.read("confirm_frames", c.tracking.confirm_frames); },
+                           [&] { return s.read("min_extent_cells", c.tracking.min_extent_cells); },
                            [&] { return s.read("gone_frames", c.tracking.gone_frames); },
                            [&] { return s.read("max_range_m", c.tracking.max_range_m); },
                            [&] { return s.read("segmentation_stride_px", c.tracking.segmentation_stride_px); });

@@ -31,7 +31,8 @@ std::vector<int> match(const std::vector<TrackerObservation>& obs, const std::ve
 
 }  // namespace
 
-void ObjectTracker::update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction) {
+void ObjectTracker::update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction,
+                           const SeenFraction& seen_fraction) {
   for (auto& o : observations) o.cluster.indices.clear();  // indices belong to this frame only
   // What each observation stands on, by the centroid of the supporting observation (the indices
   // of supported_by are this frame's and do not survive matching).
@@ -41,8 +42,12 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     if (s >= 0 && static_cast<std::size_t>(s) < observations.size()) support[c] = observations[s].cluster.centroid;
   }
   std::size_t in_range = 0;
+  const auto resolved = [&](const TrackerObservation& o) {
+    const double need = config_.min_extent_cells * o.resolution_m;
+    return std::min(o.cluster.box.extents.x(), o.cluster.box.extents.y()) >= need;
+  };
   for (std::size_t c = 0; c < observations.size(); ++c) {
-    if (observations[c].range_m > config_.max_range_m) continue;
+    if (observations[c].range_m > config_.max_range_m || !resolved(observations[c])) continue;
     if (in_range != c) {
       observations[in_range] = std::move(observations[c]);
       support[in_range] = support[c];
@@ -81,7 +86,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     t.samples = std::move(observations[c].samples);
     t.points = std::move(observations[c].points);
     t.support_centroid = support[c];
-    t.misses = t.seen_free = 0;
+    t.misses = t.seen_free = t.seen_unmatched = 0;
   }
 
   // Confirmed objects unmatched in this frame leave only when their space keeps being seen free.
@@ -93,6 +98,9 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
       const bool free = free_fraction && free_fraction(t.samples) >= config_.gone_free_fraction;
       t.seen_free = free ? t.seen_free + 1 : 0;
       if (t.seen_free >= config_.gone_frames) continue;
+      const bool seen = !free && seen_fraction && seen_fraction(t.samples) >= config_.gone_free_fraction;
+      t.seen_unmatched = seen ? t.seen_unmatched + 1 : 0;
+      if (t.seen_unmatched >= std::max(config_.gone_frames, (t.object.observations + 1) / 2)) continue;
     }
     kept.push_back(std::move(t));
   }

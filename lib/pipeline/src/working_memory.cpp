@@ -150,6 +150,25 @@ std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectClu
   return observations;
 }
 
+// The share of `points` (world) an organized frame sees where they are: in its image, with the
+// frame's depth there within the sensor's 3 sigma plus a voxel of theirs.
+double seen_in_place(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                     const std::vector<Eigen::Vector3d>& points) {
+  if (!K || cloud.height <= 1 || points.empty() || static_cast<int>(cloud.width) != K->width) return 0.0;
+  const Pose T_camera_world = T.inverse();
+  std::size_t n = 0;
+  for (const auto& p : points) {
+    const Eigen::Vector3d q = T_camera_world * p;
+    if (q.z() <= 0) continue;
+    const long u = std::lround(K->fx * q.x() / q.z() + K->cx), v = std::lround(K->fy * q.y() / q.z() + K->cy);
+    if (u < 0 || v < 0 || u >= static_cast<long>(cloud.width) || v >= static_cast<long>(cloud.height)) continue;
+    const PointT& f = cloud.points[static_cast<std::size_t>(v) * cloud.width + static_cast<std::size_t>(u)];
+    if (!is_valid(f)) continue;
+    n += std::abs(f.z - q.z()) < 3 * config.sensor.sigma_z(q.z()) + config.segmentation.voxel_size_m;
+  }
+  return static_cast<double>(n) / static_cast<double>(points.size());
+}
+
 // Objects stand on tables, shelves and floors, not on walls: the clusters whose supporting plane
 // faces more than 45 degrees away from the world's up (up_direction's own bound) are a wall's
 // relief (a whiteboard, a poster, a socket), not objects to list. Their space is never seen free,
@@ -346,9 +365,12 @@ struct WorkingMemory::Impl {
 
   // The object list (no events: a change is reported by the change detector, once); the
   // foreground's objects are not background objects.
-  void track_objects(const FrameResult& result, const Frame& frame, const Pose& T, const std::vector<std::size_t>& claimed,
-                     const std::optional<Eigen::Vector3d>& configured_up) {
+  void track_objects(const FrameResult& result, const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
+                     const std::vector<std::size_t>& claimed, const Config& config) {
+    const std::optional<Eigen::Vector3d>& configured_up = config.segmentation.up;
     std::vector<TrackerObservation> observations = tracker_observations(result.objects, *frame.cloud, T, claimed);
+    for (auto& o : observations)
+      o.resolution_m = std::max(config.segmentation.voxel_size_m, 2 * config.sensor.sigma_z(o.range_m));
     // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
     if (const auto up = level_up(configured_up, result.planes, T)) keep_on_level_supports(observations, result.planes, *up, T.translation());
     std::shared_lock<std::shared_mutex> read(map_mutex);
@@ -357,7 +379,7 @@ struct WorkingMemory::Impl {
       std::size_t n = 0;
       for (const auto& p : pts) n += (map.freed_by_last_insert(p) || map.query(p) == background::Occupancy::kFree) ? 1 : 0;
       return static_cast<double>(n) / pts.size();
-    });
+    }, [&](const std::vector<Eigen::Vector3d>& pts) { return seen_in_place(*frame.cloud, T, K, config, pts); });
   }
 
   // Change detection against the map as it stands before this frame, then the frame into the
@@ -482,6 +504,8 @@ Status validate(const Config& c) {
   if (!(c.tracking.match_distance_m > 0 && c.tracking.match_distance_m < 5)) return invalid_argument("tracking.match_distance_m: must be in (0, 5) m");
   if (!(c.tracking.gone_free_fraction > 0 && c.tracking.gone_free_fraction <= 1)) return invalid_argument("tracking.gone_free_fraction: must be in (0, 1]");
   if (c.tracking.confirm_frames < 1 || c.tracking.confirm_frames > 100) return invalid_argument("tracking.confirm_frames: must be in [1, 100]");
+  if (!(c.tracking.min_extent_cells >= 0 && c.tracking.min_extent_cells <= 100))
+    return invalid_argument("tracking.min_extent_cells: must be in [0, 100]");
   if (c.tracking.gone_frames < 1 || c.tracking.gone_frames > 100) return invalid_argument("tracking.gone_frames: must be in [1, 100]");
   if (!(c.tracking.max_range_m > 0 && c.tracking.max_range_m <= 20)) return invalid_argument("tracking.max_range_m: must be in (0, 20] m");
   if (c.tracking.segmentation_stride_px < 1 || c.tracking.segmentation_stride_px > 8)
@@ -581,7 +605,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   foreground::ForegroundUpdate fg = m.foreground.update(result.objects, m.tracker.objects(), result);
   result.events = m.fuse(result, changed, fg.quiet_boxes, frame.stamp_s, camera_id);
 
-  m.track_objects(result, frame, T, fg.claimed_clusters, config_.segmentation.up);
+  m.track_objects(result, frame, T, camera, fg.claimed_clusters, config_);
   for (std::uint64_t id : fg.promoted) m.tracker.remove(id);
   if (!fg.vacated.empty()) {
     // A promoted object's old place is empty now: its removal is explained, not a surprise.

@@ -1,10 +1,17 @@
 #pragma once
 /// The object list of the working memory: clusters of each frame matched to remembered objects,
-/// with hysteresis both ways. A cluster becomes an object only after it was seen in
-/// `confirm_frames` frames (a noise cluster that comes and goes never enters the list); an object
-/// leaves only when the space it filled has been seen free in `gone_frames` frames (an occluded or
-/// out-of-view object keeps its place). Clusters farther from the camera than `max_range_m`
-/// (where a Kinect's depth noise is as large as a small object) are not objects.
+/// with hysteresis both ways. A listed object must be an object, by evidence noise cannot give:
+///  - it was seen in `confirm_frames` frames (1 by default: a single cloud sent once lists its
+///    objects; more keep a noise cluster that comes and goes out of the list);
+///  - it is as wide as the sensor can resolve at its range: both horizontal extents span at least
+///    `min_extent_cells` cells of max(segmentation voxel, 2 sigma_z(range)) (a strip one voxel
+///    wide along a rim or an edge is a fragment: its width was never measured, only quantized);
+///  - clusters farther from the camera than `max_range_m` (where a Kinect's depth noise is as
+///    large as a small object) are not objects.
+/// An object leaves when the space it filled has been seen free in `gone_frames` frames (an
+/// occluded or out-of-view object keeps its place), and silently when its surface is seen where
+/// it was but no cluster stands for it there (a piece of a larger object, a fragment of an edge)
+/// in as many frames in a row as half its sightings, at least `gone_frames`.
 ///
 /// The tracker raises no events: what changed in the scene is reported once, by the change
 /// detector (OBJECT_ADDED / OBJECT_REMOVED / OBJECT_MOVED); the list is what GetObjects returns.
@@ -25,6 +32,8 @@ struct TrackingConfig {
   /// in space the frame saw through (or that the map holds free).
   double gone_free_fraction = 0.6;
   int confirm_frames = 1;    ///< sightings before a cluster joins the object list (1: at first sight)
+  /// Cells of the resolution (see above) each horizontal extent must span; 0: no size check.
+  double min_extent_cells = 2.0;
   int gone_frames = 2;       ///< frames of seen-free space before an object leaves the list
   double max_range_m = 2.0;  ///< clusters whose centroid is farther from the camera are ignored
   /// Each organized frame is segmented for the object list on every Nth pixel of every Nth row,
@@ -42,6 +51,8 @@ struct TrackerObservation {
   /// Its points (world, thinned), kept with the object for what describes it (the ontology).
   std::shared_ptr<const std::vector<Eigen::Vector3d>> points;
   double range_m = 0.0;  ///< distance of its centroid from the camera
+  /// The smallest extent the sensor resolves at that range: max(voxel, 2 sigma_z(range_m)).
+  double resolution_m = 0.0;
 };
 
 /// NOT thread safe: owned by the working memory's writer.
@@ -52,8 +63,13 @@ class ObjectTracker {
   /// The share of `points` seen free (by the map, or by the last frame's rays).
   using FreeFraction = std::function<double(const std::vector<Eigen::Vector3d>& points)>;
 
-  /// One frame. `free_fraction` is asked about objects that were not matched.
-  void update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction);
+  /// The share of `points` the frame sees where they are (the surface there, neither occluded nor
+  /// gone): an object unmatched although seen so was not an object of its own.
+  using SeenFraction = std::function<double(const std::vector<Eigen::Vector3d>& points)>;
+
+  /// One frame. `free_fraction` and `seen_fraction` are asked about objects that were not matched.
+  void update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction,
+              const SeenFraction& seen_fraction = {});
 
   /// Confirmed objects, in the order they were confirmed.
   const std::vector<TrackedObject>& objects() const { return objects_; }
@@ -78,6 +94,7 @@ class ObjectTracker {
     std::shared_ptr<const std::vector<Eigen::Vector3d>> points;
     int misses = 0;       ///< consecutive frames unmatched
     int seen_free = 0;    ///< consecutive frames unmatched with its space seen free
+    int seen_unmatched = 0;  ///< consecutive frames unmatched with its surface seen in place
     /// Centroid of the observation it stood on in its last frame (a box on a box), if any.
     std::optional<Eigen::Vector3d> support_centroid;
   };
