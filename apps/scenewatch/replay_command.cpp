@@ -62,7 +62,14 @@ void print_objects(std::size_t frame, const pipeline::SceneSnapshot& snapshot, b
                       {"points", o.cluster.point_count}, {"observations", o.observations}, {"plane", o.cluster.plane_id},
                       {"foreground", o.foreground.has_value()}});
     }
-    std::cout << nlohmann::json{{"frame", frame}, {"objects", list}}.dump() << "\n";
+    nlohmann::json planes = nlohmann::json::array();
+    for (const auto& p : snapshot.planes) {
+      nlohmann::json hull = nlohmann::json::array();
+      for (const auto& h : p.hull) hull.push_back({h.x(), h.y(), h.z()});
+      planes.push_back({{"id", p.id}, {"centroid", {p.centroid.x(), p.centroid.y(), p.centroid.z()}}, {"area_m2", p.area_m2},
+                        {"hull", hull}});
+    }
+    std::cout << nlohmann::json{{"frame", frame}, {"objects", list}, {"planes", planes}}.dump() << "\n";
     return;
   }
   std::printf("frame %4zu  %zu objects:", frame, snapshot.objects.size());

@@ -425,6 +425,23 @@ TEST_F(CliTest, ReplayTellsTheStreamAndCountsIt) {
   EXPECT_NE(result.err.find("1 frames"), std::string::npos) << result.err;
   result = cli({"replay", before, "--stride", "0"});
   EXPECT_EQ(result.exit_code, 2) << "usage error";
+  // --objects: the list after each frame. learn12 holds two objects on the table.
+  result = cli({"replay", before, "--objects", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::istringstream listed(result.out);
+  std::string first;
+  ASSERT_TRUE(std::getline(listed, first));
+  const json list = parse(first);
+  EXPECT_EQ(list.at("frame"), 0);
+  ASSERT_EQ(list.at("objects").size(), 2u) << first;
+  ASSERT_GE(list.at("planes").size(), 1u);
+  for (const auto& o : list.at("objects")) {
+    EXPECT_EQ(o.at("plane"), list.at("planes").at(0).at("id")) << "both stand on the table";
+    EXPECT_GT(o.at("points").get<int>(), 1000);
+    EXPECT_EQ(o.at("observations"), 1);
+  }
+  result = cli({"replay", before, "--objects"});
+  EXPECT_NE(result.out.find("frame    0  2 objects:  #1 "), std::string::npos) << result.out;
 }
 
 // `ingest` takes the frame forms every other command takes (README, "Frames on the command line"):
