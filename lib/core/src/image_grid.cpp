@@ -11,8 +11,11 @@ namespace {
 
 struct Ray {
   int index;
-  double tx, ty, range;
+  float tx, ty, range;  // float: 1e-7 of a tangent is 1e-4 of a pixel at f = 1000
 };
+
+// Nearest integer, for values far inside int's range (pixel coordinates).
+inline long nearest(double x) { return static_cast<long>(std::floor(x + 0.5)); }
 
 struct Axis {
   double f = 0;       ///< pixels per unit of tan(angle)
@@ -25,7 +28,7 @@ struct Axis {
 // holds points, so neighbouring values are one column apart), refined by a least-squares line
 // through all distinct values against their column numbers. Kept when 99 % of all points lie
 // within a tenth of a pixel of a column.
-std::optional<Axis> lattice(std::vector<double> t, const std::vector<double>& all) {
+std::optional<Axis> lattice(std::vector<double> t, const std::vector<Ray>& rays, float Ray::*axis_of) {
   if (t.size() < 100) return std::nullopt;
   std::sort(t.begin(), t.end());
   std::vector<double> distinct;
@@ -42,7 +45,7 @@ std::optional<Axis> lattice(std::vector<double> t, const std::vector<double>& al
   double sk = 0, st = 0, skk = 0, skt = 0;
   const double n = static_cast<double>(distinct.size());
   for (double v : distinct) {
-    const double k = std::round((v - distinct.front()) / s0);
+    const double k = static_cast<double>(nearest((v - distinct.front()) / s0));
     sk += k;
     st += v;
     skk += k * k;
@@ -57,14 +60,14 @@ std::optional<Axis> lattice(std::vector<double> t, const std::vector<double>& al
   axis.c = -a * axis.f;  // column 0 at the smallest tangent
   std::size_t on = 0;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (double v : all) {
-    const double u = v * axis.f + axis.c;
-    on += std::abs(u - std::round(u)) < 0.1;
+  for (const Ray& r : rays) {
+    const double u = r.*axis_of * axis.f + axis.c;
+    on += std::abs(u - static_cast<double>(nearest(u))) < 0.1;
     lo = std::min(lo, u), hi = std::max(hi, u);
   }
-  if (on * 100 < all.size() * 99) return std::nullopt;
-  axis.c -= std::round(lo);  // the first column that holds a point is column 0
-  axis.size = static_cast<int>(std::lround(hi - std::round(lo))) + 1;
+  if (on * 100 < rays.size() * 99) return std::nullopt;
+  axis.c -= static_cast<double>(nearest(lo));  // the first column that holds a point is column 0
+  axis.size = static_cast<int>(nearest(hi) - nearest(lo)) + 1;
   return axis;
 }
 
@@ -107,8 +110,8 @@ std::optional<ImageGrid> recover_image_grid(const Cloud& cloud, const Eigen::Vec
     ++valid;
     const Eigen::Vector3d q = R_t * (p.getVector3fMap().cast<double>() - sensor_origin);
     if (!(q.z() > 1e-6)) continue;
-    Ray r{static_cast<int>(i), q.x() / q.z(), q.y() / q.z(), q.norm()};
-    x0 = std::min(x0, r.tx), x1 = std::max(x1, r.tx), y0 = std::min(y0, r.ty), y1 = std::max(y1, r.ty);
+    Ray r{static_cast<int>(i), static_cast<float>(q.x() / q.z()), static_cast<float>(q.y() / q.z()), static_cast<float>(q.norm())};
+    x0 = std::min<double>(x0, r.tx), x1 = std::max<double>(x1, r.tx), y0 = std::min<double>(y0, r.ty), y1 = std::max<double>(y1, r.ty);
     rays.push_back(r);
   }
   // One view sees what is in front of it: a cloud with points behind is in another frame.
@@ -116,17 +119,12 @@ std::optional<ImageGrid> recover_image_grid(const Cloud& cloud, const Eigen::Vec
 
   // The lattice is found on a sample (every k-th ray) and checked on all.
   const std::size_t step = std::max<std::size_t>(1, rays.size() / 20000);
-  std::vector<double> sx, sy, ax, ay;
-  ax.reserve(rays.size());
-  ay.reserve(rays.size());
-  for (std::size_t i = 0; i < rays.size(); ++i) {
-    ax.push_back(rays[i].tx);
-    ay.push_back(rays[i].ty);
-    if (i % step == 0) sx.push_back(rays[i].tx), sy.push_back(rays[i].ty);
-  }
+  std::vector<double> sx, sy;
+  for (std::size_t i = 0; i < rays.size(); i += step) sx.push_back(rays[i].tx), sy.push_back(rays[i].ty);
   ImageGrid grid;
   Axis u, v;
-  const auto lu = lattice(sx, ax), lv = lattice(sy, ay);
+  const auto lu = lattice(std::move(sx), rays, &Ray::tx);
+  const auto lv = lu ? lattice(std::move(sy), rays, &Ray::ty) : std::nullopt;
   if (lu && lv) {
     u = *lu, v = *lv;
     grid.exact = true;
@@ -142,19 +140,19 @@ std::optional<ImageGrid> recover_image_grid(const Cloud& cloud, const Eigen::Vec
   // Each pixel's nearest point stands for it.
   grid.pixel.assign(cloud.size(), -1);
   grid.point.assign(static_cast<std::size_t>(u.size) * v.size, -1);
-  std::vector<double> nearest(grid.point.size(), std::numeric_limits<double>::infinity());
+  std::vector<float> closest(grid.point.size(), std::numeric_limits<float>::infinity());
   for (const Ray& r : rays) {
-    const long a = std::lround(r.tx * u.f + u.c), b = std::lround(r.ty * v.f + v.c);
+    const long a = nearest(r.tx * u.f + u.c), b = nearest(r.ty * v.f + v.c);
     if (a < 0 || b < 0 || a >= u.size || b >= v.size) continue;
     const int px = static_cast<int>(b * u.size + a);
     grid.pixel[r.index] = px;
-    if (r.range < nearest[px]) nearest[px] = r.range, grid.point[px] = r.index;
+    if (r.range < closest[px]) closest[px] = r.range, grid.point[px] = r.index;
   }
   // Several views: many points lie well behind the point that stands for their pixel.
   std::size_t hidden = 0;
   for (const Ray& r : rays) {
     const int px = grid.pixel[r.index];
-    if (px >= 0 && r.range > nearest[px] + params.hidden_gap_m + 0.05 * r.range) ++hidden;
+    if (px >= 0 && r.range > closest[px] + params.hidden_gap_m + 0.05 * r.range) ++hidden;
   }
   if (static_cast<double>(hidden) > params.max_hidden_share * static_cast<double>(rays.size())) return std::nullopt;
   return grid;
