@@ -86,36 +86,40 @@ struct Method {
   change::ChangeScore score;
 };
 
-}  // namespace
-
-int run_change(const Options& o) {
-  const auto dir = o.data_dir / "mosd/learn";
-  if (!std::filesystem::exists(dir / "learn0.pcd")) {
-    std::printf("\n== Change detection: skipped, %s not found\n", dir.c_str());
-    return 0;
-  }
-  std::vector<Scene> scenes(45);
-  for (int i = 0; i <= 44; ++i) {
-    const auto path = dir / ("learn" + std::to_string(i) + ".pcd");
+// The labelled scenes `prefix`first..last of a folder; false (and a message) when one is missing.
+bool load_scenes(const std::filesystem::path& dir, const char* prefix, int first, int last, std::vector<Scene>& scenes) {
+  for (int i = first; i <= last; ++i) {
+    const auto path = dir / (prefix + std::to_string(i) + ".pcd");
     auto file = io::read_cloud(path);
     auto labels = io::read_pcd_labels(path);
     if (!file || !labels) {
       std::printf("cannot read %s\n", path.c_str());
-      return 1;
+      return false;
     }
-    scenes[i].cloud = file->cloud;
-    scenes[i].labels = *labels;
-    for (const auto& p : file->cloud->points) scenes[i].xyz.push_back(p.getVector3fMap());
+    Scene scene;
+    scene.cloud = file->cloud;
+    scene.labels = *labels;
+    for (const auto& p : file->cloud->points) scene.xyz.push_back(p.getVector3fMap());
+    scenes.push_back(std::move(scene));
   }
+  return true;
+}
+
+// Consecutive organized scenes taken from one unmoved camera, with their true changes.
+std::vector<Pair> same_camera_pairs(const std::vector<Scene>& scenes, int first) {
   std::vector<Pair> pairs;
-  for (int i = 0; i < 44; ++i) {
-    if (!same_camera(scenes[i], scenes[i + 1])) continue;
-    Pair p{i, &scenes[i], &scenes[i + 1], {}};
+  for (std::size_t i = 0; i + 1 < scenes.size(); ++i) {
+    if (scenes[i].cloud->height <= 1 || scenes[i + 1].cloud->height <= 1 || !same_camera(scenes[i], scenes[i + 1])) continue;
+    Pair p{first + static_cast<int>(i), &scenes[i], &scenes[i + 1], {}};
     p.truth = change::true_changes_from_labels(p.before->xyz, p.before->labels, p.after->xyz, p.after->labels);
     pairs.push_back(std::move(p));
   }
-  std::printf("\n== Change detection: %zu mOSD same-camera pairs (Kinect, 640x480), median of %d runs per pair\n",
-              pairs.size(), o.repetitions);
+  return pairs;
+}
+
+void run_pairs(const std::vector<Pair>& pairs, const char* what, const Options& o) {
+  std::printf("\n== Change detection: %zu mOSD same-camera pairs of %s (Kinect, 640x480), median of %d runs per pair\n",
+              pairs.size(), what, o.repetitions);
 
   const change::Config config;
   Method methods[] = {{"scenewatch same camera (per pixel), evidence only", {}, {}},
@@ -184,6 +188,25 @@ int run_change(const Options& o) {
               " at point IoU >= 0.5, recall = changed objects so matched; building the 1 cm map from BEFORE takes another\n"
               " %.1f ms median)\n",
               methods[0].score.true_changes, median(insert_ms));
+}
+
+}  // namespace
+
+int run_change(const Options& o) {
+  const auto dir = o.data_dir / "mosd/learn";
+  if (!std::filesystem::exists(dir / "learn0.pcd")) {
+    std::printf("\n== Change detection: skipped, %s not found\n", dir.c_str());
+    return 0;
+  }
+  std::vector<Scene> learn;
+  if (!load_scenes(dir, "learn", 0, 44, learn)) return 1;
+  run_pairs(same_camera_pairs(learn, 0), "learn", o);
+  // test_dev: mixed scenes and piles (test45->46, 46->47, 47->48, 51->52, 52->53 share a camera).
+  const auto dev = o.data_dir / "mosd/test_dev";
+  if (!std::filesystem::exists(dev / "test43.pcd")) return 0;
+  std::vector<Scene> test;
+  if (!load_scenes(dev, "test", 43, 59, test)) return 1;
+  run_pairs(same_camera_pairs(test, 43), "test_dev", o);
   return 0;
 }
 
