@@ -110,6 +110,20 @@ TEST(ObjectTracker, SeenInPlaceWithoutAClusterLeavesAfterHalfItsSightings) {
   EXPECT_NEAR(tracker.objects()[0].cluster.centroid.x(), 0.3, 1e-9);
 }
 
+// A cluster that lies mostly in a hand or an arm (fingers, a sleeve) starts no track; a listed
+// object the hand reaches keeps its own.
+TEST(ObjectTracker, PiecesOfAPersonStartNoTrack) {
+  ObjectTracker tracker(TrackingConfig{});
+  tracker.update({seen_at(0, 0)}, 1, kOccluded);
+  TrackerObservation held = seen_at(0.005, 0), finger = seen_at(0.4, 0);
+  held.touches_person = finger.touches_person = true;
+  tracker.update({held, finger}, 2, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 1u) << "the finger is not listed";
+  EXPECT_EQ(tracker.objects()[0].observations, 2) << "the object in reach keeps its track";
+  tracker.update({seen_at(0.4, 0)}, 3, kOccluded);
+  EXPECT_EQ(tracker.objects().size(), 2u) << "seen apart from the hand, it is listed";
+}
+
 Event region_at(double x, double y, double kl = 15.0) {
   Event e;
   e.kind = EventKind::kAppearanceChange;

@@ -17,10 +17,11 @@ namespace {
 
 // Also the object list: what stands on the wall (the relief of a whiteboard, posters) is not an
 // object. Two objects stand on the table (a bin and a toy). The most listed in any frame from the
-// fifth on, measured: pick_toy_1 8, pick_toy_2 11 (at the end 18 and 25-26 before strips narrower
-// than the sensor resolves and pieces seen in place without a cluster of their own were dropped;
-// 41 and 60 when the wall's pieces were listed). What remains: two pieces of the chair beside
-// the table, which stand inside the table's hull, and the person's arm.
+// fifth on, measured: pick_toy_1 7, pick_toy_2 10 (at the end 18 and 25-26 before strips narrower
+// than the sensor resolves, pieces seen in place without a cluster of their own and pieces of
+// hands were dropped; 41 and 60 when the wall's pieces were listed). What remains: two pieces of
+// the chair beside the table, inside the table's hull (bands of the wall and the chair's back at
+// the table's height stretch it), and the person's arm.
 void expect_table_up_on_every_frame(const std::string& name, std::size_t max_objects) {
   std::vector<std::string> sections = pipeline_sections();
   sections.push_back("server");  // the daemon's own sections
@@ -67,12 +68,12 @@ void expect_table_up_on_every_frame(const std::string& name, std::size_t max_obj
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy1AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_1");
-  expect_table_up_on_every_frame("pick_toy_1", 8);
+  expect_table_up_on_every_frame("pick_toy_1", 7);
 }
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy2AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_2");
-  expect_table_up_on_every_frame("pick_toy_2", 11);
+  expect_table_up_on_every_frame("pick_toy_2", 10);
 }
 
 }  // namespace

@@ -67,6 +67,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
   std::vector<char> hit(known.size(), 0);
   for (std::size_t c = 0; c < observations.size(); ++c) {
     const int k = matched[c];
+    if (k < 0 && observations[c].touches_person) continue;
     if (k < 0) {
       Track t;
       t.object.cluster = std::move(observations[c].cluster);

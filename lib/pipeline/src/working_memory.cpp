@@ -150,6 +150,18 @@ std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectClu
   return observations;
 }
 
+// A box that lies for the most part (half its volume or more) in one of the frame's hands or arms,
+// each grown by `margin_m`: a finger or a sleeve, not an object the hand reaches for.
+bool touches_hand(const Aabb& box, const HandsSeen& hands, double margin_m) {
+  const double volume = (box.max - box.min).cwiseMax(1e-6).prod();
+  for (const auto& h : hands.hands) {
+    const Eigen::Vector3d lo = (h.box_world.min.array() - margin_m).max(box.min.array());
+    const Eigen::Vector3d hi = (h.box_world.max.array() + margin_m).min(box.max.array());
+    if ((hi.array() > lo.array()).all() && (hi - lo).prod() >= 0.5 * volume) return true;
+  }
+  return false;
+}
+
 // The share of `points` (world) an organized frame sees where they are: in its image, with the
 // frame's depth there within the sensor's 3 sigma plus a voxel of theirs.
 double seen_in_place(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
@@ -369,8 +381,11 @@ struct WorkingMemory::Impl {
                      const std::vector<std::size_t>& claimed, const Config& config) {
     const std::optional<Eigen::Vector3d>& configured_up = config.segmentation.up;
     std::vector<TrackerObservation> observations = tracker_observations(result.objects, *frame.cloud, T, claimed);
-    for (auto& o : observations)
+    const HandsSeen& hands = foreground.hands();
+    for (auto& o : observations) {
       o.resolution_m = std::max(config.segmentation.voxel_size_m, 2 * config.sensor.sigma_z(o.range_m));
+      if (hands.frame_index == frames) o.touches_person = touches_hand(o.cluster.box.aabb(), hands, config.segmentation.cluster_tolerance_m);
+    }
     // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
     if (const auto up = level_up(configured_up, result.planes, T)) keep_on_level_supports(observations, result.planes, *up, T.translation());
     std::shared_lock<std::shared_mutex> read(map_mutex);

@@ -11,7 +11,8 @@
 /// An object leaves when the space it filled has been seen free in `gone_frames` frames (an
 /// occluded or out-of-view object keeps its place), and silently when its surface is seen where
 /// it was but no cluster stands for it there (a piece of a larger object, a fragment of an edge)
-/// in as many frames in a row as half its sightings, at least `gone_frames`.
+/// in as many frames in a row as half its sightings, at least `gone_frames`. A cluster that lies
+/// mostly in a hand or an arm starts no track (never part of a person).
 ///
 /// The tracker raises no events: what changed in the scene is reported once, by the change
 /// detector (OBJECT_ADDED / OBJECT_REMOVED / OBJECT_MOVED); the list is what GetObjects returns.
@@ -53,6 +54,10 @@ struct TrackerObservation {
   double range_m = 0.0;  ///< distance of its centroid from the camera
   /// The smallest extent the sensor resolves at that range: max(voxel, 2 sigma_z(range_m)).
   double resolution_m = 0.0;
+  /// Half its box or more lies in a hand or arm seen in the same frame (grown by the
+  /// segmentation's link distance): fingers and sleeves cut off the hand. It keeps a listed
+  /// object's track but starts none.
+  bool touches_person = false;
 };
 
 /// NOT thread safe: owned by the working memory's writer.
