@@ -20,6 +20,10 @@ std::uint64_t cell_key(long a, long b) {
 class CellGrid {
  public:
   explicit CellGrid(const PlaneGrid& plane) : plane_(plane) {}
+  std::uint64_t key(const Eigen::Vector3d& p) const {
+    return cell_key(static_cast<long>(std::floor(p.dot(plane_.u) / plane_.cell_m)),
+                    static_cast<long>(std::floor(p.dot(plane_.v) / plane_.cell_m)));
+  }
   int add(const Eigen::Vector3d& p) {
     const long a = static_cast<long>(std::floor(p.dot(plane_.u) / plane_.cell_m));
     const long b = static_cast<long>(std::floor(p.dot(plane_.v) / plane_.cell_m));
@@ -60,6 +64,11 @@ class CellGrid {
   std::vector<std::pair<long, long>> coords_;
 };
 
+bool has_pieces(const CellGrid& grid) {
+  const std::vector<int> comp = grid.components();
+  return std::any_of(comp.begin(), comp.end(), [](int c) { return c > 0; });
+}
+
 }  // namespace
 
 std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
@@ -69,18 +78,28 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
   CellGrid grid(plane);
   std::vector<int> voxel_cell(inliers.size());
   for (std::size_t i = 0; i < inliers.size(); ++i) voxel_cell[i] = grid.add(centroids[inliers[i]].cast<double>());
-  if (sensor_origin) {
+  // One piece in sight: nothing to bridge.
+  if (sensor_origin && has_pieces(grid)) {
     const Eigen::Vector3d& o = *sensor_origin;
     const double o_height = plane.n.dot(o) + plane.d;
+    // The highest voxel over each cell hides the most: its shadow covers those of the voxels
+    // under it (same foot, shorter shadow the same way).
+    tsl::robin_map<std::uint64_t, std::pair<double, int>, MixHash64> highest;
     for (int w : standing) {
       const Eigen::Vector3d q = centroids[w].cast<double>();
       const double h = plane.n.dot(q) + plane.d;
       if (h <= min_height_m || h > max_height_m || h >= o_height) continue;
+      const std::uint64_t key = grid.key(q);
+      auto [it, inserted] = highest.try_emplace(key, h, w);
+      if (!inserted && it->second.first < h) it.value() = {h, w};
+    }
+    for (const auto& [key, top] : highest) {
+      const Eigen::Vector3d q = centroids[top.second].cast<double>();
+      const double h = top.first;
       // The ray o + t (q - o) meets the plane at t = o_height / (o_height - h) > 1: behind q.
       const Eigen::Vector3d foot = q - h * plane.n;
       const Eigen::Vector3d shadow = o + (o_height / (o_height - h)) * (q - o);
-      const double span = (shadow - foot).norm();
-      const int steps = static_cast<int>(std::ceil(span / plane.cell_m));
+      const int steps = static_cast<int>(std::ceil((shadow - foot).norm() / plane.cell_m));
       for (int k = 0; k <= steps; ++k) grid.add(foot + (shadow - foot) * (steps ? static_cast<double>(k) / steps : 0.0));
     }
   }
