@@ -1,10 +1,8 @@
 // Local convexity over voxel patches (see convex_parts.h):
-//  1. patches: a voxel grid over the cluster, its cells cut at depth steps on organized clouds
-//     (surface_patches.h); each patch gets a normal (PCA of its points, oriented towards the
-//     sensor);
+//  1. patches: a voxel grid over the cluster; each patch gets a normal (PCA of its points,
+//     oriented towards the sensor);
 //  2. smooth surfaces: neighbouring patches whose normals agree within the concavity tolerance,
-//     unless they are a step (parallel, offset along the normal, or a depth step in the image)
-//     or, on an organized cloud, their pixels do not meet;
+//     unless they are a step (parallel, offset along the normal);
 //  3. surfaces join when most links along their border are convex (or only mildly concave, as
 //     inside a cup), strongest evidence first, never joining two surfaces whose border is a
 //     concave crease; patches too small for a normal join their largest neighbour;
@@ -14,13 +12,13 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
-#include <optional>
 #include <set>
 
-#include "surface_patches.h"
 #include "union_find.h"
+#include "voxel_index.h"
 
 namespace scenewatch::segmentation {
 namespace {
@@ -38,18 +36,16 @@ struct Patch {
   bool has_normal = false;
 };
 
-std::vector<Patch> make_patches(const Cloud& cloud, const std::vector<std::vector<int>>& members,
-                                const Eigen::Vector3d& sensor_origin) {
-  std::vector<Patch> patches(members.size());
+std::vector<Patch> make_patches(const Cloud& cloud, const VoxelIndex& grid, const Eigen::Vector3d& sensor_origin) {
+  std::vector<Patch> patches(grid.centroids.size());
   for (std::size_t v = 0; v < patches.size(); ++v) {
     Patch& p = patches[v];
-    p.points = static_cast<int>(members[v].size());
-    for (int i : members[v]) p.centroid += cloud[i].getVector3fMap().cast<double>();
-    p.centroid /= std::max(1, p.points);
+    p.centroid = grid.centroids[v].cast<double>();
+    p.points = grid.member_count(static_cast<int>(v));
     if (p.points < kMinPatchPoints) continue;
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (int i : members[v]) {
-      const Eigen::Vector3d q = cloud[i].getVector3fMap().cast<double>() - p.centroid;
+    for (const int* i = grid.members_begin(static_cast<int>(v)); i != grid.members_end(static_cast<int>(v)); ++i) {
+      const Eigen::Vector3d q = cloud[*i].getVector3fMap().cast<double>() - p.centroid;
       cov += q * q.transpose();
     }
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
@@ -81,6 +77,20 @@ Link classify(const Patch& a, const Patch& b, const ConvexityParams& params) {
   return cos_angle >= std::cos(params.crease_angle_deg * M_PI / 180.0) ? Link::kConvex : Link::kConcave;
 }
 
+// The 13 forward offsets of the 26-neighbourhood: each unordered pair of patches once.
+const std::vector<std::array<int, 3>>& forward_offsets() {
+  static const std::vector<std::array<int, 3>> offsets = [] {
+    std::vector<std::array<int, 3>> out;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          if (dx > 0 || (dx == 0 && (dy > 0 || (dy == 0 && dz > 0)))) out.push_back({dx, dy, dz});
+        }
+    return out;
+  }();
+  return offsets;
+}
+
 // Point statistics of a part: its width is the extent across its second principal axis
 // (sqrt(12 var) for points spread evenly over that width).
 struct PartShape {
@@ -106,17 +116,22 @@ struct PartShape {
 
 std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std::vector<int>& cluster,
                                                    const Eigen::Vector3d& sensor_origin, const ConvexityParams& params) {
-  std::optional<DepthStepParams> steps;
-  if (params.use_depth_steps) steps = params.depth_steps;
-  const SurfacePatches surface = surface_patches(cloud, cluster, params.patch_size_m, sensor_origin, steps);
-  const std::vector<Patch> patches = make_patches(cloud, surface.members, sensor_origin);
+  const VoxelIndex grid(cloud, cluster, params.patch_size_m);
+  const std::vector<Patch> patches = make_patches(cloud, grid, sensor_origin);
   const int n = static_cast<int>(patches.size());
   // Too sparse to judge convexity (a far or low-resolution view): most points must lie in patches
   // dense enough for a steady normal, else there is no evidence of a crease.
   std::size_t in_dense = 0;
   for (const Patch& p : patches) in_dense += p.points >= kDensePatchPoints ? p.points : 0;
   if (2 * in_dense < cluster.size()) return {cluster};
-  const std::vector<std::pair<int, int>>& adjacent = surface.adjacent;
+  std::vector<std::pair<int, int>> adjacent;
+  for (int v = 0; v < n; ++v) {
+    const auto& c = grid.coords[v];
+    for (const auto& o : forward_offsets()) {
+      const int w = grid.find(c[0] + o[0], c[1] + o[1], c[2] + o[2]);
+      if (w >= 0) adjacent.emplace_back(v, w);
+    }
+  }
 
   // Smooth surfaces first (faces of a box, the body of a bowl); then neighbouring surfaces are
   // one object when most patch links along their common border are convex. One noisy link
@@ -126,10 +141,8 @@ std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std
   for (std::size_t e = 0; e < adjacent.size(); ++e) {
     const auto [a, b] = adjacent[e];
     if (!patches[a].has_normal || !patches[b].has_normal) continue;
-    links[e] = surface.stepped[e] ? Link::kConcave : classify(patches[a], patches[b], params);
-    // One smooth surface only where the pixels meet: patches close in space but apart in the
-    // image may be one surface in front of another (their normals agree all the same).
-    if (links[e] == Link::kSmooth && surface.touching[e]) patch_uf.unite(a, b);
+    links[e] = classify(patches[a], patches[b], params);
+    if (links[e] == Link::kSmooth) patch_uf.unite(a, b);
   }
   std::map<std::pair<int, int>, std::pair<int, int>> votes;  // (convex, concave) per surface pair
   for (std::size_t e = 0; e < adjacent.size(); ++e) {
@@ -165,9 +178,7 @@ std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std
   }
   // Patches without a normal take the part of their largest neighbour with one.
   std::vector<int> best_neighbour(n, -1);
-  for (std::size_t e = 0; e < adjacent.size(); ++e) {
-    if (surface.stepped[e]) continue;  // not across a step
-    const auto [a, b] = adjacent[e];
+  for (const auto& [a, b] : adjacent) {
     for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, a}}) {
       if (patches[x].has_normal || !patches[y].has_normal) continue;
       if (best_neighbour[x] < 0 || patches[y].points > patches[best_neighbour[x]].points) best_neighbour[x] = y;
@@ -184,7 +195,7 @@ std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std
   for (int v = 0; v < n; ++v) label[v] = patch_uf.find(v);
   std::map<int, PartShape> shapes;
   for (int v = 0; v < n; ++v) {
-    for (int i : surface.members[v]) shapes[label[v]].add(cloud[i].getVector3fMap().cast<double>());
+    for (const int* i = grid.members_begin(v); i != grid.members_end(v); ++i) shapes[label[v]].add(cloud[*i].getVector3fMap().cast<double>());
   }
   std::map<int, bool> wide;  // per part, one eigen-solve
   for (const auto& [part, shape] : shapes) wide[part] = shape.width() >= params.min_part_size_m;
@@ -220,7 +231,7 @@ std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std
   std::map<int, std::vector<int>> by_part;
   for (int v = 0; v < n; ++v) {
     auto& out = by_part[owner[v]];
-    out.insert(out.end(), surface.members[v].begin(), surface.members[v].end());
+    out.insert(out.end(), grid.members_begin(v), grid.members_end(v));
   }
   std::vector<std::vector<int>> result;
   result.reserve(by_part.size());

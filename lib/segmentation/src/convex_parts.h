@@ -11,7 +11,6 @@
 
 #include <vector>
 
-#include "depth_steps.h"
 #include "scenewatch/core/cloud.h"
 
 namespace scenewatch::segmentation {
@@ -27,10 +26,6 @@ struct ConvexityParams {
   /// Parts narrower than this (across their second principal axis) are fragments (a row of
   /// patches straddling a crease) and are shared out among the parts they touch.
   double min_part_size_m = 0.03;
-  /// Organized clouds: patches are cut at depth steps, and neighbouring patches whose pixels
-  /// meet mostly across steps are one surface in front of another (surface_patches.h).
-  bool use_depth_steps = true;
-  DepthStepParams depth_steps;
 };
 
 /// The convex parts of one cluster (indices into `cloud`), each a sorted index list. The sensor
