@@ -2,7 +2,8 @@
 //  1. voxelize the valid points (centroid per voxel, point -> voxel map);
 //  2. RANSAC planes on the voxel centroids (seeded, optional up-vector constraint), refined by
 //     least squares; each plane keeps its largest connected part (a 2D grid on the plane bridges
-//     the shadows that objects cast on the table);
+//     the shadows that objects cast on the table and, seen from one view, the table hidden
+//     behind a pile: support_extent.h);
 //  3. convex hull of each plane (Andrew's monotone chain in the plane's 2D basis);
 //  4. voxels in the prism above a hull are clustered (Euclidean, union-find over grid
 //     neighbours), and every input point of a cluster voxel at object height joins the object.
