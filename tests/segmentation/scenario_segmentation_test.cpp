@@ -127,5 +127,16 @@ TEST(ScenarioSegmentation, Clutter) {
   EXPECT_GE(run.correct, 154u) << "of " << run.clusters << " clusters";
 }
 
+// A box as wide as the table hides the table behind it: the table shows in two pieces, one
+// support all the same, and the boxes on both pieces are found (with the largest piece alone
+// as the support: 6 of 9, the box behind is lost).
+TEST(ScenarioSegmentation, TableSplitByAnOccluderIsOneSupport) {
+  const SceneRun run = run_scenario("hidden_table");
+  ASSERT_EQ(run.frames, 3u);
+  std::printf("hidden table: matched %zu of %zu, correct %zu of %zu\n", run.matched, run.objects, run.correct, run.clusters);
+  EXPECT_EQ(run.matched, run.objects);
+  EXPECT_EQ(run.correct, run.clusters);
+}
+
 }  // namespace
 }  // namespace scenewatch::segmentation

@@ -2,7 +2,8 @@
 //  1. voxelize the valid points (centroid per voxel, point -> voxel map);
 //  2. RANSAC planes on the voxel centroids (seeded, optional up-vector constraint), refined by
 //     least squares; each plane keeps its largest connected part (a 2D grid on the plane bridges
-//     the shadows that objects cast on the table);
+//     the shadows that objects cast on the table and, seen from one view, the table hidden
+//     behind a pile: support_extent.h);
 //  3. convex hull of each plane (Andrew's monotone chain in the plane's 2D basis);
 //  4. voxels in the prism above a hull are clustered (Euclidean, union-find over grid
 //     neighbours), and every input point of a cluster voxel at object height joins the object.
@@ -20,6 +21,7 @@
 #include "hull2d.h"
 #include "occlusion_join.h"
 #include "support.h"
+#include "support_extent.h"
 #include "through_image.h"
 #include "union_find.h"
 #include "voxel_columns.h"
@@ -106,52 +108,6 @@ RansacResult ransac_plane(const std::vector<Eigen::Vector3f>& centroids, const s
     }
   }
   return best;
-}
-
-// Largest 8-connected group of the inlier voxels on a 2D grid of cell `cell_m` in the plane.
-std::vector<int> largest_component(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
-                                   const Eigen::Vector3d& u, const Eigen::Vector3d& v, double cell_m) {
-  auto key = [](long a, long b) { return (static_cast<std::uint64_t>(a + (1 << 30)) << 32) | static_cast<std::uint64_t>(b + (1 << 30)); };
-  tsl::robin_map<std::uint64_t, int, MixHash64> cells;
-  std::vector<std::pair<long, long>> cell_coords;
-  std::vector<int> voxel_cell(inliers.size());
-  for (std::size_t i = 0; i < inliers.size(); ++i) {
-    const Eigen::Vector3d p = centroids[inliers[i]].cast<double>();
-    const long a = static_cast<long>(std::floor(p.dot(u) / cell_m)), b = static_cast<long>(std::floor(p.dot(v) / cell_m));
-    auto [it, inserted] = cells.try_emplace(key(a, b), static_cast<int>(cell_coords.size()));
-    if (inserted) cell_coords.emplace_back(a, b);
-    voxel_cell[i] = it->second;
-  }
-  std::vector<int> comp(cell_coords.size(), -1);
-  std::vector<int> stack;
-  int ncomp = 0;
-  for (std::size_t c = 0; c < cell_coords.size(); ++c) {
-    if (comp[c] >= 0) continue;
-    comp[c] = ncomp;
-    stack.assign(1, static_cast<int>(c));
-    while (!stack.empty()) {
-      const int cur = stack.back();
-      stack.pop_back();
-      for (long da = -1; da <= 1; ++da)
-        for (long db = -1; db <= 1; ++db) {
-          auto it = cells.find(key(cell_coords[cur].first + da, cell_coords[cur].second + db));
-          if (it != cells.end() && comp[it->second] < 0) {
-            comp[it->second] = ncomp;
-            stack.push_back(it->second);
-          }
-        }
-    }
-    ++ncomp;
-  }
-  std::vector<std::size_t> size(ncomp, 0);
-  for (std::size_t i = 0; i < inliers.size(); ++i) ++size[comp[voxel_cell[i]]];
-  const int best = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
-  std::vector<int> out;
-  out.reserve(size[best]);
-  for (std::size_t i = 0; i < inliers.size(); ++i) {
-    if (comp[voxel_cell[i]] == best) out.push_back(inliers[i]);
-  }
-  return out;
 }
 
 // Least height above the plane at which a point at `range_m` from the sensor counts as an object:
@@ -373,7 +329,13 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
     PlaneFrame frame;
     frame.model = model;
     plane_basis(model.n, frame.u, frame.v);
-    const std::vector<int> part = largest_component(centroids, inliers, frame.u, frame.v, cfg.plane_connectivity_m);
+    // One view sees where a pile hides the plane: its visible pieces around the pile are one
+    // support (support_extent.h). A merged cloud has no single viewpoint.
+    std::optional<Eigen::Vector3d> viewpoint;
+    if (cloud.height > 1) viewpoint = sensor_origin;
+    const PlaneGrid plane_grid{model.n, frame.u, frame.v, model.d, cfg.plane_connectivity_m};
+    const std::vector<int> part = support_extent(centroids, inliers, plane_grid, remaining, viewpoint, cfg.plane_distance_m,
+                                                 cfg.max_object_height_m);
     std::vector<Vec2> pts2;
     pts2.reserve(part.size());
     for (int v : part) {

@@ -1,0 +1,118 @@
+// Connected part of a support, bridged where the sensor cannot see it: see support_extent.h.
+#include "support_extent.h"
+
+#include <tsl/robin_map.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "scenewatch/core/hash.h"
+
+namespace scenewatch::segmentation {
+namespace {
+
+std::uint64_t cell_key(long a, long b) {
+  return (static_cast<std::uint64_t>(a + (1 << 30)) << 32) | static_cast<std::uint64_t>(b + (1 << 30));
+}
+
+// Cells of the plane's grid; inlier cells and hidden (connecting only) cells.
+class CellGrid {
+ public:
+  explicit CellGrid(const PlaneGrid& plane) : plane_(plane) {}
+  std::uint64_t key(const Eigen::Vector3d& p) const {
+    return cell_key(static_cast<long>(std::floor(p.dot(plane_.u) / plane_.cell_m)),
+                    static_cast<long>(std::floor(p.dot(plane_.v) / plane_.cell_m)));
+  }
+  int add(const Eigen::Vector3d& p) {
+    const long a = static_cast<long>(std::floor(p.dot(plane_.u) / plane_.cell_m));
+    const long b = static_cast<long>(std::floor(p.dot(plane_.v) / plane_.cell_m));
+    auto [it, inserted] = cells_.try_emplace(cell_key(a, b), static_cast<int>(coords_.size()));
+    if (inserted) coords_.emplace_back(a, b);
+    return it->second;
+  }
+  std::size_t size() const { return coords_.size(); }
+  // 8-connected components over all cells.
+  std::vector<int> components() const {
+    std::vector<int> comp(coords_.size(), -1);
+    std::vector<int> stack;
+    int ncomp = 0;
+    for (std::size_t c = 0; c < coords_.size(); ++c) {
+      if (comp[c] >= 0) continue;
+      comp[c] = ncomp;
+      stack.assign(1, static_cast<int>(c));
+      while (!stack.empty()) {
+        const int cur = stack.back();
+        stack.pop_back();
+        for (long da = -1; da <= 1; ++da)
+          for (long db = -1; db <= 1; ++db) {
+            auto it = cells_.find(cell_key(coords_[cur].first + da, coords_[cur].second + db));
+            if (it != cells_.end() && comp[it->second] < 0) {
+              comp[it->second] = ncomp;
+              stack.push_back(it->second);
+            }
+          }
+      }
+      ++ncomp;
+    }
+    return comp;
+  }
+
+ private:
+  const PlaneGrid& plane_;
+  tsl::robin_map<std::uint64_t, int, MixHash64> cells_;
+  std::vector<std::pair<long, long>> coords_;
+};
+
+bool has_pieces(const CellGrid& grid) {
+  const std::vector<int> comp = grid.components();
+  return std::any_of(comp.begin(), comp.end(), [](int c) { return c > 0; });
+}
+
+}  // namespace
+
+std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
+                                const PlaneGrid& plane, const std::vector<int>& standing,
+                                const std::optional<Eigen::Vector3d>& sensor_origin, double min_height_m,
+                                double max_height_m) {
+  CellGrid grid(plane);
+  std::vector<int> voxel_cell(inliers.size());
+  for (std::size_t i = 0; i < inliers.size(); ++i) voxel_cell[i] = grid.add(centroids[inliers[i]].cast<double>());
+  // One piece in sight: nothing to bridge.
+  if (sensor_origin && has_pieces(grid)) {
+    const Eigen::Vector3d& o = *sensor_origin;
+    const double o_height = plane.n.dot(o) + plane.d;
+    // The highest voxel over each cell hides the most: its shadow covers those of the voxels
+    // under it (same foot, shorter shadow the same way).
+    tsl::robin_map<std::uint64_t, std::pair<double, int>, MixHash64> highest;
+    for (int w : standing) {
+      const Eigen::Vector3d q = centroids[w].cast<double>();
+      const double h = plane.n.dot(q) + plane.d;
+      if (h <= min_height_m || h > max_height_m || h >= o_height) continue;
+      const std::uint64_t key = grid.key(q);
+      auto [it, inserted] = highest.try_emplace(key, h, w);
+      if (!inserted && it->second.first < h) it.value() = {h, w};
+    }
+    for (const auto& [key, top] : highest) {
+      const Eigen::Vector3d q = centroids[top.second].cast<double>();
+      const double h = top.first;
+      // The ray o + t (q - o) meets the plane at t = o_height / (o_height - h) > 1: behind q.
+      const Eigen::Vector3d foot = q - h * plane.n;
+      const Eigen::Vector3d shadow = o + (o_height / (o_height - h)) * (q - o);
+      const int steps = static_cast<int>(std::ceil((shadow - foot).norm() / plane.cell_m));
+      for (int k = 0; k <= steps; ++k) grid.add(foot + (shadow - foot) * (steps ? static_cast<double>(k) / steps : 0.0));
+    }
+  }
+  const std::vector<int> comp = grid.components();
+  std::vector<std::size_t> size(grid.size(), 0);
+  for (int c : voxel_cell) ++size[comp[c]];
+  const int best = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  std::vector<int> out;
+  out.reserve(size[best]);
+  for (std::size_t i = 0; i < inliers.size(); ++i) {
+    if (comp[voxel_cell[i]] == best) out.push_back(inliers[i]);
+  }
+  return out;
+}
+
+}  // namespace scenewatch::segmentation

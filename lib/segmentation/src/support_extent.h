@@ -1,0 +1,30 @@
+#pragma once
+// The extent of a supporting plane: the connected part of its inliers on a coarse grid in the
+// plane. Seen from one sensor, a pile of objects hides the table under and behind it, so the
+// visible table falls into pieces around the pile; the pieces are one support when the table
+// continues, hidden, between them. The hidden cells are those each object voxel covers: from its
+// foot on the plane to where the ray from the sensor through it meets the plane (its shadow).
+#include <Eigen/Core>
+
+#include <optional>
+#include <vector>
+
+namespace scenewatch::segmentation {
+
+/// A plane n.x + d = 0 with its 2D basis (u, v); n points to where objects stand.
+struct PlaneGrid {
+  Eigen::Vector3d n, u, v;
+  double d = 0.0;
+  double cell_m = 0.05;  ///< gaps narrower than a cell do not split the plane
+};
+
+/// The largest 8-connected group of the inlier voxels (indices into `centroids`) on the plane's
+/// grid, with cells hidden from `sensor_origin` counted as connecting (not as inliers) when
+/// `sensor_origin` is given: hidden by the voxels `standing`, those at a height above the plane
+/// in (min_height_m, max_height_m].
+std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
+                                const PlaneGrid& plane, const std::vector<int>& standing,
+                                const std::optional<Eigen::Vector3d>& sensor_origin, double min_height_m,
+                                double max_height_m);
+
+}  // namespace scenewatch::segmentation
