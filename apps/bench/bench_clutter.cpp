@@ -80,10 +80,7 @@ std::vector<int> range(int a, int b) {
   return v;
 }
 
-}  // namespace
-
-int run_clutter(const Options& o) {
-  const segmentation::Config cfg;
+int run_clutter_with(const Options& o, const segmentation::Config& cfg, const char* label) {
   const std::vector<Set> sets = {
       {"learn boxes 0-16", "mosd/learn", "learn", range(0, 16)},
       {"learn stacked 17-24", "mosd/learn", "learn", range(17, 24)},
@@ -94,7 +91,7 @@ int run_clutter(const Options& o) {
       {"test_dev mixed, held out 52-54", "mosd/test_dev", "test", range(52, 54)},
       {"test_dev piles, held out 58-59", "mosd/test_dev", "test", range(58, 59)},
   };
-  std::printf("\n== Objects in clutter: mOSD learn + test_dev, as recorded and unorganized (shuffled, height 1)\n");
+  std::printf("\n== Objects in clutter: mOSD learn + test_dev, as recorded and unorganized (shuffled, height 1), %s\n", label);
   std::printf("%-32s %7s %16s %16s %9s %16s %16s %9s\n", "scenes", "objects", "recall", "precision", "ms", "unorg. recall",
               "unorg. precision", "ms");
   Tally total[2];
@@ -140,6 +137,15 @@ int run_clutter(const Options& o) {
               " one labelled object; ms = median segmentation time per scene. Tuning scenes: test43-51, test55-57; the\n"
               " held-out rows were not used to choose anything)\n");
   return 0;
+}
+
+}  // namespace
+
+int run_clutter(const Options& o) {
+  segmentation::Config bridged;
+  bridged.bridge_hidden_support = true;
+  return run_clutter_with(o, segmentation::Config{}, "default config") |
+         run_clutter_with(o, bridged, "segmentation.bridge_hidden_support: true");
 }
 
 }  // namespace scenewatch::bench

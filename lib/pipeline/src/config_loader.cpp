@@ -143,7 +143,8 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("concavity_tolerance_deg", g.concavity_tolerance_deg); },
                            [&] { return s.read("crease_angle_deg", g.crease_angle_deg); },
                            [&] { return s.read("join_occluded", g.join_occluded); },
-                           [&] { return s.read("recover_image_grid", g.recover_image_grid); });
+                           [&] { return s.read("recover_image_grid", g.recover_image_grid); },
+                           [&] { return s.read("bridge_hidden_support", g.bridge_hidden_support); });
         !st)
       return st;
     if (!up.empty()) {

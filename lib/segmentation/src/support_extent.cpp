@@ -32,6 +32,15 @@ class CellGrid {
     return it->second;
   }
   std::size_t size() const { return coords_.size(); }
+  /// True when the cell of p or one of its 8 neighbours is in the grid.
+  bool near(const Eigen::Vector3d& p) const {
+    const long a = static_cast<long>(std::floor(p.dot(plane_.u) / plane_.cell_m));
+    const long b = static_cast<long>(std::floor(p.dot(plane_.v) / plane_.cell_m));
+    for (long da = -1; da <= 1; ++da)
+      for (long db = -1; db <= 1; ++db)
+        if (cells_.count(cell_key(a + da, b + db))) return true;
+    return false;
+  }
   // 8-connected components over all cells.
   std::vector<int> components() const {
     std::vector<int> comp(coords_.size(), -1);
@@ -85,10 +94,13 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
     // The highest voxel over each cell hides the most: its shadow covers those of the voxels
     // under it (same foot, shorter shadow the same way).
     tsl::robin_map<std::uint64_t, std::pair<double, int>, MixHash64> highest;
+    const CellGrid visible = grid;
     for (int w : standing) {
       const Eigen::Vector3d q = centroids[w].cast<double>();
       const double h = plane.n.dot(q) + plane.d;
       if (h <= min_height_m || h > max_height_m || h >= o_height) continue;
+      // Only what stands on the visible support hides it: its foot is at a visible cell.
+      if (!visible.near(q - h * plane.n)) continue;
       const std::uint64_t key = grid.key(q);
       auto [it, inserted] = highest.try_emplace(key, h, w);
       if (!inserted && it->second.first < h) it.value() = {h, w};

@@ -332,7 +332,7 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
     // One view sees where a pile hides the plane: its visible pieces around the pile are one
     // support (support_extent.h). A merged cloud has no single viewpoint.
     std::optional<Eigen::Vector3d> viewpoint;
-    if (cloud.height > 1) viewpoint = sensor_origin;
+    if (cfg.bridge_hidden_support && cloud.height > 1) viewpoint = sensor_origin;
     const PlaneGrid plane_grid{model.n, frame.u, frame.v, model.d, cfg.plane_connectivity_m};
     const std::vector<int> part = support_extent(centroids, inliers, plane_grid, remaining, viewpoint, cfg.plane_distance_m,
                                                  cfg.max_object_height_m);
