@@ -5,8 +5,6 @@
 // The split: thresholds were only ever looked at on the tuning scenes of test_dev (test43-51 and
 // test55-57); test52-54 and test58-59 are reported apart and were not used to choose anything.
 // test56 and test58 are unorganized as shipped: their "as recorded" figure is already unorganized.
-#include <random>
-
 #include "bench.h"
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/segmentation/evaluation.h"
@@ -35,27 +33,11 @@ struct Labelled {
   std::vector<std::uint32_t> labels;
 };
 
-// The valid points of a scene in a random order (seeded), with their labels: what a merged or
-// converted cloud looks like to the segmentation.
-Labelled unorganized_copy(const Labelled& in, std::uint32_t seed) {
-  std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < in.cloud->size(); ++i)
-    if (is_valid((*in.cloud)[i])) order.push_back(i);
-  std::mt19937 rng(seed);
-  std::shuffle(order.begin(), order.end(), rng);
-  auto cloud = std::make_shared<Cloud>();
-  Labelled out;
-  cloud->reserve(order.size());
-  out.labels.reserve(order.size());
-  for (std::size_t i : order) {
-    cloud->push_back((*in.cloud)[i]);
-    out.labels.push_back(in.labels[i]);
-  }
-  cloud->width = static_cast<std::uint32_t>(cloud->size());
-  cloud->height = 1;
-  cloud->is_dense = true;
-  out.cloud = cloud;
-  return out;
+// The unorganized copy of a scene (segmentation::unorganized_copy): what a merged or converted
+// cloud looks like to the segmentation.
+Labelled unorganized(const Labelled& in, std::uint32_t seed) {
+  auto copy = segmentation::unorganized_copy(*in.cloud, in.labels, seed);
+  return {std::make_shared<Cloud>(std::move(copy.cloud)), std::move(copy.labels)};
 }
 
 segmentation::LabelScore score(const Labelled& scene, const segmentation::Config& cfg, double& ms) {
@@ -106,7 +88,7 @@ int run_clutter_with(const Options& o, const segmentation::Config& cfg, const ch
         return 1;
       }
       const Labelled scene{file->cloud, std::move(*labels)};
-      const Labelled shuffled = unorganized_copy(scene, 1000u + static_cast<std::uint32_t>(i));
+      const Labelled shuffled = unorganized(scene, 1000u + static_cast<std::uint32_t>(i));
       double ms[2] = {0, 0};
       const segmentation::LabelScore s0 = score(scene, cfg, ms[0]);
       const segmentation::LabelScore s1 = score(shuffled, cfg, ms[1]);

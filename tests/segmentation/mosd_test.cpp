@@ -3,7 +3,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <random>
 
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/segmentation/evaluation.h"
@@ -18,10 +17,7 @@ struct SceneFigures {
   double table_iou = 0;
 };
 
-struct Labelled {
-  Cloud cloud;
-  std::vector<std::uint32_t> labels;
-};
+using Labelled = LabelledCloud;
 
 Labelled load(const std::filesystem::path& path) {
   auto file = io::read_cloud(path);
@@ -30,24 +26,6 @@ Labelled load(const std::filesystem::path& path) {
   EXPECT_TRUE(labels.ok());
   if (!file.ok() || !labels.ok()) return {};
   return {*file->cloud, std::move(*labels)};
-}
-
-// The valid points of a scene in a seeded random order with their labels, height 1: the scene as
-// a converter that drops NaNs, or a merge, hands it over.
-Labelled unorganized_copy(const Labelled& in, std::uint32_t seed) {
-  std::vector<std::size_t> order;
-  for (std::size_t i = 0; i < in.cloud.size(); ++i)
-    if (is_valid(in.cloud[i])) order.push_back(i);
-  std::mt19937 rng(seed);
-  std::shuffle(order.begin(), order.end(), rng);
-  Labelled out;
-  for (std::size_t i : order) {
-    out.cloud.push_back(in.cloud[i]);
-    out.labels.push_back(in.labels[i]);
-  }
-  out.cloud.width = static_cast<std::uint32_t>(out.cloud.size());
-  out.cloud.height = 1;
-  return out;
 }
 
 SceneFigures figures(const Labelled& scene, const std::string& name, bool print, int stride = 1, const Config& config = {}) {
@@ -190,7 +168,7 @@ TEST(Mosd, UnorganizedCopiesGiveTheSameObjects) {
     const Labelled scene = load(paths[k]);
     ASSERT_GT(scene.cloud.height, 1u) << paths[k];
     const SceneFigures a = figures(scene, paths[k].filename().string(), false);
-    const SceneFigures b = figures(unorganized_copy(scene, 100 + static_cast<std::uint32_t>(k)), "shuffled", false);
+    const SceneFigures b = figures(unorganized_copy(scene.cloud, scene.labels, 100 + static_cast<std::uint32_t>(k)), "shuffled", false);
     EXPECT_EQ(a.objects, b.objects) << paths[k];
     EXPECT_EQ(a.matched, b.matched) << paths[k];
     EXPECT_EQ(a.clusters, b.clusters) << paths[k];

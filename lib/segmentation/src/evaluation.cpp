@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <random>
 
 namespace scenewatch::segmentation {
 
@@ -54,6 +55,25 @@ LabelScore score_against_labels(const std::vector<std::vector<int>>& clusters, c
     if (n >= min_object_points) score.objects.push_back(o);
   }
   return score;
+}
+
+LabelledCloud unorganized_copy(const Cloud& cloud, const std::vector<std::uint32_t>& labels, std::uint32_t seed) {
+  std::vector<std::size_t> order;
+  for (std::size_t i = 0; i < cloud.size(); ++i)
+    if (is_valid(cloud[i])) order.push_back(i);
+  std::mt19937 rng(seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  LabelledCloud out;
+  out.cloud.reserve(order.size());
+  out.labels.reserve(order.size());
+  for (std::size_t i : order) {
+    out.cloud.push_back(cloud[i]);
+    out.labels.push_back(labels[i]);
+  }
+  out.cloud.width = static_cast<std::uint32_t>(out.cloud.size());
+  out.cloud.height = 1;
+  out.cloud.is_dense = true;
+  return out;
 }
 
 }  // namespace scenewatch::segmentation

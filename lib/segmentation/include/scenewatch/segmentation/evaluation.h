@@ -4,6 +4,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "scenewatch/core/cloud.h"
+
 namespace scenewatch::segmentation {
 
 struct ObjectScore {
@@ -34,5 +36,15 @@ struct LabelScore {
 LabelScore score_against_labels(const std::vector<std::vector<int>>& clusters, const std::vector<int>& plane_indices,
                                 const std::vector<std::uint32_t>& labels, std::uint32_t table_label = 1,
                                 std::uint32_t divisor = 10, std::size_t min_object_points = 0);
+
+/// A cloud with one label per point.
+struct LabelledCloud {
+  Cloud cloud;
+  std::vector<std::uint32_t> labels;
+};
+
+/// The valid points of a labelled scene in a seeded random order, with their labels, height 1:
+/// the scene as a converter that drops NaNs, or a merge, hands it over.
+LabelledCloud unorganized_copy(const Cloud& cloud, const std::vector<std::uint32_t>& labels, std::uint32_t seed);
 
 }  // namespace scenewatch::segmentation
