@@ -134,6 +134,7 @@ void offline_side_by_side(const Sequence& s) {
   no_sensor_remedies.change.measure_pose = false;
   no_sensor_remedies.change.trusted_pixels_only = false;
   no_sensor_remedies.change.witness_per_camera = false;
+  no_sensor_remedies.change.incidence_aware = false;
   const auto before = offline(s, every_pixel, false);
   const auto without = offline(s, no_sensor_remedies, false);
   const auto now = offline(s, config, true);

@@ -158,10 +158,12 @@ int run_sensor_model(const Options& o) {
       {"no measured pose", [](pipeline::Config& c) { c.change.measure_pose = false; }},
       {"every pixel evidence", [](pipeline::Config& c) { c.change.trusted_pixels_only = false; }},
       {"no per-camera witness", [](pipeline::Config& c) { c.change.witness_per_camera = false; }},
+      {"head-on noise only", [](pipeline::Config& c) { c.change.incidence_aware = false; }},
       {"none of these", [](pipeline::Config& c) {
          c.change.measure_pose = false;
          c.change.trusted_pixels_only = false;
          c.change.witness_per_camera = false;
+         c.change.incidence_aware = false;
        }},
   });
   return 0;

@@ -95,15 +95,7 @@ ChangeCluster cluster_on(const Cloud& cloud, ChangeKind kind, std::vector<int> i
   return c;
 }
 
-Intrinsics flat_camera() {
-  Intrinsics K;
-  K.fx = K.fy = 525;
-  K.cx = 49.5;
-  K.cy = 4.5;
-  K.width = 100;
-  K.height = 10;
-  return K;
-}
+Intrinsics flat_camera() { return centred_pinhole(100, 10, 525); }
 
 TEST(Completion, TwoFringesOfOneObjectBecomeOneWholeObject) {
   const Cloud before = flat_cloud(), after = flat_cloud();

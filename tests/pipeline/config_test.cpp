@@ -119,6 +119,7 @@ TEST_F(ConfigTest, ShippedConfigIsValid) {
   EXPECT_EQ(c.change.trusted_pixels_only, d.change.trusted_pixels_only);
   EXPECT_EQ(c.change.measure_pose, d.change.measure_pose);
   EXPECT_EQ(c.change.witness_per_camera, d.change.witness_per_camera);
+  EXPECT_EQ(c.change.incidence_aware, d.change.incidence_aware);
 }
 
 TEST_F(ConfigTest, StreamKeysAreChecked) {

@@ -226,7 +226,9 @@ TEST(Stream, TwoCamerasOnOneRoomInterleaved) {
   }
   const auto events = run_recording(test::data_dir() / "redkitchen_long", order, cameras);
   std::printf("redkitchen_long two cameras interleaved: %zu events in 200 frames\n", events.size());
-  EXPECT_LE(events.size(), 3u);  // 3 measured (1.5 per 100 frames; the issue asks at most 1)
+  // 3 measured before the noise along the ray counted the incidence (change.incidence_aware), 1
+  // since (0.5 per 100 frames; the issue asks at most 1).
+  EXPECT_LE(events.size(), 1u);
 }
 
 }  // namespace

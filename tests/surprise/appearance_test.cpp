@@ -10,15 +10,7 @@
 namespace scenewatch::background {
 namespace {
 
-Intrinsics small_camera() {
-  Intrinsics K;
-  K.fx = K.fy = 150;
-  K.cx = 79.5;
-  K.cy = 59.5;
-  K.width = 160;
-  K.height = 120;
-  return K;
-}
+Intrinsics small_camera() { return centred_pinhole(160, 120, 150); }
 
 // A camera at T_world_camera looking at the world plane z = 0 (the camera's z axis must point at
 // it); colour is a checkerboard of the plane's world coordinates.

@@ -3,12 +3,14 @@
 #include "scenewatch/change/mismatch.h"
 
 #include "scenewatch/core/depth_validity.h"
+#include "scenewatch/core/surface_incidence.h"
 #include "scenewatch/io/rgbd.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace scenewatch::change {
 namespace {
@@ -43,6 +45,35 @@ bool claims_new_surface(const background::DenseGrid& grid, const Eigen::Vector3d
   return true;
 }
 
+// The farthest ring of voxels searched for a surface near a point (7 x 7 x 7 .. 11 x 11 x 11).
+constexpr int kMaxRing = 5;
+
+// Whether a voxel that is not free (a surface, or space never seen: the far side of a thin leg
+// whose silhouette rays grazed this voxel) has its centre within `reach` of w, in voxel idx.
+bool surface_within(const background::DenseGrid& grid, long idx, const Eigen::Vector3d& w, double reach) {
+  using background::Occupancy;
+  const int ring = std::min(kMaxRing, static_cast<int>(std::ceil(reach / grid.resolution - 0.5)));
+  const long sz = static_cast<long>(grid.nx) * grid.ny;
+  const long i0 = idx % grid.nx, j0 = (idx / grid.nx) % grid.ny, k0 = idx / sz;
+  const double reach2 = reach * reach;
+  for (int dk = -ring; dk <= ring; ++dk) {
+    const long k = k0 + dk;
+    if (k < 0 || k >= grid.nz) continue;
+    for (int dj = -ring; dj <= ring; ++dj) {
+      const long j = j0 + dj;
+      if (j < 0 || j >= grid.ny) continue;
+      for (int di = -ring; di <= ring; ++di) {
+        const long ii = i0 + di;
+        if (ii < 0 || ii >= grid.nx) continue;
+        const long n = k * sz + j * grid.nx + ii;
+        if (grid.state[n] == static_cast<std::uint8_t>(Occupancy::kFree)) continue;
+        if ((grid.center(n) - w).squaredNorm() < reach2) return true;
+      }
+    }
+  }
+  return false;
+}
+
 }  // namespace
 
 Status validate(const Config& c) {
@@ -74,8 +105,12 @@ Status validate(const Config& c) {
 double tolerance_m(const Config& c, double z) { return std::max(c.min_tolerance_m, c.sigma_factor * c.sensor.sigma_z(z)); }
 
 double map_tolerance_m(const Config& c, double z, double pose_shift_m) {
-  const double sensor = c.sensor.sigma_z(z), pose = c.sensor.pose_sigma_at(z);
-  return std::max(c.min_tolerance_m, c.sigma_factor * std::sqrt(sensor * sensor + pose * pose)) + pose_shift_m;
+  return map_tolerance_from_sigma(c, c.sensor.sigma_z(z), z, pose_shift_m);
+}
+
+double map_tolerance_from_sigma(const Config& c, double sensor_sigma_m, double z, double pose_shift_m) {
+  const double pose = c.sensor.pose_sigma_at(z);
+  return std::max(c.min_tolerance_m, c.sigma_factor * std::hypot(sensor_sigma_m, pose)) + pose_shift_m;
 }
 
 Result<Intrinsics> observation_camera(const Cloud& cloud, const std::optional<Intrinsics>& K) {
@@ -172,49 +207,34 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   //    occupied voxel may lie anywhere in it). Only points in free voxels pay for the search.
   const auto t1 = Clock::now();
   const bool organized = cloud.height > 1 && static_cast<int>(cloud.width) == K.width;
-  using background::Occupancy;
-  const long sx = 1, sy = grid.nx, sz = static_cast<long>(grid.nx) * grid.ny;
+  auto pixel_of = [&](std::size_t i, const PointT& p) {
+    if (organized) return std::pair<int, int>(static_cast<int>(i % cloud.width), static_cast<int>(i / cloud.width));
+    return std::pair<int, int>(static_cast<int>(std::lround(K.fx * p.x / p.z + K.cx)), static_cast<int>(std::lround(K.fy * p.y / p.z + K.cy)));
+  };
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const PointT& p = cloud.points[i];
     if (!is_valid(p) || p.z > config.max_range_m) continue;
     const Eigen::Vector3d w = (Tf * p.getVector3fMap()).cast<double>();
     const long idx = grid.index_of(w);
-    if (grid.at(idx) != Occupancy::kFree) continue;
-    if (config.trusted_pixels_only) {
-      const int u = organized ? static_cast<int>(i % cloud.width) : static_cast<int>(std::lround(K.fx * p.x / p.z + K.cx));
-      const int v = organized ? static_cast<int>(i / cloud.width) : static_cast<int>(std::lround(K.fy * p.y / p.z + K.cy));
-      if (!trusted_at(u, v)) continue;
-    }
-    const double reach = kHalfDiagonal * res + map_tolerance_m(config, p.z, measured_pose.shift_at(w));
-    const int ring = std::min(3, static_cast<int>(std::ceil(reach / res - 0.5)));
-    const long i0 = idx % grid.nx, j0 = (idx / grid.nx) % grid.ny, k0 = idx / sz;
-    double nearest2 = reach * reach;
-    bool near_surface = false;
-    for (int dk = -ring; dk <= ring && !near_surface; ++dk) {
-      const long k = k0 + dk;
-      if (k < 0 || k >= grid.nz) continue;
-      for (int dj = -ring; dj <= ring && !near_surface; ++dj) {
-        const long j = j0 + dj;
-        if (j < 0 || j >= grid.ny) continue;
-        for (int di = -ring; di <= ring; ++di) {
-          const long ii = i0 + di;
-          if (ii < 0 || ii >= grid.nx) continue;
-          const long n = k * sz + j * sy + ii * sx;
-          // Near a surface, or near space never seen (the far side of a thin leg whose
-          // silhouette rays grazed this voxel): no claim.
-          if (grid.state[n] == static_cast<std::uint8_t>(Occupancy::kFree)) continue;
-          const double d2 = (grid.center(n) - w).squaredNorm();
-          if (d2 < nearest2) {
-            near_surface = true;
-            break;
-          }
-        }
+    if (grid.at(idx) != background::Occupancy::kFree) continue;
+    const auto [u, v] = pixel_of(i, p);
+    if (!trusted_at(u, v)) continue;
+    const double shift = measured_pose.shift_at(w);
+    const double gap = kHalfDiagonal * res + map_tolerance_m(config, p.z, shift);
+    if (surface_within(grid, idx, w, gap)) continue;
+    if (config.incidence_aware) {
+      // The depth of a surface seen at a grazing angle is known only coarsely along its ray, and
+      // so is the free space that rays running along it carved: the claim must clear that too.
+      const double incidence = surface_incidence_rad(depth.z, K, u, v, config.sensor, config.sigma_factor);
+      if (std::isfinite(incidence)) {
+        const double sigma = config.sensor.sigma_along_ray(p.z, incidence, std::min(K.fx, K.fy));
+        const double reach = kHalfDiagonal * res + map_tolerance_from_sigma(config, sigma, p.z, shift);
+        if (reach > (kMaxRing + 0.5) * res || surface_within(grid, idx, w, reach)) continue;
       }
     }
-    if (near_surface) continue;
     if (witness != nullptr && !claims_new_surface(grid, T.translation(), w, *witness, camera)) continue;
     out.added.push_back(static_cast<int>(i));
-    out.added_gap_m.push_back(static_cast<float>(reach));
+    out.added_gap_m.push_back(static_cast<float>(gap));
   }
   out.added_ms = ms_since(t1);
 

@@ -46,6 +46,16 @@ const char* to_string(EventKind kind) {
   return "UNKNOWN";
 }
 
+Intrinsics centred_pinhole(int width, int height, double focal_px) {
+  Intrinsics K;
+  K.fx = K.fy = focal_px;
+  K.cx = width / 2.0 - 0.5;
+  K.cy = height / 2.0 - 0.5;
+  K.width = width;
+  K.height = height;
+  return K;
+}
+
 Status validate_rigid(const Eigen::Matrix4d& m, double tolerance) {
   if (!m.allFinite()) return invalid_argument("pose has non-finite entries");
   const Eigen::RowVector4d last_row = m.row(3);

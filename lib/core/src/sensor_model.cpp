@@ -35,6 +35,12 @@ double SensorModel::lateral_sigma_px(double incidence_rad) const {
   return lateral_px * (1.0 + 0.035 / 0.8 * theta / (M_PI / 2 - theta));
 }
 
+double SensorModel::sigma_along_ray(double z, double incidence_rad, double focal_px) const {
+  const double theta = std::clamp(incidence_rad, 0.0, kMaxIncidenceRad);
+  const double slope = lateral_sigma_px(theta) * z / std::max(focal_px, 1.0) * std::tan(theta);
+  return std::hypot(sigma_z(z, theta), slope);
+}
+
 int SensorModel::edge_band_px(double sigma_factor) const { return static_cast<int>(std::ceil(sigma_factor * lateral_px - 1e-9)); }
 
 double SensorModel::pose_sigma_at(double range_m) const {

@@ -191,7 +191,8 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("completion_stride_px", g.completion_stride_px); },
                            [&] { return s.read("trusted_pixels_only", g.trusted_pixels_only); },
                            [&] { return s.read("measure_pose", g.measure_pose); },
-                           [&] { return s.read("witness_per_camera", g.witness_per_camera); });
+                           [&] { return s.read("witness_per_camera", g.witness_per_camera); },
+                           [&] { return s.read("incidence_aware", g.incidence_aware); });
         !st)
       return st;
     if (auto st = s.finish(); !st) return st;

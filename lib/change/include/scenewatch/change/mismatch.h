@@ -39,6 +39,12 @@ struct Config {
   /// surfaces it saw itself (SurfaceWitness, surface_witness.h). false: against every surface of
   /// the map, whoever saw it.
   bool witness_per_camera = true;
+  /// Against a map: a point in free space claims a new surface only when it lies farther from
+  /// every surface than its noise along the ray at the incidence its surface is seen at
+  /// (SensorModel::sigma_along_ray, core/surface_incidence.h) allows. A surface seen at a grazing
+  /// angle (a cupboard's side, a standing magazine) is placed only coarsely along the ray, and the
+  /// space in front of it was carved by rays running along it. false: the head-on noise alone.
+  bool incidence_aware = true;
   /// Only voxels the map holds occupied with at least this probability can be claimed removed:
   /// a surface seen once (a flying pixel at a silhouette) is no evidence of an object. A map
   /// built from one frame holds prob_hit (0.7); diff() lowers the threshold to it.
@@ -94,6 +100,8 @@ double tolerance_m(const Config& config, double z);
 /// declared pose uncertainty (sensor.pose_sigma_*) together, plus how far the frame's measured
 /// misalignment (pose_agreement.h) has moved the point: a measured offset, not a spread.
 double map_tolerance_m(const Config& config, double z, double pose_shift_m = 0.0);
+/// ... for a measurement whose own noise is sensor_sigma_m (SensorModel::sigma_along_ray).
+double map_tolerance_from_sigma(const Config& config, double sensor_sigma_m, double z, double pose_shift_m = 0.0);
 
 /// A depth image in some camera: z per pixel (NaN where none), plus that camera.
 struct DepthView {

@@ -19,6 +19,9 @@ struct Intrinsics {
   bool valid() const { return fx > 0 && fy > 0 && width > 0 && height > 0; }
 };
 
+/// A pinhole of the given size and focal length (pixels), its principal point at the image centre.
+Intrinsics centred_pinhole(int width, int height, double focal_px);
+
 /// Checks that a 4x4 matrix is finite, rigid (orthonormal rotation, det +1) and has last row
 /// [0 0 0 1]. The message names what is wrong.
 Status validate_rigid(const Eigen::Matrix4d& m, double tolerance = 1e-3);

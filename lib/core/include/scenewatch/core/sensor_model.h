@@ -59,6 +59,10 @@ struct SensorModel {
   double sigma_z(double z_m, double incidence_rad) const;
   /// Lateral noise at an incidence angle, pixels (Nguyen's eq. (3)).
   double lateral_sigma_px(double incidence_rad) const;
+  /// How far along its ray a pixel's point may lie from where its surface crosses that ray, metres:
+  /// the axial noise at that incidence, and the lateral noise, which on a surface inclined at the
+  /// incidence moves the depth by lateral_sigma_px z / f tan(incidence).
+  double sigma_along_ray(double z_m, double incidence_rad, double focal_px) const;
   /// The uncertainty of a world position placed with the given pose at range z, metres:
   /// translation plus the rotation's arc, 1 sigma.
   double pose_sigma_at(double range_m) const;
