@@ -2,6 +2,7 @@
 #include "scenewatch/localization/keyframe_features.h"
 
 #include <cmath>
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 
@@ -62,7 +63,11 @@ ViewFeatures extract_features(const ColorImage& color, const DepthImage& depth, 
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
   orb->detectAndCompute(gray, cv::noArray(), keypoints, descriptors);
-  for (std::size_t i = 0; i < keypoints.size(); ++i) {
+  // Strongest first (ORB ranks keypoints by their Harris response): retrieval uses the first few.
+  std::vector<std::size_t> order(keypoints.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return keypoints[a].response > keypoints[b].response; });
+  for (std::size_t i : order) {
     const cv::Point2f& p = keypoints[i].pt;
     const float z = depth_at(depth, static_cast<int>(std::lround(p.x)), static_cast<int>(std::lround(p.y)), sensor);
     if (z <= 0.0f) continue;

@@ -12,7 +12,9 @@ namespace {
 // descriptors are not one corner.
 constexpr int kMaxHamming = 50;
 
-int hamming(const Descriptor& a, const Descriptor& b) {
+// Hamming distance of two 256-bit descriptors; the hardware popcount where the CPU has one
+// (chosen at load time).
+__attribute__((target_clones("popcnt", "default"))) int hamming(const Descriptor& a, const Descriptor& b) {
   int d = 0;
   for (int w = 0; w < 4; ++w) {
     std::uint64_t x, y;
@@ -36,6 +38,7 @@ Status validate(const RelocalizerConfig& c) {
   if (c.candidate_keyframes < 1 || c.candidate_keyframes > 20) return invalid_argument("localization.candidate_keyframes: must be in [1, 20]");
   if (!(c.match_ratio > 0 && c.match_ratio <= 1)) return invalid_argument("localization.match_ratio: must be in (0, 1]");
   if (c.min_inliers < 3) return invalid_argument("localization.min_feature_inliers: must be at least 3");
+  if (c.retrieval_features < 20) return invalid_argument("localization.retrieval_features: must be at least 20");
   if (!(c.tolerance_sigmas > 0 && c.tolerance_sigmas <= 10)) return invalid_argument("localization.tolerance_sigmas: must be in (0, 10]");
   return {};
 }
@@ -61,26 +64,26 @@ double Relocalizer::tolerance_m(const Eigen::Vector3f& p, float pixel_size, doub
 }
 
 std::vector<Correspondence> Relocalizer::correspondences(const ViewFeatures& frame, double frame_focal_px, const ViewFeatures& kf,
-                                                         double kf_focal_px) const {
+                                                         double kf_focal_px, std::size_t frame_limit) const {
   std::vector<Correspondence> pairs;
   if (kf.size() < 2) return pairs;
-  for (std::size_t i = 0; i < frame.size(); ++i) {
+  for (std::size_t i = 0; i < std::min(frame.size(), frame_limit); ++i) {
     int best = 257, second = 257;
-    std::size_t best_j = 0;
-    for (std::size_t j = 0; j < kf.size(); ++j) {
-      const int d = hamming(frame.descriptors[i], kf.descriptors[j]);
+    std::size_t j = 0;
+    for (std::size_t k = 0; k < kf.size(); ++k) {
+      const int d = hamming(frame.descriptors[i], kf.descriptors[k]);
       if (d < best) {
         second = best;
         best = d;
-        best_j = j;
+        j = k;
       } else if (d < second) {
         second = d;
       }
     }
     if (best > kMaxHamming || best >= config_.match_ratio * second) continue;
     const double sa = tolerance_m(frame.points_camera[i], frame.pixel_size[i], frame_focal_px);
-    const double sb = tolerance_m(kf.points_camera[best_j], kf.pixel_size[best_j], kf_focal_px);
-    pairs.push_back({kf.points_camera[best_j].cast<double>(), frame.points_camera[i].cast<double>(),
+    const double sb = tolerance_m(kf.points_camera[j], kf.pixel_size[j], kf_focal_px);
+    pairs.push_back({kf.points_camera[j].cast<double>(), frame.points_camera[i].cast<double>(),
                      config_.tolerance_sigmas * std::sqrt(sa * sa + sb * sb)});
   }
   return pairs;
@@ -92,17 +95,21 @@ std::vector<Hypothesis> Relocalizer::hypotheses(const ViewFeatures& frame, doubl
     std::shared_ptr<const background::Keyframe> keyframe;
     std::vector<Correspondence> pairs;
   };
+  // Retrieval: the keyframes sharing most of the frame's strongest features (a view of the same
+  // corners); then all of the frame's features are matched with those candidates only.
   std::vector<Candidate> candidates;
   for (const auto& kf : keyframes) {
-    auto pairs = correspondences(frame, focal_px, features(*kf), kf->intrinsics.fx);
-    if (pairs.size() >= config_.min_inliers) candidates.push_back({kf, std::move(pairs)});
+    auto pairs = correspondences(frame, focal_px, features(*kf), kf->intrinsics.fx, config_.retrieval_features);
+    candidates.push_back({kf, std::move(pairs)});
   }
-  // Retrieval: the keyframes with the most matches (a view that shares the frame's corners).
   const std::size_t n = std::min(config_.candidate_keyframes, candidates.size());
   std::partial_sort(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(n), candidates.end(),
                     [](const Candidate& a, const Candidate& b) { return a.pairs.size() > b.pairs.size(); });
+  candidates.resize(n);
+  for (auto& c : candidates) c.pairs = correspondences(frame, focal_px, features(*c.keyframe), c.keyframe->intrinsics.fx, frame.size());
   std::vector<Hypothesis> out;
   for (std::size_t c = 0; c < n; ++c) {
+    if (candidates[c].pairs.size() < config_.min_inliers) continue;
     const RigidFit fit = fit_rigid_ransac(candidates[c].pairs, config_.ransac);
     if (fit.inliers.size() < config_.min_inliers) continue;
     out.push_back({candidates[c].keyframe->T_world_camera * fit.T_target_source, candidates[c].keyframe, candidates[c].pairs.size(),

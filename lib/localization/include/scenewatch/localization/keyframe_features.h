@@ -30,7 +30,7 @@ Status validate(const FeatureConfig& config);
 /// 256-bit ORB descriptor.
 using Descriptor = std::array<std::uint8_t, 32>;
 
-/// The features of one view. Value type; not synchronised.
+/// The features of one view, strongest keypoint first. Value type; not synchronised.
 struct ViewFeatures {
   std::vector<Eigen::Vector3f> points_camera;  ///< the keypoint's 3D point in the view's camera frame
   std::vector<float> pixel_size;               ///< keypoint scale in pixels of the input (its ORB level's)

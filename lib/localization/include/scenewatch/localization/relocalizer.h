@@ -19,8 +19,10 @@ namespace scenewatch::localization {
 struct RelocalizerConfig {
   FeatureConfig features;
   RansacConfig ransac;
-  /// Keyframes with the most ratio-test matches that RANSAC is run on.
+  /// Keyframes with the most ratio-test matches of the frame's strongest `retrieval_features`
+  /// that all of its features are matched with, and RANSAC is run on.
   std::size_t candidate_keyframes = 3;
+  std::size_t retrieval_features = 200;
   /// Lowe's ratio test (IJCV 2004): a match counts when its Hamming distance is below this
   /// fraction of the second best's.
   double match_ratio = 0.8;
@@ -65,9 +67,10 @@ class Relocalizer {
   const SensorModel& sensor() const { return sensor_; }
 
  private:
-  /// Ratio-test matches of the frame's features with a keyframe's, as 3D pairs (keyframe: target).
+  /// Ratio-test matches of the frame's first `frame_limit` features (the strongest) with a
+  /// keyframe's, as 3D pairs (keyframe: target).
   std::vector<Correspondence> correspondences(const ViewFeatures& frame, double frame_focal_px, const ViewFeatures& keyframe,
-                                              double keyframe_focal_px) const;
+                                              double keyframe_focal_px, std::size_t frame_limit) const;
   double tolerance_m(const Eigen::Vector3f& p, float pixel_size, double focal_px) const;
 
   RelocalizerConfig config_;
