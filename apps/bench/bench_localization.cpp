@@ -53,7 +53,8 @@ struct Trajectory {
 };
 
 // Runs the localizer over the recording as the pipeline does: each placed frame may become a
-// keyframe of the memory (AppearanceMemory's default spacing) at the pose it was placed at.
+// keyframe of the memory (AppearanceMemory's default spacing) at the pose it was placed at; a lost
+// camera is relocalized against the keyframes.
 Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& given, LocalizationMode mode,
                localization::Config lc = {}) {
   background::AppearanceMemory memory;
@@ -68,7 +69,8 @@ Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& 
     }
     frame->T_world_camera = given[i];
     frame->localization = mode;
-    const auto r = localizer.localize(*frame, 0, [&](const Pose& p, std::size_t n) { return memory.nearest(p, n); });
+    const auto r = localizer.localize(*frame, 0, [&](const Pose& p, std::size_t n) { return memory.nearest(p, n); },
+                                      [&] { return memory.keyframes(); });
     out.used.push_back(r.T_world_camera);
     out.ms.push_back(r.ms);
     if (!r.placed()) {
