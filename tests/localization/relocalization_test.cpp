@@ -13,6 +13,7 @@
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/localization/keyframe_features.h"
 #include "scenewatch/localization/localizer.h"
+#include "scenewatch/localization/relocalizer.h"
 #include "scenewatch/localization/rigid_ransac.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "test_data.h"
@@ -89,6 +90,16 @@ TEST(KeyframeFeatures, AFrameKeepsOnlyKeypointsWithDepthAndTheFileRoundTrips) {
   EXPECT_TRUE(back->front().T_world_camera.isApprox(*f.T_world_camera));
   EXPECT_EQ(back->front().features.descriptors, features.descriptors);
   EXPECT_EQ(back->front().features.points_camera, features.points_camera);
+  // Saved with a model, the features find their keyframes again after a reload (ids are renumbered
+  // then; the pose names the keyframe).
+  background::AppearanceMemory memory;
+  for (std::size_t i : {0, 40, 80}) ASSERT_TRUE(memory.add(*background::keyframe_from_frame(load(seq, i))).ok());
+  ASSERT_TRUE(memory.save(dir / "model").ok());
+  background::AppearanceMemory reloaded;
+  ASSERT_TRUE(reloaded.load(dir / "model").ok());
+  const Relocalizer original;
+  Relocalizer restored;
+  EXPECT_EQ(restored.restore(original.to_save(memory.keyframes()), reloaded.keyframes()), 3u);
   // A truncated file is an error naming it.
   std::filesystem::resize_file(dir / "f.bin", 2000);
   auto truncated = load_features(dir / "f.bin");
