@@ -59,11 +59,11 @@ if(NOT TARGET scenewatch::cgal)
   target_link_libraries(scenewatch::cgal INTERFACE CGAL::CGAL)
 endif()
 
-scenewatch_find_dependency(OpenCV 4 COMPONENTS core imgproc imgcodecs)
+scenewatch_find_dependency(OpenCV 4 COMPONENTS core imgproc imgcodecs features2d)
 if(NOT TARGET scenewatch::opencv)
   add_library(scenewatch::opencv INTERFACE IMPORTED)
   set_target_properties(scenewatch::opencv PROPERTIES INTERFACE_INCLUDE_DIRECTORIES "${OpenCV_INCLUDE_DIRS}")
-  target_link_libraries(scenewatch::opencv INTERFACE opencv_core opencv_imgproc opencv_imgcodecs)
+  target_link_libraries(scenewatch::opencv INTERFACE opencv_core opencv_imgproc opencv_imgcodecs opencv_features2d)
 endif()
 
 scenewatch_find_dependency(Protobuf 3)

@@ -53,7 +53,8 @@ struct Trajectory {
 };
 
 // Runs the localizer over the recording as the pipeline does: each placed frame may become a
-// keyframe of the memory (AppearanceMemory's default spacing) at the pose it was placed at.
+// keyframe of the memory (AppearanceMemory's default spacing) at the pose it was placed at; a lost
+// camera is relocalized against the keyframes.
 Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& given, LocalizationMode mode,
                localization::Config lc = {}) {
   background::AppearanceMemory memory;
@@ -68,7 +69,8 @@ Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& 
     }
     frame->T_world_camera = given[i];
     frame->localization = mode;
-    const auto r = localizer.localize(*frame, 0, [&](const Pose& p, std::size_t n) { return memory.nearest(p, n); });
+    const auto r = localizer.localize(*frame, 0, [&](const Pose& p, std::size_t n) { return memory.nearest(p, n); },
+                                      [&] { return memory.keyframes(); });
     out.used.push_back(r.T_world_camera);
     out.ms.push_back(r.ms);
     if (!r.placed()) {
@@ -258,6 +260,38 @@ int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
   return 0;
 }
 
+// Relocalization without a prior (issue 29 item 3): keyframes of files 0-248 at the recording's
+// poses, each frame of files 250-498 placed from keyframe features, densely refined and verified.
+int run_relocalization(const io::Sequence& seq, const std::vector<Pose>& truth) {
+  const std::size_t half = seq.frames.size() / 2;
+  background::AppearanceMemory memory;
+  for (std::size_t i = 0; i < half; ++i)
+    if (auto frame = io::load_sequence_frame(seq, i))
+      if (auto kf = background::keyframe_from_frame(*frame)) (void)memory.consider(std::move(*kf));
+  const auto keyframes = memory.keyframes();
+  localization::Localizer localizer;
+  Errors e;
+  std::vector<double> ms;
+  std::size_t placed = 0, within = 0;
+  for (std::size_t i = half; i < seq.frames.size(); ++i) {
+    auto frame = io::load_sequence_frame(seq, i);
+    if (!frame) continue;
+    frame->T_world_camera.reset();
+    const auto r = localizer.relocalize(*frame, keyframes);
+    ms.push_back(r.relocalization_ms);
+    if (!r.placed()) continue;
+    ++placed;
+    add_error(e, r.T_world_camera, truth[i]);
+    if (e.m.back() <= 0.05 && e.deg.back() <= 5.0) ++within;
+  }
+  const std::size_t n = seq.frames.size() - half;
+  std::printf("\nrelocalization: %zu frames of files 250-498 against %zu keyframes of files 0-248, no prior\n", n, keyframes.size());
+  std::printf("  placed %zu | within 5 cm / 5 deg %.1f %% | median %5.1f mm %5.2f deg | p95 %5.1f mm | median %5.1f ms, p95 %5.1f ms "
+              "(features, matching, RANSAC, dense refinement; one thread)\n",
+              placed, 100.0 * within / n, 1000 * median(e.m), median(e.deg), 1000 * quantile(e.m, 0.95), median(ms), quantile(ms, 0.95));
+  return 0;
+}
+
 }  // namespace
 
 int run_localization(const Options& o) {
@@ -269,6 +303,7 @@ int run_localization(const Options& o) {
   std::vector<Pose> truth;
   for (const auto& f : seq->frames) truth.push_back(f.T_world_camera.value_or(Pose::Identity()));
   int rc = run_pairs(*seq, truth);
+  rc |= run_relocalization(*seq, truth);
   rc |= run_trajectories(*seq, truth);
   return rc;
 }

@@ -42,9 +42,11 @@ std::string camera_name(const std::string& given, const std::vector<std::string>
 
 int run_health(const RemoteOptions& options);
 int run_stats(const RemoteOptions& options);
+/// GetLocalization: every camera, or options.camera alone.
+int run_localization(const RemoteOptions& options);
 /// `depth_scale_m`: metres per depth unit of sequence folders (unset: the folder's or layout's).
 int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side,
-               const std::optional<double>& depth_scale_m);
+               const std::optional<double>& depth_scale_m, const std::string& trajectory_path = {});
 /// Sequence folders streamed as a live sensor would: `fps` frames per second without waiting for
 /// replies, each frame marked live (the daemon skips frames it cannot keep up with).
 int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,

@@ -150,7 +150,22 @@ nlohmann::json to_json(const proto::LocalizationResult& l) {
           {"residual_m", l.residual_m()},
           {"reference_keyframe", l.reference_keyframe()},
           {"reason", l.reason()},
-          {"compute_ms", l.compute_ms()}};
+          {"compute_ms", l.compute_ms()},
+          {"T_world_odom", std::vector<double>(l.t_world_odom().matrix().begin(), l.t_world_odom().matrix().end())},
+          {"relocalized", l.relocalized()},
+          {"homed", l.homed()},
+          {"feature_matches", l.feature_matches()},
+          {"feature_inliers", l.feature_inliers()},
+          {"relocalization_ms", l.relocalization_ms()},
+          {"odom_change_m", l.odom_change_m()},
+          {"odom_change_deg", l.odom_change_deg()},
+          {"camera", l.camera()}};
+}
+
+nlohmann::json to_json(const proto::LocalizationReply& reply) {
+  nlohmann::json cameras = nlohmann::json::array();
+  for (const auto& c : reply.cameras()) cameras.push_back(to_json(c));
+  return {{"cameras", std::move(cameras)}};
 }
 
 nlohmann::json to_json(const proto::IngestReply& ingest) {
@@ -253,6 +268,26 @@ std::string text(const proto::Event& event) {
   os << " at " << text(event.centroid_world()) << ", t " << fixed(event.stamp_s(), 2) << " s";
   if (!event.detail().empty()) os << ": " << event.detail();
   return os.str();
+}
+
+std::string text(const proto::LocalizationResult& l) {
+  std::ostringstream out;
+  out << "camera " << (l.camera().empty() ? "(default)" : "'" + l.camera() + "'") << ": " << l.state() << " (mode " << l.mode()
+      << (l.homed() ? ", homed" : ", not homed") << ")" << (l.reason().empty() ? "" : ": " + l.reason()) << "\n";
+  const auto row = [&](const proto::Pose& p, int r) {
+    std::string line;
+    for (int c = 0; c < 4; ++c) line += (c ? " " : "") + fixed(p.matrix_size() == 16 ? p.matrix(4 * r + c) : (r == c ? 1.0 : 0.0), 4);
+    return line;
+  };
+  for (int r = 0; r < 3; ++r) out << "  " << (r == 0 ? "T_world_odom  " : "              ") << row(l.t_world_odom(), r) << "\n";
+  out << "  last correction " << fixed(1000 * l.odom_change_m(), 1) << " mm, " << fixed(l.odom_change_deg(), 2) << " deg of T_world_odom; "
+      << fixed(1000 * l.correction_m(), 1) << " mm, " << fixed(l.correction_deg(), 2) << " deg from the given pose\n"
+      << "  quality         " << fixed(100 * l.inlier_fraction(), 1) << " % depth inliers, residual " << fixed(1000 * l.residual_m(), 1)
+      << " mm, keyframe " << l.reference_keyframe();
+  if (l.relocalized()) out << "; relocalized: " << l.feature_inliers() << " of " << l.feature_matches() << " feature matches, "
+                           << fixed(l.relocalization_ms(), 1) << " ms";
+  out << "\n";
+  return out.str();
 }
 
 }  // namespace scenewatch::cli

@@ -19,6 +19,7 @@ nlohmann::json to_json(const proto::Event& event);
 nlohmann::json to_json(const proto::HealthReply& health);
 nlohmann::json to_json(const proto::StatsReply& stats);
 nlohmann::json to_json(const proto::LocalizationResult& localization);
+nlohmann::json to_json(const proto::LocalizationReply& reply);
 nlohmann::json to_json(const proto::IngestReply& ingest);
 nlohmann::json to_json(const proto::BoxOccupancy& box);
 /// Name of an occupancy state ("free", "occupied", "unknown").
@@ -31,6 +32,8 @@ std::string text(const proto::Plane& plane);
 std::string text(const proto::Object& object);
 std::string text(const proto::Cluster& cluster);
 std::string text(const proto::Event& event);
+/// A camera's localization (GetLocalization), a few lines.
+std::string text(const proto::LocalizationResult& localization);
 
 /// Progress of a sequence on stderr, for terminals.
 class ProgressBar {

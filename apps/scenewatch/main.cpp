@@ -53,6 +53,11 @@ int main(int argc, char** argv) {
   add_remote_options(stats, remote);
   stats->callback([&] { action = [&] { return run_stats(remote); }; });
 
+  auto* where = app.add_subcommand("localization", "where each camera is: state, T_world_odom, last correction, quality");
+  where->add_option("--camera", remote.camera, "this camera only (an error when it sent no frame)");
+  add_remote_options(where, remote);
+  where->callback([&] { action = [&] { return run_localization(remote); }; });
+
   std::vector<std::string> ingest_paths;
   bool server_side = false;
   std::optional<double> ingest_depth_scale;
@@ -84,15 +89,19 @@ int main(int argc, char** argv) {
       ->each([&](const std::string& m) {
         remote.localization = m == "given" ? scenewatch::LocalizationMode::kGiven : m == "refine" ? scenewatch::LocalizationMode::kRefine : scenewatch::LocalizationMode::kTrack;
       });
+  std::string ingest_trajectory;
+  ingest->add_option("--trajectory", ingest_trajectory,
+                     "write the poses the memory used (frames not lost) as a TUM trajectory: t tx ty tz qx qy qz qw");
   add_depth_scale_option(ingest, ingest_depth_scale);
   add_remote_options(ingest, remote);
   ingest->callback([&] {
     action = [&] {
       if (live_fps) {
         if (server_side) return fail("--live and --server-side do not go together");
+        if (!ingest_trajectory.empty()) return fail("--trajectory and --live do not go together (live replies may be skipped)");
         return run_live_ingest(remote, ingest_paths, *live_fps, ingest_depth_scale);
       }
-      return run_ingest(remote, ingest_paths, server_side, ingest_depth_scale);
+      return run_ingest(remote, ingest_paths, server_side, ingest_depth_scale, ingest_trajectory);
     };
   });
 

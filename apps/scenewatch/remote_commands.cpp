@@ -13,10 +13,12 @@
 #include <sstream>
 #include <optional>
 #include <thread>
+#include <tuple>
 
 #include "commands.h"
 #include "format.h"
 #include "frame_spec.h"
+#include "scenewatch/io/rgbd.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/service/client.h"
 
@@ -194,15 +196,16 @@ std::string camera_name(const std::string& given, const std::vector<std::string>
 }
 
 int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side,
-               const std::optional<double>& depth_scale_m) {
+               const std::optional<double>& depth_scale_m, const std::string& trajectory_path) {
   const std::string camera = camera_name(options.camera, paths);
   auto client = connect(options);
   if (!client) return fail(client.error().message);
   const bool show_progress = !options.json && ::isatty(STDOUT_FILENO) == 1;
   int failures = 0;
+  std::vector<io::StampedPose> trajectory;  // the poses the memory used (--trajectory)
 
   // The answer to one request; false when the connection is gone (no point going on).
-  auto take = [&](Result<proto::Response> response, const std::string& source, ProgressBar* bar) {
+  auto take = [&](Result<proto::Response> response, const std::string& source, ProgressBar* bar, double stamp_s = 0.0) {
     if (bar != nullptr) bar->clear();
     if (!response) {
       fail(response.error().message);
@@ -215,10 +218,22 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       return true;
     }
     print_ingest(options, source, response->ingest());
+    const auto& where = response->ingest().localization();
+    if (where.state() != "lost" && where.pose().matrix_size() == 16) {
+      Eigen::Matrix4d m;
+      for (int k = 0; k < 16; ++k) m(k / 4, k % 4) = where.pose().matrix(k);
+      trajectory.push_back({stamp_s, pose_from_matrix(m)});
+    }
     return true;
   };
-  auto send = [&](proto::Request request, const std::string& source, ProgressBar* bar) {
-    return take(client->call(std::move(request), options.timeout_s), source, bar);
+  auto send = [&](proto::Request request, const std::string& source, ProgressBar* bar, double stamp_s = 0.0) {
+    return take(client->call(std::move(request), options.timeout_s), source, bar, stamp_s);
+  };
+  auto finish = [&] {
+    if (!trajectory_path.empty()) {
+      if (auto st = io::write_tum(trajectory_path, trajectory); !st) return fail("--trajectory: " + st.error().message);
+    }
+    return failures == 0 ? kExitOk : kExitError;
   };
 
   for (const std::string& path : paths) {
@@ -251,11 +266,11 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       // while the one before it is processed; the answers come in the order sent.
       ProgressBar bar(show_progress);
       const std::size_t total = seq.last - seq.first + 1;
-      std::deque<std::pair<std::uint64_t, std::string>> in_flight;  // request id, source
+      std::deque<std::tuple<std::uint64_t, std::string, double>> in_flight;  // request id, source, stamp
       auto answer_oldest = [&] {
-        const auto [id, source] = in_flight.front();
+        const auto [id, source, stamp_s] = in_flight.front();
         in_flight.pop_front();
-        return take(client->wait_for(id, options.timeout_s), source, &bar);
+        return take(client->wait_for(id, options.timeout_s), source, &bar, stamp_s);
       };
       for (std::size_t i = seq.first; i <= seq.last; ++i) {
         const std::string source = (fs::path(seq.folder) / seq.sequence.frames[i].name).string();
@@ -274,7 +289,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
         *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
         auto id = client->start(std::move(request));
         if (!id) return fail(id.error().message);
-        in_flight.emplace_back(*id, source);
+        in_flight.emplace_back(*id, source, frame->stamp_s);
         if (in_flight.size() >= 2 && !answer_oldest()) return kExitError;
       }
       while (!in_flight.empty()) {
@@ -293,9 +308,21 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
     frame->localization = options.localization;
     proto::Request request;
     *request.mutable_ingest_frame() = service::make_ingest_frame(*frame);
-    if (!send(std::move(request), path, nullptr)) return kExitError;
+    if (!send(std::move(request), path, nullptr, frame->stamp_s)) return kExitError;
   }
-  return failures == 0 ? kExitOk : kExitError;
+  return finish();
+}
+
+int run_localization(const RemoteOptions& options) {
+  proto::Request request;
+  if (!options.camera.empty()) request.mutable_get_localization()->set_camera(options.camera);
+  else request.mutable_get_localization();
+  return simple_call(options, request, [&](const proto::Response& r) {
+    if (options.json) return print_json(to_json(r.localization()));
+    if (r.localization().cameras_size() == 0) std::cout << "no camera has sent a frame since the start or the last load\n";
+    for (const auto& c : r.localization().cameras()) std::cout << text(c);
+    std::cout << std::flush;
+  });
 }
 
 int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,

@@ -13,22 +13,14 @@
 #include "scenewatch/localization/localizer.h"
 #include "scenewatch/pipeline/config_loader.h"
 #include "scenewatch/pipeline/working_memory.h"
+#include "kitchen_data.h"
 #include "test_data.h"
 
 namespace scenewatch::localization {
 namespace {
 
-io::Sequence kitchen() {
-  auto seq = io::open_sequence(test::data_dir() / "redkitchen_long");
-  EXPECT_TRUE(seq.ok()) << seq.error().message;
-  return *seq;
-}
-
-Frame load(const io::Sequence& seq, std::size_t i) {
-  auto f = io::load_sequence_frame(seq, i);
-  EXPECT_TRUE(f.ok()) << f.error().message;
-  return *f;
-}
+using test_kitchen::kitchen;
+using test_kitchen::load;
 
 // The frame's points seen from a camera moved by T_new_old (z-buffered into the same image grid).
 Frame moved_camera(const Frame& frame, const Pose& T_new_old) {

@@ -93,7 +93,7 @@ TEST_F(CliTest, SegmentPrintsPlanesAndObjectsWithIndices) {
 
 TEST_F(CliTest, HelpAndUsageErrors) {
   EXPECT_EQ(cli({"--help"}).exit_code, 0);
-  for (const char* command : {"health", "stats", "ingest", "planes", "objects", "occupancy", "clear-box", "reset",
+  for (const char* command : {"health", "stats", "localization", "ingest", "planes", "objects", "occupancy", "clear-box", "reset",
                               "save", "load", "events", "watch", "segment", "fit"}) {
     const auto result = cli({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;
@@ -476,6 +476,29 @@ TEST_F(CliTest, IngestTakesOneFrameOrARangeOfASequence) {
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.err.find("the sequence has 3 frames"), std::string::npos) << result.err;
   EXPECT_EQ(frames_processed(), 4);
+
+  // --trajectory: the poses the memory used, one TUM line per frame (given mode: the frame's own).
+  result = remote({"ingest", seq.string() + ":0-2", "--camera", "arm", "--trajectory", (tmp_ / "used.txt").string()});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::ifstream used(tmp_ / "used.txt");
+  std::string line;
+  int poses = 0;
+  while (std::getline(used, line))
+    if (!line.empty() && line[0] != '#') ++poses;
+  EXPECT_EQ(poses, 3);
+  // localization: per camera; an unknown camera is an error naming it.
+  result = remote({"localization", "--camera", "arm", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  const auto where = parse(result.out).at("cameras").at(0);
+  EXPECT_EQ(where.at("camera"), "arm");
+  EXPECT_EQ(where.at("state"), "given");
+  EXPECT_EQ(where.at("T_world_odom").size(), 16u);
+  result = remote({"localization"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find("camera 'arm': given"), std::string::npos) << result.out;
+  result = remote({"localization", "--camera", "nope"});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("camera 'nope'"), std::string::npos) << result.err;
 }
 
 TEST_F(CliTest, TumFoldersAndDepthScalesWhereverSequencesAreRead) {

@@ -10,9 +10,13 @@
 #include <chrono>
 #include <thread>
 
+#include <Eigen/Geometry>
+
 #include "daemon_harness.h"
 #include "scenewatch.pb.h"
+#include "scenewatch/background/appearance.h"
 #include "scenewatch/io/sequence.h"
+#include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/sim/simulator.h"
 #include "scenewatch/sim/scenario_yaml.h"
@@ -795,6 +799,67 @@ TEST_F(DaemonTest, OnlyTheTokenHolderChangesTheModel) {
   EXPECT_EQ(refused.exit_code, 1);
   EXPECT_NE(refused.err.find("chmod 600"), std::string::npos) << refused.err;
   EXPECT_NE(refused.err.find(open_token.string()), std::string::npos) << refused.err;
+}
+
+// Homing after a restart (issue 29 item 4) through the real daemon: a model of the kitchen's
+// files 0-248 saved, scenewatchd started on it in refine mode, files 250-... streamed over TCP
+// with their poses in another odometry frame (35 degrees about z, 1.4 m). GetLocalization then
+// reports the camera homed with T_world_odom the inverse of that offset; an unknown camera is NOT_FOUND.
+TEST_F(DaemonTest, GetLocalizationReportsTheHomedCameraAfterARestart) {
+  SCENEWATCH_REQUIRE_DATA("redkitchen_long");
+  auto seq = io::open_sequence(data_dir() / "redkitchen_long");
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  const std::size_t half = seq->frames.size() / 2;
+  {
+    pipeline::WorkingMemory model(pipeline::Config{});
+    for (std::size_t i = 0; i < half; ++i) ASSERT_TRUE(model.process(*io::load_sequence_frame(*seq, i)).ok());
+    ASSERT_TRUE(model.save(model_dir_).ok());
+  }
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml("localization:\n  mode: refine\n")));
+  Client client = daemon_.connect();
+  const auto where = [&](const std::string& camera) {
+    return call(client, request([&](proto::Request& r) { r.mutable_get_localization()->set_camera(camera); }));
+  };
+  EXPECT_EQ(where("kitchen").status().code(), proto::Status::NOT_FOUND) << "no frame yet";
+  Pose offset = Pose::Identity();
+  offset.linear() = Eigen::AngleAxisd(35.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  offset.translation() = Eigen::Vector3d(1.4, 0.0, 0.0);
+  std::optional<std::size_t> homed_at;
+  const std::size_t streamed = 10;
+  for (std::size_t i = half; i < half + streamed; ++i) {
+    auto frame = io::load_sequence_frame(*seq, i);
+    ASSERT_TRUE(frame.ok()) << frame.error().message;
+    frame->T_world_camera = offset * *frame->T_world_camera;
+    frame->camera = "kitchen";
+    proto::Request r;
+    *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+    const auto reply = call(client, r);
+    ASSERT_EQ(reply.status().code(), proto::Status::OK) << reply.status().message();
+    if (!homed_at && reply.ingest().localization().state() == "tracking") homed_at = i - half;
+  }
+  ASSERT_TRUE(homed_at.has_value()) << "not homed within " << streamed << " frames";
+  const auto reply = where("kitchen");
+  ASSERT_EQ(reply.status().code(), proto::Status::OK) << reply.status().message();
+  ASSERT_EQ(reply.localization().cameras_size(), 1);
+  const auto& cam = reply.localization().cameras(0);
+  EXPECT_EQ(cam.camera(), "kitchen");
+  EXPECT_EQ(cam.state(), "tracking") << cam.reason();
+  EXPECT_TRUE(cam.homed());
+  ASSERT_EQ(cam.t_world_odom().matrix_size(), 16);
+  Eigen::Matrix4d m;
+  for (int k = 0; k < 16; ++k) m(k / 4, k % 4) = cam.t_world_odom().matrix(k);
+  const auto odom_error = background::view_distance(pose_from_matrix(m), offset.inverse());
+  std::cout << "daemon homing: tracking from frame " << *homed_at << ", T_world_odom off by " << 1000 * odom_error.translation_m
+            << " mm " << odom_error.rotation_deg << " deg\n";
+  EXPECT_LT(odom_error.translation_m, 0.05);
+  EXPECT_LT(odom_error.rotation_deg, 5.0);
+  // Every camera, and a camera the daemon never heard of: an error naming it.
+  const auto all = call(client, request([](proto::Request& r) { r.mutable_get_localization(); }));
+  ASSERT_EQ(all.status().code(), proto::Status::OK);
+  EXPECT_EQ(all.localization().cameras_size(), 1);
+  const auto unknown = where("nope");
+  EXPECT_EQ(unknown.status().code(), proto::Status::NOT_FOUND);
+  EXPECT_NE(unknown.status().message().find("nope"), std::string::npos) << unknown.status().message();
 }
 
 TEST_F(DaemonTest, StartsEmptyWithoutAModelAndRefusesABadConfig) {

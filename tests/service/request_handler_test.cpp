@@ -232,6 +232,36 @@ TEST_F(RequestHandlerTest, ValidFrameIsProcessed) {
   EXPECT_EQ(stats.stats().points_processed(), 3000u);
 }
 
+TEST_F(RequestHandlerTest, GetLocalizationAnswersPerCameraAndRefusesAnUnknownOne) {
+  RequestHandler handler(memory_, {});
+  const auto where = [&](const std::string& camera, bool only_default = false) {
+    proto::Request request;
+    request.mutable_get_localization()->set_camera(camera);
+    request.mutable_get_localization()->set_only_default(only_default);
+    return call(handler, request);
+  };
+  // Before any frame: no camera at all, and the default camera is not known yet.
+  EXPECT_EQ(where("").localization().cameras_size(), 0);
+  EXPECT_EQ(where("", true).status().code(), proto::Status::NOT_FOUND);
+  Frame frame = grid_frame(60, 50);
+  Pose pose = Pose::Identity();
+  pose.translation() = Eigen::Vector3d(0.5, 0, 0);
+  frame.T_world_camera = pose;
+  frame.camera = "arm";
+  ASSERT_EQ(ingest(handler, make_ingest_frame(frame)).status().code(), proto::Status::OK);
+  const auto arm = where("arm");
+  ASSERT_EQ(arm.status().code(), proto::Status::OK) << arm.status().message();
+  ASSERT_EQ(arm.localization().cameras_size(), 1);
+  EXPECT_EQ(arm.localization().cameras(0).camera(), "arm");
+  EXPECT_EQ(arm.localization().cameras(0).state(), "given");  // the default mode
+  EXPECT_EQ(arm.localization().cameras(0).t_world_odom().matrix_size(), 16);
+  EXPECT_EQ(where("").localization().cameras_size(), 1);
+  const auto unknown = where("head");
+  EXPECT_EQ(unknown.status().code(), proto::Status::NOT_FOUND);
+  EXPECT_NE(unknown.status().message().find("camera 'head'"), std::string::npos) << unknown.status().message();
+  EXPECT_NE(unknown.status().message().find("'arm'"), std::string::npos) << unknown.status().message();
+}
+
 TEST_F(RequestHandlerTest, LiveFramesAreRecognisedWithoutDecodingAndSkippedUnprocessed) {
   RequestHandler handler(memory_, {});
   proto::Request request;

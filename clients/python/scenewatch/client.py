@@ -162,6 +162,16 @@ class Client:
         """Counters of the daemon and its map: pb.StatsReply."""
         return self._call("stats", pb.Stats())
 
+    def get_localization(self, camera=None):
+        """Where each camera is: pb.LocalizationReply, one pb.LocalizationResult per camera (state,
+        T_world_odom as 16 row-major numbers, the last correction odom_change_m / _deg, quality,
+        homed, relocalized). ``camera``: that camera only; StatusError NOT_FOUND when it sent no
+        frame since the daemon started or loaded its model ("" names the default camera)."""
+        if camera is None:
+            return self._call("get_localization", pb.GetLocalization(), result="localization")
+        return self._call("get_localization", pb.GetLocalization(camera=camera, only_default=camera == ""),
+                          result="localization")
+
     def ingest_frame(self, frame=None, **fields):
         """Processes one frame: a pb.IngestFrame, or its fields as keywords (cloud=pb.Cloud,
         pose=4x4 matrix or pb.Pose, intrinsics=pb.Intrinsics, stamp_s, source, camera,

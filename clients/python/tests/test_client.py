@@ -74,6 +74,15 @@ class ClientTest(unittest.TestCase):
         self.assertGreater(stats.map_occupied_leaves, 0)
         self.assertEqual(stats.connections, 1)
 
+        # GetLocalization: the default camera sent the frame; its poses are taken as given.
+        where = self.client.get_localization()
+        self.assertEqual([c.camera for c in where.cameras], [""])
+        self.assertEqual(where.cameras[0].state, "given")
+        self.assertEqual(len(where.cameras[0].T_world_odom.matrix), 16)
+        self.assertEqual(self.client.get_localization("").cameras[0].state, "given")
+        with self.assertRaisesRegex(scenewatch.StatusError, "NOT_FOUND.*camera 'nope'"):
+            self.client.get_localization("nope")
+
         planes = self.client.get_planes()
         self.assertEqual(planes.frames_processed, 1)
         self.assertGreaterEqual(len(planes.planes), 1)

@@ -28,6 +28,8 @@ struct Localizer::Track {
   Pose T_world_odom = Pose::Identity();
   /// Variance of the camera's placement relative to the memory (refine mode): m^2, rad^2.
   double var_m2 = 0.0, var_rad2 = 0.0;
+  bool homed = false;       ///< placed against the memory (or started it) since the camera's first frame
+  int lost_in_row = 0;
   Localization result;
 };
 
@@ -47,7 +49,9 @@ Status validate(const Config& c) {
     return invalid_argument("localization.drift_m_per_frame / drift_deg_per_frame: must be in [0, 1] m and [0, 90] degrees");
   if (c.reference_keyframes < 1 || c.reference_keyframes > 8)
     return invalid_argument("localization.reference_keyframes: must be in [1, 8]");
-  return {};
+  if (c.rehome_after_lost_frames < 1 || c.rehome_after_lost_frames > 1000)
+    return invalid_argument("localization.rehome_after_lost_frames: must be in [1, 1000]");
+  return validate(c.relocalization);
 }
 
 Result<LocalizationMode> parse_mode(const std::string& name) {
@@ -76,7 +80,8 @@ const char* state_name(State state) {
   return "?";
 }
 
-Localizer::Localizer(Config config, SensorModel sensor) : config_(std::move(config)), sensor_(std::move(sensor)) {}
+Localizer::Localizer(Config config, SensorModel sensor)
+    : config_(std::move(config)), sensor_(std::move(sensor)), relocalizer_(config_.relocalization, sensor_) {}
 
 std::shared_ptr<const RgbdPyramid> Localizer::reference(const background::Keyframe& keyframe) {
   ++uses_;
@@ -97,6 +102,85 @@ std::shared_ptr<const RgbdPyramid> Localizer::reference(const background::Keyfra
 }
 
 Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const KeyframeSource& keyframes) {
+  return localize(frame, camera, keyframes, {});
+}
+
+bool Localizer::must_relocalize(const Track& track, LocalizationMode mode, bool memory_has_keyframes) const {
+  if (mode == LocalizationMode::kGiven || !memory_has_keyframes) return false;
+  if (!track.homed) return true;  // homing: the camera's frame is not the memory's yet
+  if (mode == LocalizationMode::kTrack) return track.result.state == State::kLost;
+  return track.lost_in_row >= config_.rehome_after_lost_frames;
+}
+
+bool Localizer::accept(Localization& r, const Alignment& a, const background::Keyframe& keyframe) const {
+  r.T_world_camera = keyframe.T_world_camera * a.T_reference_current;
+  r.inlier_fraction = a.inlier_fraction;
+  r.residual_m = a.residual_m;
+  r.conditioning = a.conditioning;
+  const Mat6 A = twist_adjoint(keyframe.T_world_camera);
+  r.covariance = A * a.covariance * A.transpose();
+  r.reference_keyframe = keyframe.id;
+  if (a.inlier_fraction < config_.min_inlier_fraction) {
+    r.reason = "alignment with keyframe " + std::to_string(keyframe.id) + " poor: " +
+               std::to_string(static_cast<int>(std::lround(100 * a.inlier_fraction))) + " % of the depth pixels agree";
+    return false;
+  }
+  if (a.conditioning < config_.min_conditioning) {
+    r.reason = "the view does not constrain every motion (conditioning " + std::to_string(a.conditioning) + ")";
+    return false;
+  }
+  r.state = State::kTracking;
+  r.reason.clear();
+  return true;
+}
+
+Localization Localizer::relocalize(const Frame& frame, const std::vector<std::shared_ptr<const background::Keyframe>>& keyframes) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Localization out;
+  out.mode = frame.localization.value_or(config_.mode);
+  out.given = frame.T_world_camera;
+  out.state = State::kLost;
+  out.T_world_camera = frame.pose_or_identity();
+  auto finish = [&](Localization r) {
+    r.relocalization_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  };
+  const ViewFeatures features = extract_features(frame, sensor_, config_.relocalization.features);
+  if (features.size() < config_.relocalization.min_inliers) {
+    out.reason = "relocalization: " + std::to_string(features.size()) + " features with depth in the frame";
+    return finish(out);
+  }
+  const auto hypotheses = relocalizer_.hypotheses(features, frame.intrinsics->fx, keyframes);
+  if (hypotheses.empty()) {
+    out.reason = "relocalization: no keyframe shares " + std::to_string(config_.relocalization.min_inliers) + " consistent features";
+    return finish(out);
+  }
+  const RgbdPyramid current = build_pyramid(*frame.cloud, *frame.intrinsics, sensor_, config_.pyramid, false);
+  Localization best = out;
+  for (const auto& h : hypotheses) {
+    // Seed section 4.1.2: the feature hypothesis refined densely, then verified against the view.
+    const Alignment a = align(*reference(*h.keyframe), current, h.keyframe->T_world_camera.inverse() * h.T_world_camera, sensor_,
+                              config_.alignment);
+    Localization r = out;
+    r.relocalized = true;
+    r.feature_matches = h.matches;
+    r.feature_inliers = h.inliers;
+    if (accept(r, a, *h.keyframe)) return finish(r);
+    r.state = State::kLost;
+    r.T_world_camera = out.T_world_camera;
+    r.reason = "relocalization: " + r.reason;
+    if (best.reference_keyframe == 0 || r.inlier_fraction > best.inlier_fraction) best = r;
+  }
+  return finish(best);
+}
+
+std::vector<std::uint32_t> Localizer::cameras() const {
+  std::vector<std::uint32_t> out;
+  for (const auto& [id, track] : tracks_) out.push_back(id);
+  return out;
+}
+
+Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const KeyframeSource& keyframes, const AllKeyframes& all) {
   const auto t0 = std::chrono::steady_clock::now();
   auto& slot = tracks_[camera];
   if (!slot) slot = std::make_shared<Track>();
@@ -113,12 +197,24 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
   auto finish = [&](Localization r) {
     r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (r.placed()) {
-      if (track.started) track.motion = track.last.inverse() * r.T_world_camera;
+      if (track.started && !r.relocalized) track.motion = track.last.inverse() * r.T_world_camera;
+      if (r.relocalized) track.motion = Pose::Identity();
       track.last = r.T_world_camera;
       track.started = true;
-      if (use_given) track.T_world_odom = r.T_world_camera * frame.T_world_camera->inverse();
+      track.homed = true;
+      track.lost_in_row = 0;
+      if (use_given) {
+        const Pose before = track.T_world_odom;
+        track.T_world_odom = r.T_world_camera * frame.T_world_camera->inverse();
+        const auto moved = background::view_distance(before, track.T_world_odom);
+        r.odom_change_m = moved.translation_m;
+        r.odom_change_deg = moved.rotation_deg;
+      }
       r.T_world_odom = track.T_world_odom;
+    } else {
+      ++track.lost_in_row;
     }
+    r.homed = track.homed;
     track.result = r;
     return r;
   };
@@ -132,6 +228,27 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
     out.reason = "not an organized frame with intrinsics: its pose is used as given";
     out.T_world_camera = frame.pose_or_identity();
     return finish(out);
+  }
+  if (all) {
+    const auto every = all();
+    if (must_relocalize(track, out.mode, !every.empty())) {
+      Localization r = relocalize(frame, every);
+      r.mode = out.mode;
+      if (!r.placed()) {
+        r.T_world_camera = prior;  // placed nowhere new
+        if (!track.homed) r.reason = "homing: " + r.reason;
+        return finish(r);
+      }
+      if (use_given) {
+        // The relocalized pose starts the camera's correction anew: its error is the alignment's.
+        track.var_m2 = r.residual_m * r.residual_m;
+        track.var_rad2 = track.var_m2;
+        const auto from_given = background::view_distance(r.T_world_camera, *frame.T_world_camera);
+        r.correction_m = from_given.translation_m;
+        r.correction_deg = from_given.rotation_deg;
+      }
+      return finish(r);
+    }
   }
   const auto candidates = keyframes ? keyframes(prior, config_.reference_keyframes) : decltype(keyframes(prior, 1)){};
   if (candidates.empty()) {
@@ -161,21 +278,7 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
       if (still.inlier_fraction > a.inlier_fraction) a = std::move(still);
     }
     Localization r = out;
-    r.T_world_camera = keyframe->T_world_camera * a.T_reference_current;
-    r.inlier_fraction = a.inlier_fraction;
-    r.residual_m = a.residual_m;
-    r.conditioning = a.conditioning;
-    const Mat6 A = twist_adjoint(keyframe->T_world_camera);
-    r.covariance = A * a.covariance * A.transpose();
-    r.reference_keyframe = keyframe->id;
-    if (a.inlier_fraction < config_.min_inlier_fraction) {
-      r.reason = "alignment with keyframe " + std::to_string(keyframe->id) + " poor: " +
-                 std::to_string(static_cast<int>(std::lround(100 * a.inlier_fraction))) + " % of the depth pixels agree";
-    } else if (a.conditioning < config_.min_conditioning) {
-      r.reason = "the view does not constrain every motion (conditioning " + std::to_string(a.conditioning) + ")";
-    } else {
-      r.state = State::kTracking;
-      r.reason.clear();
+    if (accept(r, a, *keyframe)) {
       best = r;
       aligned = a;
       break;
@@ -241,6 +344,7 @@ void Localizer::forget_camera(std::uint32_t camera) { tracks_.erase(camera); }
 void Localizer::reset() {
   tracks_.clear();
   references_.clear();
+  relocalizer_.reset();
 }
 
 }  // namespace scenewatch::localization

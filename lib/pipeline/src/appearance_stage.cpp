@@ -166,6 +166,11 @@ std::vector<std::shared_ptr<const background::Keyframe>> AppearanceStage::neares
   return memory_.nearest(T_world_camera, n);
 }
 
+std::vector<std::shared_ptr<const background::Keyframe>> AppearanceStage::all_keyframes() const {
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  return memory_.keyframes();
+}
+
 std::size_t AppearanceStage::keyframes() const {
   std::shared_lock<std::shared_mutex> read(mutex_);
   return memory_.size();

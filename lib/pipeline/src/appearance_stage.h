@@ -28,6 +28,8 @@ class AppearanceStage {
                                                 std::uint32_t camera = 0);
   /// Up to n keyframes seeing towards a pose, nearest first (for localization).
   std::vector<std::shared_ptr<const background::Keyframe>> nearest(const Pose& T_world_camera, std::size_t n) const;
+  /// Every keyframe (for relocalization and the keyframe features saved with the model).
+  std::vector<std::shared_ptr<const background::Keyframe>> all_keyframes() const;
   /// Forgets what is kept of a camera that is no longer followed.
   void forget_camera(std::uint32_t camera);
 

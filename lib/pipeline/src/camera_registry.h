@@ -36,6 +36,18 @@ class CameraRegistry {
   }
 
   std::size_t size() const { return cameras_.size(); }
+  /// The id of a known camera name.
+  std::optional<std::uint32_t> find(const std::string& name) const {
+    auto it = cameras_.find(name);
+    if (it == cameras_.end()) return std::nullopt;
+    return it->second.id;
+  }
+  /// Every followed camera: name and id, by name.
+  std::map<std::string, std::uint32_t> names() const {
+    std::map<std::string, std::uint32_t> out;
+    for (const auto& [name, entry] : cameras_) out[name] = entry.id;
+    return out;
+  }
   void reset() { cameras_.clear(); }
 
  private:

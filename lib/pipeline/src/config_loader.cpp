@@ -92,7 +92,13 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
                          [&] { return s.read("max_correction_deg", l.max_correction_deg); },
                          [&] { return s.read("reference_keyframes", l.reference_keyframes); },
                          [&] { return s.read("drift_m_per_frame", l.drift_m_per_frame); },
-                         [&] { return s.read("drift_deg_per_frame", l.drift_deg_per_frame); });
+                         [&] { return s.read("drift_deg_per_frame", l.drift_deg_per_frame); },
+                         [&] { return s.read("rehome_after_lost_frames", l.rehome_after_lost_frames); },
+                         [&] { return s.read("max_features", l.relocalization.features.max_features); },
+                         [&] { return s.read("candidate_keyframes", l.relocalization.candidate_keyframes); },
+                         [&] { return s.read("ransac_iterations", l.relocalization.ransac.iterations); },
+                         [&] { return s.read("match_ratio", l.relocalization.match_ratio); },
+                         [&] { return s.read("min_feature_inliers", l.relocalization.min_inliers); });
       !st)
     return st;
   auto parsed = localization::parse_mode(mode);

@@ -541,6 +541,9 @@ Status validate(const Config& c) {
 }
 
 namespace {
+// The keyframes' features in a snapshot folder (localization::save_features).
+constexpr const char* kFeaturesFile = "keyframe-features.bin";
+
 // The frame at the pose localization found (unchanged when its pose was taken as given).
 Frame placed(const Frame& frame, const localization::Localization& where) {
   if (where.state == localization::State::kGiven) return frame;
@@ -570,8 +573,9 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   result.points = *valid_points;
   const std::uint32_t camera_id = m.camera_of(original);
   // Where the frame was taken, against the memory; a camera that is lost changes nothing.
-  result.localization =
-      m.localizer.localize(original, camera_id, [&](const Pose& p, std::size_t n) { return m.appearance.nearest(p, n); });
+  result.localization = m.localizer.localize(
+      original, camera_id, [&](const Pose& p, std::size_t n) { return m.appearance.nearest(p, n); },
+      [&] { return m.appearance.all_keyframes(); });
   if (!result.localization.placed()) {
     ++m.frames;
     result.total_ms = ms_since(t0);
@@ -780,6 +784,25 @@ Status load_background(background::OccupancyMap& map, const fs::path& path, cons
 
 }  // namespace
 
+Result<localization::Localization> WorkingMemory::localization(const std::string& camera) const {
+  std::lock_guard<std::mutex> lock(impl_->writer);
+  const auto id = impl_->cameras.find(camera);
+  const auto last = id ? impl_->localizer.last(*id) : std::nullopt;
+  if (last) return *last;
+  std::string known;
+  for (const auto& [name, cam] : impl_->cameras.names()) known += (known.empty() ? "" : ", ") + ("'" + name + "'");
+  return not_found("camera '" + camera + "': no frame from it since the start or the last load (known: " +
+                   (known.empty() ? std::string("none") : known) + ")");
+}
+
+std::vector<std::pair<std::string, localization::Localization>> WorkingMemory::localizations() const {
+  std::lock_guard<std::mutex> lock(impl_->writer);
+  std::vector<std::pair<std::string, localization::Localization>> out;
+  for (const auto& [name, id] : impl_->cameras.names())
+    if (auto last = impl_->localizer.last(id)) out.emplace_back(name, *last);
+  return out;
+}
+
 Status WorkingMemory::save(const fs::path& model_dir, std::size_t keep_snapshots) const {
   std::lock_guard<std::mutex> lock(impl_->writer);
   const Impl& m = *impl_;
@@ -832,6 +855,9 @@ Status WorkingMemory::save(const fs::path& model_dir, std::size_t keep_snapshots
       }
     }
     if (auto st = m.appearance.save(dir); !st) return st;
+    // The keyframes' features, for relocalization (homing) after a restart.
+    if (auto st = localization::save_features(dir / kFeaturesFile, m.localizer.relocalizer().to_save(m.appearance.all_keyframes())); !st)
+      return st;
     if (auto st = write_file_synced(dir / "scene.json", scene.dump(2)); !st) return st;
     return write_file_synced(dir / "events.jsonl", log);
   }, keep_snapshots);
@@ -937,11 +963,21 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
     }
   }
 
+  // Keyframe features (absent in models saved before them: extracted again on first use).
+  std::vector<localization::SavedFeatures> features;
+  if (std::error_code ec; fs::exists(dir / kFeaturesFile, ec)) {
+    auto loaded = localization::load_features(dir / kFeaturesFile);
+    if (!loaded) return loaded.error();
+    features = std::move(*loaded);
+  }
+
   std::lock_guard<std::mutex> lock(impl_->writer);
   Impl& m = *impl_;
   // Keyframes last among the reads: AppearanceStage::load changes nothing when it fails.
   if (auto st = m.appearance.load(dir); !st) return st;
+  // Every camera homes anew: its frames are relocalized against the loaded keyframes.
   m.localizer.reset();
+  m.localizer.relocalizer().restore(features, m.appearance.all_keyframes());
   {
     std::unique_lock<std::shared_mutex> write(m.map_mutex);
     m.map = std::move(map);

@@ -215,6 +215,14 @@ void to_proto(const localization::Localization& where, proto::LocalizationResult
   out->set_reference_keyframe(where.reference_keyframe);
   out->set_reason(where.reason);
   out->set_compute_ms(where.ms);
+  to_proto(where.T_world_odom, out->mutable_t_world_odom());
+  out->set_relocalized(where.relocalized);
+  out->set_homed(where.homed);
+  out->set_feature_matches(where.feature_matches);
+  out->set_feature_inliers(where.feature_inliers);
+  out->set_relocalization_ms(where.relocalization_ms);
+  out->set_odom_change_m(where.odom_change_m);
+  out->set_odom_change_deg(where.odom_change_deg);
 }
 
 proto::LocalizationMode to_proto(const std::optional<LocalizationMode>& mode) {

@@ -43,6 +43,7 @@ Route route_of(proto::Request::CallCase call) {
   switch (call) {
     case proto::Request::kQueryOccupancy:
     case proto::Request::kStats:
+    case proto::Request::kGetLocalization:
     case proto::Request::kGetSurpriseMap:
     case proto::Request::kNextBestView:
       return Route::kQuery;
@@ -218,6 +219,7 @@ struct RequestHandler::Impl {
       case proto::Request::kGetSurpriseMap: return get_surprise_map(request.get_surprise_map(), response);
       case proto::Request::kDefineClass: return define_class(request.define_class(), response);
       case proto::Request::kListClasses: return list_classes(response);
+      case proto::Request::kGetLocalization: return get_localization(request.get_localization(), response);
       case proto::Request::kNextBestView:
         return service::next_best_view(memory, request.next_best_view(), response.mutable_next_best_view());
       case proto::Request::CALL_NOT_SET: break;
@@ -253,6 +255,24 @@ struct RequestHandler::Impl {
     out->set_frames_skipped(frames_skipped.load());
     out->set_connections(connections ? static_cast<std::uint32_t>(connections()) : 0);
     out->set_uptime_s(uptime_s());
+    return {};
+  }
+
+  Status get_localization(const proto::GetLocalization& msg, proto::Response& response) {
+    auto* out = response.mutable_localization();
+    if (!msg.camera().empty() || msg.only_default()) {
+      auto where = memory.localization(msg.camera());
+      if (!where) return where.error();
+      auto* camera = out->add_cameras();
+      convert::to_proto(*where, camera);
+      camera->set_camera(msg.camera());
+      return {};
+    }
+    for (const auto& [name, where] : memory.localizations()) {
+      auto* camera = out->add_cameras();
+      convert::to_proto(where, camera);
+      camera->set_camera(name);
+    }
     return {};
   }
 

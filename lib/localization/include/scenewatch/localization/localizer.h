@@ -19,6 +19,7 @@
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/sensor_model.h"
 #include "scenewatch/localization/dense_alignment.h"
+#include "scenewatch/localization/relocalizer.h"
 #include "scenewatch/localization/rgbd_pyramid.h"
 
 namespace scenewatch::localization {
@@ -48,6 +49,11 @@ struct Config {
   /// three sigmas is not believed (the prior is used).
   double drift_m_per_frame = 0.001;
   double drift_deg_per_frame = 0.05;
+  /// Relocalization from keyframe features (homing): a camera's first frames when the memory
+  /// already has keyframes (a loaded model), every lost frame in `track` mode, and in `refine`
+  /// mode after this many lost frames in a row (the pose source jumped for good).
+  RelocalizerConfig relocalization;
+  int rehome_after_lost_frames = 3;
 };
 
 Status validate(const Config& config);
@@ -80,6 +86,15 @@ struct Localization {
   /// Covariance of the pose's error as a twist in the world frame (translation, rotation).
   Eigen::Matrix<double, 6, 6> covariance = Eigen::Matrix<double, 6, 6>::Zero();
   std::uint64_t reference_keyframe = 0;  ///< the keyframe it was aligned to (0: none)
+  /// This frame was placed by relocalization (feature matches, then dense alignment), not from its prior.
+  bool relocalized = false;
+  /// The camera has been placed against the memory since it started (or started an empty memory):
+  /// until then its frames are relocalized and, when that fails, lost.
+  bool homed = false;
+  std::size_t feature_matches = 0, feature_inliers = 0;  ///< of the relocalization, when one ran
+  double relocalization_ms = 0.0;
+  /// How far this frame's placement moved the camera's T_world_odom, metres and degrees.
+  double odom_change_m = 0.0, odom_change_deg = 0.0;
   std::string reason;                    ///< why it is lost, or starting
   double ms = 0.0;
   /// True when the frame may change the memory.
@@ -88,6 +103,8 @@ struct Localization {
 
 /// Up to n keyframes near a pose, nearest first (AppearanceMemory::nearest).
 using KeyframeSource = std::function<std::vector<std::shared_ptr<const background::Keyframe>>(const Pose&, std::size_t)>;
+/// Every keyframe of the memory (AppearanceMemory::keyframes), for relocalization.
+using AllKeyframes = std::function<std::vector<std::shared_ptr<const background::Keyframe>>()>;
 
 /// NOT thread safe: one writer (the pipeline's frame loop).
 class Localizer {
@@ -97,6 +114,17 @@ class Localizer {
   /// Places a frame of `camera`. Frames that cannot be aligned (no intrinsics, not organized)
   /// keep their given pose (state kGiven, with the reason).
   Localization localize(const Frame& frame, std::uint32_t camera, const KeyframeSource& keyframes);
+  /// The same, with relocalization against `all` when the camera is not homed or lost (see Config).
+  Localization localize(const Frame& frame, std::uint32_t camera, const KeyframeSource& keyframes, const AllKeyframes& all);
+  /// Relocalizes a frame against the keyframes without a prior: feature hypotheses, each refined
+  /// densely and verified (Config::min_inlier_fraction, min_conditioning). State kTracking with
+  /// the pose when found, else kLost with the reason. The camera's track does not change.
+  Localization relocalize(const Frame& frame, const std::vector<std::shared_ptr<const background::Keyframe>>& keyframes);
+  /// The cameras that sent frames, in id order.
+  std::vector<std::uint32_t> cameras() const;
+  /// Keyframe features (to save with the model, restore after a load).
+  Relocalizer& relocalizer() { return relocalizer_; }
+  const Relocalizer& relocalizer() const { return relocalizer_; }
   /// The last result of a camera, if it sent a frame.
   std::optional<Localization> last(std::uint32_t camera) const;
   void forget_camera(std::uint32_t camera);
@@ -107,9 +135,13 @@ class Localizer {
   struct Track;
   std::shared_ptr<const RgbdPyramid> reference(const background::Keyframe& keyframe);
   Pose fuse_with_prior(Track& track, const Pose& prior, const Pose& measured, const Alignment& alignment, bool& rejected) const;
+  bool must_relocalize(const Track& track, LocalizationMode mode, bool memory_has_keyframes) const;
+  /// Fills r's quality from an alignment with a keyframe; true when it passes the checks.
+  bool accept(Localization& r, const Alignment& a, const background::Keyframe& keyframe) const;
 
   Config config_;
   SensorModel sensor_;
+  Relocalizer relocalizer_;
   std::map<std::uint32_t, std::shared_ptr<Track>> tracks_;
   /// Pyramids of recently used keyframes by id, with the use counter of each.
   std::map<std::uint64_t, std::pair<std::shared_ptr<const RgbdPyramid>, std::uint64_t>> references_;

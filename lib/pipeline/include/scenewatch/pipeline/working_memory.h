@@ -171,6 +171,11 @@ class WorkingMemory {
 
   std::shared_ptr<const SceneSnapshot> snapshot() const;
   Stats stats() const;
+  /// Where a camera is (its last frame's localization; T_world_odom, state, quality). kNotFound,
+  /// naming the known cameras, for a camera that sent no frame since the start or the last load.
+  Result<localization::Localization> localization(const std::string& camera) const;
+  /// Every camera that sent a frame since the start or the last load, by name ("" the default camera).
+  std::vector<std::pair<std::string, localization::Localization>> localizations() const;
 
   background::Occupancy query(const Eigen::Vector3d& p_world) const;
   background::BoxOccupancy query_box(const Aabb& box_world) const;
