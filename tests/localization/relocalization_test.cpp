@@ -97,7 +97,9 @@ TEST(KeyframeFeatures, AFrameKeepsOnlyKeypointsWithDepthAndTheFileRoundTrips) {
   ASSERT_TRUE(memory.save(dir / "model").ok());
   background::AppearanceMemory reloaded;
   ASSERT_TRUE(reloaded.load(dir / "model").ok());
-  const Relocalizer original;
+  Relocalizer original;
+  EXPECT_TRUE(original.to_save(memory.keyframes()).empty());  // none extracted yet: none saved
+  for (const auto& kf : memory.keyframes()) original.features(*kf);
   Relocalizer restored;
   EXPECT_EQ(restored.restore(original.to_save(memory.keyframes()), reloaded.keyframes()), 3u);
   // A truncated file is an error naming it.

@@ -123,8 +123,7 @@ std::vector<SavedFeatures> Relocalizer::to_save(const std::vector<std::shared_pt
   std::vector<SavedFeatures> out;
   for (const auto& kf : keyframes) {
     const auto it = cache_.find(kf->id);
-    out.push_back({kf->T_world_camera, it != cache_.end() ? it->second
-                                                          : extract_features(kf->color, kf->depth, kf->intrinsics, sensor_, config_.features)});
+    if (it != cache_.end()) out.push_back({kf->T_world_camera, it->second});
   }
   return out;
 }
