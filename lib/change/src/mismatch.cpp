@@ -211,6 +211,18 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
     if (organized) return std::pair<int, int>(static_cast<int>(i % cloud.width), static_cast<int>(i / cloud.width));
     return std::pair<int, int>(static_cast<int>(std::lround(K.fx * p.x / p.z + K.cx)), static_cast<int>(std::lround(K.fy * p.y / p.z + K.cy)));
   };
+  // The incidence of each 2 x 2 block of pixels, fitted once, at the first of its pixels asked
+  // for: new objects come as regions of thousands of candidate pixels, and the plane under
+  // neighbouring pixels is the same.
+  std::vector<float> block_incidence;
+  const int block_w = (K.width + 1) / 2;
+  auto incidence_at = [&](int u, int v) {
+    if (block_incidence.empty()) block_incidence.assign(static_cast<std::size_t>(block_w) * ((K.height + 1) / 2), -1.0f);
+    if (u < 0 || v < 0 || u >= K.width || v >= K.height) return std::numeric_limits<double>::quiet_NaN();
+    float& cached = block_incidence[static_cast<std::size_t>(v / 2) * block_w + u / 2];
+    if (cached == -1.0f) cached = static_cast<float>(surface_incidence_rad(depth.z, K, u, v, config.sensor, config.sigma_factor));
+    return static_cast<double>(cached);
+  };
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const PointT& p = cloud.points[i];
     if (!is_valid(p) || p.z > config.max_range_m) continue;
@@ -225,7 +237,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
     if (config.incidence_aware) {
       // The depth of a surface seen at a grazing angle is known only coarsely along its ray, and
       // so is the free space that rays running along it carved: the claim must clear that too.
-      const double incidence = surface_incidence_rad(depth.z, K, u, v, config.sensor, config.sigma_factor);
+      const double incidence = incidence_at(u, v);
       if (std::isfinite(incidence)) {
         const double sigma = config.sensor.sigma_along_ray(p.z, incidence, std::min(K.fx, K.fy));
         const double reach = kHalfDiagonal * res + map_tolerance_from_sigma(config, sigma, p.z, shift);
