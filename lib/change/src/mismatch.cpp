@@ -45,14 +45,17 @@ bool claims_new_surface(const background::DenseGrid& grid, const Eigen::Vector3d
   return true;
 }
 
-// The farthest ring of voxels searched for a surface near a point (7 x 7 x 7 .. 11 x 11 x 11).
+// The farthest ring of voxels searched for a surface near a point: 7 x 7 x 7 voxels for the
+// head-on tolerance, 11 x 11 x 11 for the noise along the ray at the surface's incidence.
+constexpr int kHeadOnRing = 3;
 constexpr int kMaxRing = 5;
 
 // Whether a voxel that is not free (a surface, or space never seen: the far side of a thin leg
-// whose silhouette rays grazed this voxel) has its centre within `reach` of w, in voxel idx.
-bool surface_within(const background::DenseGrid& grid, long idx, const Eigen::Vector3d& w, double reach) {
+// whose silhouette rays grazed this voxel) has its centre within `reach` of w, in voxel idx,
+// searching at most `max_ring` voxels each way.
+bool surface_within(const background::DenseGrid& grid, long idx, const Eigen::Vector3d& w, double reach, int max_ring) {
   using background::Occupancy;
-  const int ring = std::min(kMaxRing, static_cast<int>(std::ceil(reach / grid.resolution - 0.5)));
+  const int ring = std::min(max_ring, static_cast<int>(std::ceil(reach / grid.resolution - 0.5)));
   const long sz = static_cast<long>(grid.nx) * grid.ny;
   const long i0 = idx % grid.nx, j0 = (idx / grid.nx) % grid.ny, k0 = idx / sz;
   const double reach2 = reach * reach;
@@ -233,7 +236,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
     if (!trusted_at(u, v)) continue;
     const double shift = measured_pose.shift_at(w);
     const double gap = kHalfDiagonal * res + map_tolerance_m(config, p.z, shift);
-    if (surface_within(grid, idx, w, gap)) continue;
+    if (surface_within(grid, idx, w, gap, kHeadOnRing)) continue;
     if (config.incidence_aware) {
       // The depth of a surface seen at a grazing angle is known only coarsely along its ray, and
       // so is the free space that rays running along it carved: the claim must clear that too.
@@ -241,7 +244,7 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
       if (std::isfinite(incidence)) {
         const double sigma = config.sensor.sigma_along_ray(p.z, incidence, std::min(K.fx, K.fy));
         const double reach = kHalfDiagonal * res + map_tolerance_from_sigma(config, sigma, p.z, shift);
-        if (reach > (kMaxRing + 0.5) * res || surface_within(grid, idx, w, reach)) continue;
+        if (reach > (kMaxRing + 0.5) * res || surface_within(grid, idx, w, reach, kMaxRing)) continue;
       }
     }
     if (witness != nullptr && !claims_new_surface(grid, T.translation(), w, *witness, camera)) continue;
