@@ -97,6 +97,9 @@ run_prefix() {
   echo "== pip install of the Python client (build tree, offline, no build isolation) into a fresh venv"
   # From a copy of build/clients/python: pip builds in place, and the build tree stays as it was.
   cp -r "$build/clients/python" "$work/python-client"
+  # A build tree packaged before this change kept setuptools' build/ from then: installing it would
+  # install that old copy of the client instead of this one.
+  rm -rf "$work/python-client/build" "$work/python-client"/*.egg-info
   /usr/bin/python3 -m venv --system-site-packages "$work/venv"
   if "$work/venv/bin/python" -m pip install --no-build-isolation --no-index --no-cache-dir --quiet "$work/python-client" \
        >"$work/pip.log" 2>&1; then
