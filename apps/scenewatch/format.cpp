@@ -16,6 +16,8 @@ std::string fixed(double value, int decimals = 3) {
 
 nlohmann::json to_json(const proto::Vec3& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
 
+nlohmann::json to_json(const proto::Pose& pose) { return std::vector<double>(pose.matrix().begin(), pose.matrix().end()); }
+
 nlohmann::json to_json(const proto::Box& box) { return {{"min", to_json(box.min())}, {"max", to_json(box.max())}}; }
 
 nlohmann::json to_json(const proto::OrientedBox& box) {
@@ -80,7 +82,7 @@ nlohmann::json to_json(const proto::Object& object) {
                          {"dof_range", std::vector<double>(h.dof_range().begin(), h.dof_range().end())},
                          {"moved_dofs", std::vector<std::string>(h.moved_dofs().begin(), h.moved_dofs().end())}});
   }
-  j["foreground"] = {{"pose", std::vector<double>(object.pose().matrix().begin(), object.pose().matrix().end())},
+  j["foreground"] = {{"pose", to_json(object.pose())},
                      {"free_dofs", std::vector<std::string>(object.free_dofs().begin(), object.free_dofs().end())},
                      {"frozen_dofs", std::vector<std::string>(object.frozen_dofs().begin(), object.frozen_dofs().end())},
                      {"handlings", handlings}, {"in_hand", object.in_hand()}, {"visible", object.visible()},
@@ -140,10 +142,9 @@ nlohmann::json to_json(const proto::StatsReply& s) {
 }
 
 nlohmann::json to_json(const proto::LocalizationResult& l) {
-  std::vector<double> pose(l.pose().matrix().begin(), l.pose().matrix().end());
   return {{"mode", l.mode()},
           {"state", l.state()},
-          {"pose", pose},
+          {"pose", to_json(l.pose())},
           {"correction_m", l.correction_m()},
           {"correction_deg", l.correction_deg()},
           {"inlier_fraction", l.inlier_fraction()},
@@ -151,7 +152,7 @@ nlohmann::json to_json(const proto::LocalizationResult& l) {
           {"reference_keyframe", l.reference_keyframe()},
           {"reason", l.reason()},
           {"compute_ms", l.compute_ms()},
-          {"T_world_odom", std::vector<double>(l.t_world_odom().matrix().begin(), l.t_world_odom().matrix().end())},
+          {"T_world_odom", to_json(l.t_world_odom())},
           {"relocalized", l.relocalized()},
           {"homed", l.homed()},
           {"feature_matches", l.feature_matches()},

@@ -10,6 +10,8 @@
 namespace scenewatch::cli {
 
 nlohmann::json to_json(const proto::Vec3& v);
+/// A pose as its 16 numbers, row-major T (as the API sends it).
+nlohmann::json to_json(const proto::Pose& pose);
 nlohmann::json to_json(const proto::Box& box);
 nlohmann::json to_json(const proto::OrientedBox& box);
 nlohmann::json to_json(const proto::Plane& plane);

@@ -696,7 +696,7 @@ int run_next_view(const RemoteOptions& options, const NextViewOptions& next) {
     if (options.json) {
       json views = json::array();
       for (const auto& v : reply.views()) {
-        views.push_back({{"pose", std::vector<double>(v.pose().matrix().begin(), v.pose().matrix().end())},
+        views.push_back({{"pose", to_json(v.pose())},
                          {"score", v.score()},
                          {"expected_coverage", v.expected_coverage()},
                          {"unknown_voxels", v.unknown_voxels()},
