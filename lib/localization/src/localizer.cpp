@@ -105,8 +105,8 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
   return localize(frame, camera, keyframes, {});
 }
 
-bool Localizer::must_relocalize(const Track& track, LocalizationMode mode, bool memory_has_keyframes) const {
-  if (mode == LocalizationMode::kGiven || !memory_has_keyframes) return false;
+bool Localizer::must_relocalize(const Track& track, LocalizationMode mode) const {
+  if (mode == LocalizationMode::kGiven) return false;
   if (!track.homed) return true;  // homing: the camera's frame is not the memory's yet
   if (mode == LocalizationMode::kTrack) return track.result.state == State::kLost;
   return track.lost_in_row >= config_.rehome_after_lost_frames;
@@ -229,9 +229,10 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
     out.T_world_camera = frame.pose_or_identity();
     return finish(out);
   }
-  if (all) {
+  // The keyframe list is asked for only when the camera must relocalize: most frames do not.
+  if (all && must_relocalize(track, out.mode)) {
     const auto every = all();
-    if (must_relocalize(track, out.mode, !every.empty())) {
+    if (!every.empty()) {
       Localization r = relocalize(frame, every);
       r.mode = out.mode;
       if (!r.placed()) {

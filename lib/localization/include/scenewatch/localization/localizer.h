@@ -135,7 +135,7 @@ class Localizer {
   struct Track;
   std::shared_ptr<const RgbdPyramid> reference(const background::Keyframe& keyframe);
   Pose fuse_with_prior(Track& track, const Pose& prior, const Pose& measured, const Alignment& alignment, bool& rejected) const;
-  bool must_relocalize(const Track& track, LocalizationMode mode, bool memory_has_keyframes) const;
+  bool must_relocalize(const Track& track, LocalizationMode mode) const;
   /// Fills r's quality from an alignment with a keyframe; true when it passes the checks.
   bool accept(Localization& r, const Alignment& a, const background::Keyframe& keyframe) const;
 
