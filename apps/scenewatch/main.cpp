@@ -176,7 +176,9 @@ int main(int argc, char** argv) {
   add_remote_options(events, remote);
   events->callback([&] { action = [&] { return run_events(remote, since, max_count); }; });
 
-  auto* watch = app.add_subcommand("watch", "print events as they happen until Ctrl-C (--json: one per line)");
+  auto* watch = app.add_subcommand(
+      "watch", "print events as they happen until Ctrl-C (--json: one per line), and each change of a camera's localization "
+               "state (lost, found, homed; --json: {\"localization\": ...})");
   add_remote_options(watch, remote);
   watch->callback([&] { action = [&] { return run_watch(remote); }; });
 

@@ -655,15 +655,23 @@ int run_watch(const RemoteOptions& options) {
               << response->subscribe().last_event_id() << "); Ctrl-C to stop" << std::endl;
   }
   while (!g_interrupted) {
-    auto event = client->next_event();
-    if (!event) {
+    auto pushed = client->next_pushed();
+    if (!pushed) {
       if (g_interrupted) break;
-      return fail(event.error().message);
+      return fail(pushed.error().message);
     }
-    if (options.json) {
-      std::cout << to_json(*event).dump() << std::endl;
-    } else {
-      std::cout << text(*event).substr(2) << std::endl;
+    if (pushed->has_event()) {
+      std::cout << (options.json ? to_json(pushed->event()).dump() : text(pushed->event()).substr(2)) << std::endl;
+      continue;
+    }
+    // A camera whose localization state changed (lost, found, homed).
+    for (const auto& camera : pushed->localization().cameras()) {
+      if (options.json) {
+        std::cout << nlohmann::json{{"localization", to_json(camera)}}.dump() << std::endl;
+      } else {
+        const std::string line = text(camera);
+        std::cout << "localization: " << line.substr(0, line.find('\n')) << std::endl;
+      }
     }
   }
   return kExitOk;

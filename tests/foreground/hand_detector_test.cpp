@@ -357,10 +357,12 @@ TEST(HandDetector, HandsInAnEmptyKitchen) {
     dump(*frame->cloud, d, "redkitchen_" + std::to_string(f));
   }
   std::printf("redkitchen: hands in %d of %zu frames without a person\n", with_hands, seq->frames.size());
-  // Known weakness, measured 46 of 50: wood (a tray's edge, chair slats, a table) is skin-coloured
-  // and long, and the view is hand-held, so the border cuts everything. Kept as a figure to improve
-  // on, not a pass mark.
-  EXPECT_LE(with_hands, 50);
+  // Known weakness, measured 46 of 50: wood (a tray's edge, chair slats, a table), a red cupboard's
+  // lit edge and a red toy are skin-coloured and long, and the view is hand-held, so the border
+  // cuts everything. The detector alone has no memory; in the pipeline, hands on surfaces the map
+  // has remembered are dropped (Stream.* count 10 frames here). The floor is the measured figure,
+  // so that more false hands fail; lower it when the detector improves.
+  EXPECT_LE(with_hands, 46);
 }
 
 // ---------------------------------------------------------------------------------------------

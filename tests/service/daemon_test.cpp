@@ -862,6 +862,52 @@ TEST_F(DaemonTest, GetLocalizationReportsTheHomedCameraAfterARestart) {
   EXPECT_NE(unknown.status().message().find("nope"), std::string::npos) << unknown.status().message();
 }
 
+// Issue 29: a change of a camera's localization state is pushed to subscribers. A camera streams
+// the real kitchen in refine mode; one frame comes with its pose 1 m off, which the alignment
+// cannot accept (lost), and the next frames are right again (tracking). The subscriber is told
+// each change the ingest replies show, in order, and nothing else.
+TEST_F(DaemonTest, LocalizationChangesArePushedToSubscribers) {
+  SCENEWATCH_REQUIRE_DATA("redkitchen_long");
+  auto seq = io::open_sequence(data_dir() / "redkitchen_long");
+  ASSERT_TRUE(seq.ok()) << seq.error().message;
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml("localization:\n  mode: refine\n")));
+  Client client = daemon_.connect();
+  Client subscriber = daemon_.connect();
+  ASSERT_EQ(call(subscriber, request([](proto::Request& r) { r.mutable_subscribe(); })).status().code(), proto::Status::OK);
+  const std::size_t off_frame = 4;
+  std::vector<std::pair<std::string, bool>> seen;  // state and homing, as each reply says
+  std::vector<std::pair<std::string, bool>> changes;
+  for (std::size_t i = 0; i < 7; ++i) {
+    auto frame = io::load_sequence_frame(*seq, i);
+    ASSERT_TRUE(frame.ok()) << frame.error().message;
+    if (i == off_frame) frame->T_world_camera->translation() += Eigen::Vector3d(1.0, 0.0, 0.0);
+    frame->camera = "kitchen";
+    proto::Request r;
+    *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+    const auto reply = call(client, r);
+    ASSERT_EQ(reply.status().code(), proto::Status::OK) << reply.status().message();
+    const auto& where = reply.ingest().localization();
+    const std::pair<std::string, bool> now{where.state(), where.homed()};
+    if (seen.empty() || seen.back() != now) changes.push_back(now);
+    seen.push_back(now);
+  }
+  ASSERT_EQ(seen[off_frame].first, "lost") << "the frame 1 m off must be lost";
+  ASSERT_EQ(seen.back().first, "tracking");
+  for (std::size_t k = 0; k < changes.size(); ++k) {
+    auto pushed = subscriber.next_pushed(kCallTimeoutS);
+    ASSERT_TRUE(pushed.ok()) << "change " << k << " (" << changes[k].first << ") not pushed: " << pushed.error().message;
+    ASSERT_EQ(pushed->id(), 0u);
+    ASSERT_EQ(pushed->localization().cameras_size(), 1);
+    const auto& camera = pushed->localization().cameras(0);
+    EXPECT_EQ(camera.camera(), "kitchen");
+    EXPECT_EQ(camera.state(), changes[k].first) << "change " << k;
+    EXPECT_EQ(camera.homed(), changes[k].second) << "change " << k;
+    if (camera.state() == "lost") EXPECT_FALSE(camera.reason().empty());
+  }
+  std::cout << "localization notices: " << changes.size() << " changes in 7 frames\n";
+  EXPECT_FALSE(subscriber.next_pushed(0.5).ok()) << "nothing more than the changes";
+}
+
 TEST_F(DaemonTest, StartsEmptyWithoutAModelAndRefusesABadConfig) {
   ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, server_yaml()));
   Client client = daemon_.connect();

@@ -75,12 +75,20 @@ class Subscription:
     ``Client.get_events(since=...)``). Iterating blocks until the next event; ``next(timeout_s)``
     raises ``Timeout`` when none comes in time. When the daemon goes away the iteration raises
     ``ConnectionLost`` (it does not just end: a planner must know it is no longer told).
+
+    ``localization_changes``: a deque of pb.LocalizationResult, one per change of a camera's
+    localization state (lost, found, homed; its ``camera`` names it) that arrived while the
+    connection waited for an event or a reply, oldest first; pop them as you go.
     """
 
     def __init__(self, client, last_event_id, timeout_s):
         self._client = client
         self.last_event_id = last_event_id
         self._timeout_s = timeout_s
+
+    @property
+    def localization_changes(self):
+        return self._client._localization_changes
 
     def next(self, timeout_s=None):
         """The next event (pb.Event); waits at most timeout_s (None: the subscription's timeout,
@@ -126,6 +134,7 @@ class Client:
         self.max_message_bytes = max_message_bytes
         self._buffer = bytearray()
         self._events = collections.deque()
+        self._localization_changes = collections.deque()
         self._next_id = 1
         try:
             self._sock = socket.create_connection((host, self.port), timeout=timeout_s or None)
@@ -318,6 +327,8 @@ class Client:
     def _handle_unsolicited(self, response, call):
         if response.WhichOneof("result") == "event":
             self._events.append(response.event)
+        elif response.WhichOneof("result") == "localization":
+            self._localization_changes.extend(response.localization.cameras)
         elif response.status.code != pb.Status.OK:
             # An error without a request id: broken framing, a read timeout, too many clients.
             # The daemon closes the connection after it.

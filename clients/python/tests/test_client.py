@@ -180,6 +180,32 @@ class ClientTest(unittest.TestCase):
         self.assertGreater(surprise.known_pixels, 320 * 240 // 4)
         self.assertGreaterEqual(surprise.reference_views, 1)
 
+    def test_a_subscriber_is_told_when_a_camera_is_lost_and_found(self):
+        rendered = Rendered.get()
+        listener = scenewatch.Client("127.0.0.1", self.daemon.port, timeout_s=60)
+        self.addCleanup(listener.close)
+        subscription = listener.subscribe(timeout_s=60)
+        sequence = Sequence(os.path.join(rendered, "before"))
+        seen = []  # (state, homed) as each ingest reply says
+        for i in range(6):
+            frame = sequence.frame(i)
+            frame.camera = "arm"
+            frame.localization = pb.LOCALIZATION_REFINE
+            if i == 3:
+                frame.pose.matrix[3] += 1.0  # 1 m off along x: the alignment cannot accept it
+            reply = self.client.ingest_frame(frame)
+            seen.append((reply.localization.state, reply.localization.homed))
+        self.assertEqual(seen[3][0], "lost")
+        self.assertEqual(seen[-1][0], "tracking")
+        changes = [s for k, s in enumerate(seen) if k == 0 or seen[k - 1] != s]
+        listener.stats()  # a call: what was pushed before its reply is collected meanwhile
+        notices = list(subscription.localization_changes)
+        self.assertEqual([(c.state, c.homed) for c in notices], changes)
+        self.assertEqual({c.camera for c in notices}, {"arm"})
+        self.assertTrue(notices[changes.index(seen[3])].reason, "a lost camera says why")
+        with self.assertRaises(scenewatch.Timeout):
+            subscription.next(timeout_s=0.5)  # notices are not events
+
     def test_pure_python_frames_match_the_files(self):
         # The back-projection of rgbd.py against the organized PCD the simulator wrote of the same
         # frame (sample_clouds/tabletop.pcd is frame 0 of sample_clouds/tabletop/).

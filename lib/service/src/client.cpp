@@ -42,6 +42,9 @@ std::optional<Clock::time_point> deadline_after(double timeout_s) {
   return Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(timeout_s));
 }
 
+/// What the daemon pushes after Subscribe: id 0 with an event or a localization notice.
+bool is_pushed(const proto::Response& r) { return r.id() == 0 && (r.has_event() || r.has_localization()); }
+
 /// Connects one resolved address with a timeout; returns the fd or -1 with errno set.
 int connect_one(const addrinfo& ai, double timeout_s) {
   const int fd = ::socket(ai.ai_family, ai.ai_socktype | SOCK_CLOEXEC, ai.ai_protocol);
@@ -115,7 +118,7 @@ Client::Client(Client&& other) noexcept
       parser_(std::move(other.parser_)),
       next_id_(other.next_id_),
       token_(std::move(other.token_)),
-      events_(std::move(other.events_)) {}
+      pushed_(std::move(other.pushed_)) {}
 
 Client& Client::operator=(Client&& other) noexcept {
   if (this != &other) {
@@ -125,7 +128,7 @@ Client& Client::operator=(Client&& other) noexcept {
     parser_ = std::move(other.parser_);
     next_id_ = other.next_id_;
     token_ = std::move(other.token_);
-    events_ = std::move(other.events_);
+    pushed_ = std::move(other.pushed_);
   }
   return *this;
 }
@@ -226,8 +229,8 @@ Result<proto::Response> Client::wait_for(std::uint64_t id, double timeout_s) {
     auto response = receive(left);
     if (!response) return response.error();
     if (response->id() == id) return response;
-    if (response->id() == 0 && response->has_event()) {
-      events_.push_back(response->event());
+    if (is_pushed(*response)) {
+      pushed_.push_back(std::move(*response));
       continue;
     }
     if (response->id() == 0 && response->status().code() != proto::Status::OK) {
@@ -241,19 +244,33 @@ Result<proto::Response> Client::wait_for(std::uint64_t id, double timeout_s) {
 Result<proto::Event> Client::next_event(double timeout_s) {
   const auto deadline = deadline_after(timeout_s);
   for (;;) {
-    if (!events_.empty()) {
-      proto::Event event = std::move(events_.front());
-      events_.pop_front();
-      return event;
-    }
     double left = 0;
     if (deadline) {
       left = std::chrono::duration<double>(*deadline - Clock::now()).count();
       if (left <= 0) return unavailable("no event from " + endpoint_ + " within " + std::to_string(timeout_s) + " s");
     }
+    auto pushed = next_pushed(deadline ? left : 0);
+    if (!pushed) return pushed.error();
+    if (pushed->has_event()) return std::move(*pushed->mutable_event());
+  }
+}
+
+Result<proto::Response> Client::next_pushed(double timeout_s) {
+  const auto deadline = deadline_after(timeout_s);
+  for (;;) {
+    if (!pushed_.empty()) {
+      proto::Response pushed = std::move(pushed_.front());
+      pushed_.pop_front();
+      return pushed;
+    }
+    double left = 0;
+    if (deadline) {
+      left = std::chrono::duration<double>(*deadline - Clock::now()).count();
+      if (left <= 0) return unavailable("nothing pushed by " + endpoint_ + " within " + std::to_string(timeout_s) + " s");
+    }
     auto response = receive(left);
     if (!response) return response.error();
-    if (response->id() == 0 && response->has_event()) return response->event();
+    if (is_pushed(*response)) return response;
     if (response->id() == 0 && response->status().code() != proto::Status::OK) {
       return Error{convert::from_proto(response->status().code()),
                    "server " + endpoint_ + ": " + response->status().message()};

@@ -12,6 +12,7 @@
 #include <google/protobuf/util/json_util.h>
 
 #include "live_frame.h"
+#include "localization_notices.h"
 #include "next_best_view_call.h"
 #include "ontology_convert.h"
 #include "scenewatch/ontology/describe.h"
@@ -112,6 +113,7 @@ struct RequestHandler::Impl {
   FrameObserver frame_observer;
   std::atomic<bool> stopping{false};
   std::atomic<std::uint64_t> frames_skipped{0};  // live frames superseded by newer ones
+  LocalizationNotices localization_notices;
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
 
   Impl(pipeline::WorkingMemory& m, HandlerConfig c, Executor mu, Executor q)
@@ -210,6 +212,7 @@ struct RequestHandler::Impl {
       case proto::Request::kClearBox: return clear_box(request.clear_box(), response);
       case proto::Request::kReset:
         memory.reset();
+        localization_notices.forget_cameras();
         response.mutable_reset();
         return {};
       case proto::Request::kSaveModel: return save_model(response);
@@ -408,6 +411,7 @@ struct RequestHandler::Impl {
     auto result = memory.process(frame);
     if (!result) return result.error();
     if (frame_observer) frame_observer(frame, *result);
+    localization_notices.after_frame(frame.camera, result->localization);
     auto* out = response.mutable_ingest();
     out->set_frame_index(result->frame_index);
     out->set_points(result->points);
@@ -621,6 +625,7 @@ struct RequestHandler::Impl {
   Status load_model(proto::Response& response) {
     if (Status s = require_model_dir(); !s) return s;
     if (Status s = memory.load(config.model_dir); !s) return s;
+    localization_notices.forget_cameras();
     auto* out = response.mutable_load_model();
     out->set_model_dir(config.model_dir.string());
     out->set_objects(memory.snapshot()->objects.size());
@@ -642,6 +647,7 @@ struct RequestHandler::Impl {
         pushed.SerializeToString(&bytes);
         sink(std::move(bytes));
       });
+      localization_notices.add(context->subscription, context->event_sink);
     }
     const auto log = memory.events_since(0, std::max<std::size_t>(1, memory.config().max_event_log));
     response.mutable_subscribe()->set_last_event_id(log.empty() ? 0 : log.back().id);
@@ -693,6 +699,7 @@ Reply RequestHandler::handle_now(const std::string& payload, SessionContext& con
 void RequestHandler::unsubscribe(SessionContext& context) {
   if (context.subscription >= 0) {
     impl_->memory.unsubscribe(context.subscription);
+    impl_->localization_notices.remove(context.subscription);
     context.subscription = -1;
   }
 }

@@ -37,7 +37,8 @@ class Client {
   const std::string& token() const { return token_; }
 
   /// Sends a request (its id is set to the next free one) and waits for the response with that
-  /// id; events pushed meanwhile are kept for next_event(). timeout_s <= 0: wait forever.
+  /// id; events and localization notices pushed meanwhile are kept for next_event() and
+  /// next_pushed(). timeout_s <= 0: wait forever.
   Result<proto::Response> call(proto::Request request, double timeout_s = 0);
   /// call() in two halves, for a client that keeps several requests in flight: start() sends the
   /// request (id and token set as call() sets them) and returns its id; wait_for() waits for the
@@ -45,8 +46,12 @@ class Client {
   Result<std::uint64_t> start(proto::Request request);
   Result<proto::Response> wait_for(std::uint64_t id, double timeout_s = 0);
 
-  /// The next pushed event (after a Subscribe call). timeout_s <= 0: wait forever.
+  /// The next pushed event (after a Subscribe call); localization notices on the way are
+  /// dropped. timeout_s <= 0: wait forever.
   Result<proto::Event> next_event(double timeout_s = 0);
+  /// The next pushed message (after a Subscribe call): a Response with id 0 and either an `event`
+  /// or a `localization` (a camera whose localization state changed). timeout_s <= 0: wait forever.
+  Result<proto::Response> next_pushed(double timeout_s = 0);
 
   /// Sends a request as is (its id untouched), without waiting.
   Status send(const proto::Request& request);
@@ -71,7 +76,7 @@ class Client {
   FrameParser parser_;
   std::uint64_t next_id_ = 1;
   std::string token_;
-  std::deque<proto::Event> events_;
+  std::deque<proto::Response> pushed_;  ///< id 0, with an event or a localization notice
 };
 
 /// OK when the response's status is OK, else an Error with its code and message.
