@@ -1,12 +1,12 @@
 #!/usr/bin/python3
 """`scenewatch replay --json --objects` on ROS bags gives the same events, objects and summary as
-on the same frames read from the folder (usage: replay_bag.py SCENEWATCH FOLDER).
+on the same frames read from the folder (usage: replay_bag.py SCENEWATCH DATA_DIR).
 
-The bags are written by tests/io/make_bag.py from the folder's first 10 frames: a ROS 1 bag by
+The bags are written by tests/io/make_bag.py from the folders' first frames: ROS 1 bags by
 Debian's python3-rosbag (lz4 chunks), a rosbag2 SQLite bag and an MCAP file with zstd chunks
 (containers from their specifications and CDR by hand: ours). Only the
-fields that cannot agree are left out: each line's "source" (a file path or BAG:N) and the
-timings. The folder read is a copy of the frames whose poses are made exactly rigid (7-Scenes'
+fields that cannot agree are left out: each line's "source" (a file path or BAG:N), an event's
+stamp_s and the timings. The folder read is a copy of the frames whose poses are made exactly rigid (7-Scenes'
 rotations are orthonormal to 1e-5; TF's quaternions cannot carry that). Numbers must agree to
 1e-6 (the poses went through a quaternion and a TF chain)."""
 import json
@@ -16,8 +16,9 @@ import sys
 import tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-FRAMES = 10
-TIMINGS = {"median_frame_ms", "p90_frame_ms", "median_stage_ms", "median_ms", "source"}
+# Timings, each line's source, and the event's stamp (a frames-layout folder has no time, it counts
+# frames at 30 per second; the bag's stamps are the recording's).
+TIMINGS = {"median_frame_ms", "p90_frame_ms", "median_stage_ms", "median_ms", "source", "stamp_s"}
 
 
 def strip(value):
@@ -59,31 +60,42 @@ def replay(scenewatch, spec):
     return [strip(json.loads(line)) for line in out.stdout.splitlines() if line.strip()]
 
 
+# (folder under the data dir, frames, bags): the kitchen (a static room: objects and planes per
+# frame, no event) and hrt1's pick_toy_1 (a hand takes a toy: an event).
+CASES = [
+    ("redkitchen_long", 10, [("kitchen.bag", ["--format", "ros1", "--compression", "lz4"]),
+                             ("kitchen_rosbag2", ["--format", "rosbag2"]),
+                             ("kitchen.mcap", ["--format", "mcap", "--compression", "zstd"])]),
+    ("hrt1/pick_toy_1", 40, [("pick_toy_1.bag", ["--format", "ros1", "--compression", "bz2"]),
+                             ("pick_toy_1.mcap", ["--format", "mcap", "--compression", "lz4"])]),
+]
+
+
 def main():
-    scenewatch, folder = sys.argv[1], sys.argv[2]
-    if not os.path.isdir(folder):
-        print("real data not found: %s" % folder)
+    scenewatch, data = sys.argv[1], sys.argv[2]
+    if not os.path.isdir(data):
+        print("real data not found: %s" % data)
         return 77
     failures = 0
-    with tempfile.TemporaryDirectory(prefix="scenewatch-replay-bag-") as tmp:
-        # The folder's frames with their poses made exactly rigid, as TF carries them.
-        oracle = os.path.join(tmp, "oracle")
-        subprocess.run(["/usr/bin/python3", os.path.join(HERE, "make_bag.py"), folder, os.path.join(tmp, "unused.bag"),
-                        "--count", str(FRAMES), "--oracle", oracle], check=True)
-        expected = replay(scenewatch, oracle)
-        summary = expected[-1]
-        print("folder: %d lines, %d frames, %d events" % (len(expected), summary["frames"], summary["events"]))
-        assert summary["frames"] == FRAMES, summary
-        for name, args in (("kitchen.bag", ["--format", "ros1", "--compression", "lz4"]),
-                           ("kitchen_rosbag2", ["--format", "rosbag2"]),
-                           ("kitchen.mcap", ["--format", "mcap", "--compression", "zstd"])):
-            bag = os.path.join(tmp, name)
-            subprocess.run(["/usr/bin/python3", os.path.join(HERE, "make_bag.py"), folder, bag, "--count", str(FRAMES)] + args,
-                           check=True)
-            got = replay(scenewatch, bag)
-            diff = same(expected, got)
-            print("%s: %d lines; %s" % (name, len(got), "same as the folder" if diff is None else "DIFFERS at " + diff))
-            failures += diff is not None
+    for sub, frames, bags in CASES:
+        folder = os.path.join(data, sub)
+        with tempfile.TemporaryDirectory(prefix="scenewatch-replay-bag-") as tmp:
+            # The folder's frames with their poses made exactly rigid, as TF carries them.
+            oracle = os.path.join(tmp, "oracle")
+            subprocess.run(["/usr/bin/python3", os.path.join(HERE, "make_bag.py"), folder, os.path.join(tmp, "unused.bag"),
+                            "--count", str(frames), "--oracle", oracle], check=True)
+            expected = replay(scenewatch, oracle)
+            summary = expected[-1]
+            print("%s: folder: %d lines, %d frames, %d events" % (sub, len(expected), summary["frames"], summary["events"]))
+            assert summary["frames"] == frames, summary
+            for name, args in bags:
+                bag = os.path.join(tmp, name)
+                subprocess.run(["/usr/bin/python3", os.path.join(HERE, "make_bag.py"), folder, bag, "--count", str(frames)] + args,
+                               check=True)
+                got = replay(scenewatch, bag)
+                diff = same(expected, got)
+                print("  %s: %d lines; %s" % (name, len(got), "same as the folder" if diff is None else "DIFFERS at " + diff))
+                failures += diff is not None
     return 1 if failures else 0
 
 
