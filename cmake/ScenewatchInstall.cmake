@@ -130,7 +130,7 @@ find_package(scenewatch) gives scenewatch::pipeline (WorkingMemory) and the othe
 their Debian dependencies found again. libscenewatch_ontology.a holds CGAL's Shape_detection: \
 what links it is GPL-3.0-or-later.")
 # The -dev packages of what the exported targets name (cmake/scenewatchDependencies.cmake).
-set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "cmake (>= 3.22), g++, gcc, libpcl-dev, liboctomap-dev, libopencv-dev, libeigen3-dev, libboost-dev, libcgal-dev, libprotobuf-dev, libyaml-cpp-dev, libsqlite3-dev, nlohmann-json3-dev, robin-map-dev, liblz4-dev")
+set(CPACK_DEBIAN_DEV_PACKAGE_DEPENDS "cmake (>= 3.22), g++, gcc, libpcl-dev, liboctomap-dev, libopencv-dev, libeigen3-dev, libboost-dev, libcgal-dev, libprotobuf-dev, libyaml-cpp-dev, libsqlite3-dev, nlohmann-json3-dev, robin-map-dev, liblz4-dev, libbz2-dev, libzstd-dev")
 
 set(CPACK_DEBIAN_PYTHON_PACKAGE_NAME python3-scenewatch)
 set(CPACK_DEBIAN_PYTHON_PACKAGE_SECTION python)

@@ -70,6 +70,10 @@ scenewatch_find_dependency(Protobuf 3)
 scenewatch_find_dependency(yaml-cpp)
 # The ontology's store (lib/ontology/src/class_store.cpp); Debian: libsqlite3-dev.
 scenewatch_find_dependency(SQLite3)
+# lib/io's bag reader (src/bag/decompress.cpp): bz2 chunks of ROS 1 bags (Debian: libbz2-dev) and
+# zstd chunks of MCAP files (libzstd-dev); lz4 chunks use scenewatch::lz4 below.
+scenewatch_find_dependency(BZip2)
+scenewatch_find_dependency(zstd)
 scenewatch_find_dependency(nlohmann_json 3)
 scenewatch_find_dependency(tsl-robin-map)
 

@@ -8,6 +8,7 @@
 #include "scenewatch.pb.h"
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
+#include "scenewatch/io/bag.h"
 #include "scenewatch/service/access_token.h"
 #include "scenewatch/service/client.h"
 #include "scenewatch/service/server_config.h"
@@ -45,12 +46,14 @@ int run_stats(const RemoteOptions& options);
 /// GetLocalization: every camera, or options.camera alone.
 int run_localization(const RemoteOptions& options);
 /// `depth_scale_m`: metres per depth unit of sequence folders (unset: the folder's or layout's).
+/// `bag`: how ROS bags among the paths are read.
 int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side,
-               const std::optional<double>& depth_scale_m, const std::string& trajectory_path = {});
+               const std::optional<double>& depth_scale_m, const std::string& trajectory_path = {},
+               const io::BagOptions& bag = {});
 /// Sequence folders streamed as a live sensor would: `fps` frames per second without waiting for
 /// replies, each frame marked live (the daemon skips frames it cannot keep up with).
 int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,
-                    const std::optional<double>& depth_scale_m);
+                    const std::optional<double>& depth_scale_m, const io::BagOptions& bag = {});
 int run_planes(const RemoteOptions& options);
 /// `describe`: with each object's class, primitive and grasps (the ontology).
 int run_objects(const RemoteOptions& options, bool describe);
@@ -123,6 +126,7 @@ struct FitOptions {
   bool json = false;
   std::string config;                   ///< YAML config: its segmentation section is used
   std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
+  io::BagOptions bag;  ///< how ROS bags are read (topics, TF frames)
   std::string classes;                  ///< classes file (empty: the shipped config/ontology.yaml)
   std::string out_dir;                  ///< when set: each object's completed model as PCD and PLY
 };
@@ -149,6 +153,7 @@ struct ReplayOptions {
   bool progress = true;             ///< a progress line on stderr every 25 frames
   std::string heatmap_dir;          ///< when set: surprise-NNNNNN.png per frame with a surprise map
   std::optional<double> depth_scale_m;  ///< metres per depth unit of sequence folders (unset: theirs)
+  io::BagOptions bag;  ///< how ROS bags are read (topics, TF frames)
   std::string localization;         ///< overrides localization.mode: given, refine or track (empty: the config's)
   std::string trajectory;           ///< when set: the poses the memory used, as a TUM trajectory
   bool objects = false;             ///< after each frame, the object list a planner would get

@@ -152,7 +152,9 @@ int run_fit(const FitOptions& options) {
     std::filesystem::create_directories(options.out_dir, ec);
     if (ec) return fail(options.out_dir + ": cannot create the folder: " + ec.message());
   }
-  auto frame = load_one_frame(options.file, sequence_options(options.depth_scale_m));
+  InputOptions inputs(sequence_options(options.depth_scale_m));
+  inputs.bag = options.bag;
+  auto frame = load_one_frame(options.file, inputs);
   if (!frame) {
     const std::string& message = frame.error().message;
     return fail(message.find(options.file) != std::string::npos ? message : options.file + ": " + message);

@@ -25,6 +25,19 @@ void add_remote_options(CLI::App* command, RemoteOptions& options) {
       ->capture_default_str();
 }
 
+/// The flags of the commands that read ROS bags (replay, ingest, fit): topics and TF frames.
+void add_bag_options(CLI::App* command, scenewatch::io::BagOptions& bag) {
+  command->add_option("--color-topic", bag.color_topic, "ROS bags: the colour sensor_msgs/Image topic (default: the only one)");
+  command->add_option("--depth-topic", bag.depth_topic,
+                      "ROS bags: the depth sensor_msgs/Image topic, 16UC1 in mm or 32FC1 in m (default: the only one)");
+  command->add_option("--info-topic", bag.info_topic,
+                      "ROS bags: the depth camera's sensor_msgs/CameraInfo topic (default: the only one, or the one beside the depth topic)");
+  command->add_option("--cloud-topic", bag.cloud_topic,
+                      "ROS bags without depth images: an organized sensor_msgs/PointCloud2 topic (default: the only one)");
+  command->add_option("--world-frame", bag.world_frame, "ROS bags: the TF frame of the world (default: the root of the camera's TF tree)");
+  command->add_option("--camera-frame", bag.camera_frame, "ROS bags: the camera's TF frame (default: the depth images' header.frame_id)");
+}
+
 /// --depth-scale for every command that reads RGB-D sequence folders.
 void add_depth_scale_option(CLI::App* command, std::optional<double>& depth_scale_m) {
   command->add_option("--depth-scale", depth_scale_m,
@@ -67,9 +80,11 @@ int main(int argc, char** argv) {
       "Sequence folders: the 7-Scenes layout (frame-NNNNNN.color.png|.jpg, .depth.png, .pose.txt,\n"
       "camera-intrinsics.txt) or the TUM RGB-D layout (rgb.txt, depth.txt, groundtruth.txt), told apart by\n"
       "their files. Depth in mm (TUM: 1/5000 m) unless depth-scale.txt or --depth-scale says otherwise.\n"
+      "ROS bags (ROS 1 .bag; rosbag2 .db3 or its folder): depth and colour images, CameraInfo and TF, topics\n"
+      "guessed from their types or named by --depth-topic and the other bag flags.\n"
       "A sequence's frames go two at a time: the next frame is read and sent while the daemon processes the\n"
       "one before it; every frame is processed, in order, and the answers are printed in that order.");
-  ingest->add_option("paths", ingest_paths, "cloud files and/or sequence folders")->required();
+  ingest->add_option("paths", ingest_paths, "cloud files, sequence folders and/or ROS bags (BAG, BAG:N, BAG:A-B)")->required();
   ingest->add_flag("--server-side", server_side,
                    "let the daemon read the files itself (absolute paths under its data roots)");
   std::optional<double> live_fps;
@@ -93,15 +108,17 @@ int main(int argc, char** argv) {
   ingest->add_option("--trajectory", ingest_trajectory,
                      "write the poses the memory used (frames not lost) as a TUM trajectory: t tx ty tz qx qy qz qw");
   add_depth_scale_option(ingest, ingest_depth_scale);
+  scenewatch::io::BagOptions ingest_bag;
+  add_bag_options(ingest, ingest_bag);
   add_remote_options(ingest, remote);
   ingest->callback([&] {
     action = [&] {
       if (live_fps) {
         if (server_side) return fail("--live and --server-side do not go together");
         if (!ingest_trajectory.empty()) return fail("--trajectory and --live do not go together (live replies may be skipped)");
-        return run_live_ingest(remote, ingest_paths, *live_fps, ingest_depth_scale);
+        return run_live_ingest(remote, ingest_paths, *live_fps, ingest_depth_scale, ingest_bag);
       }
-      return run_ingest(remote, ingest_paths, server_side, ingest_depth_scale, ingest_trajectory);
+      return run_ingest(remote, ingest_paths, server_side, ingest_depth_scale, ingest_trajectory, ingest_bag);
     };
   });
 
@@ -228,13 +245,14 @@ int main(int argc, char** argv) {
       "Each class's primitive is then fitted and checked against the class's bounds: the object gets the\n"
       "best accepted class (score, grasp points, completed model) or 'unknown' with its best primitive.\n"
       "Example: scenewatch fit ../shared/data/ycb/frame-000003 --depth-scale 0.0001");
-  fit->add_option("file", fit_options.file, "cloud file or sequence frame")->required();
+  fit->add_option("file", fit_options.file, "cloud file, sequence frame or bag frame (BAG:N)")->required();
   fit->add_flag("--json", fit_options.json, "print JSON (each object's shapes, refined cylinder, class, candidates, grasps and timings)");
   fit->add_option("--config", fit_options.config, "YAML config (its segmentation section is used)");
   fit->add_option("--classes", fit_options.classes, "object classes file (default: the shipped ontology.yaml, in /etc/scenewatch when installed)");
   fit->add_option("--out", fit_options.out_dir,
                   "write each object's completed model (its class's primitive, whole surface) to DIR as object-N-CLASS.pcd and .ply");
   add_depth_scale_option(fit, fit_options.depth_scale_m);
+  add_bag_options(fit, fit_options.bag);
   fit->callback([&] { action = [&] { return run_fit(fit_options); }; });
 
   DiffOptions diff_options;
@@ -269,12 +287,13 @@ int main(int argc, char** argv) {
       "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json\n"
       "  scenewatch replay rgbd_dataset_freiburg1_xyz          (a TUM RGB-D folder: rgb.txt, depth.txt, groundtruth.txt)\n"
       "  scenewatch replay ../shared/data/ycb --depth-scale 0.0001   (depth in units of 0.1 mm)\n"
+      "  scenewatch replay kitchen.bag:0-99 --depth-topic /camera/aligned_depth_to_color/image_raw   (a ROS bag)\n"
       "Scenario scripts: `scenewatch replay SCRIPT.yaml [--check] [--port P] [--token-file F]` streams what the\n"
       "script names (a simulator scenario or a sequence folder) through a RUNNING daemon over TCP, prints the\n"
       "events and the foreground objects, and compares them with the script's expectations (README, 'Scenario\n"
       "scripts'); with --check it exits 1 when one is not met.\n"
       "  scenewatch replay tests/scenarios/hand_tilts_cup.yaml --check --port 7501");
-  replay->add_option("inputs", replay_options.inputs, "sequence folders, frame ranges or cloud files")->required();
+  replay->add_option("inputs", replay_options.inputs, "sequence folders, ROS bags, frame ranges or cloud files")->required();
   replay->add_option("--config", replay_options.config, "YAML config, as the daemon's (its pipeline sections are used)");
   replay->add_option("--stride", replay_options.stride, "process every N-th frame of each input")
       ->check(CLI::PositiveNumber)
@@ -283,6 +302,7 @@ int main(int argc, char** argv) {
                      "write each frame's image surprise over its colour image as DIR/surprise-NNNNNN.png");
   replay->add_flag("--json", replay_options.json, "one JSON object per event (with its frame), then a summary object");
   add_depth_scale_option(replay, replay_options.depth_scale_m);
+  add_bag_options(replay, replay_options.bag);
   replay->add_option("--localization", replay_options.localization,
                      "where frames were taken: given (trust their poses), refine (align the given pose to the memory; "
                      "the default), track (no poses needed); overrides localization.mode")

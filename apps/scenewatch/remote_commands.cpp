@@ -196,7 +196,8 @@ std::string camera_name(const std::string& given, const std::vector<std::string>
 }
 
 int run_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, bool server_side,
-               const std::optional<double>& depth_scale_m, const std::string& trajectory_path) {
+               const std::optional<double>& depth_scale_m, const std::string& trajectory_path,
+               const io::BagOptions& bag) {
   const std::string camera = camera_name(options.camera, paths);
   auto client = connect(options);
   if (!client) return fail(client.error().message);
@@ -249,9 +250,10 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
       if (!send(std::move(request), path, nullptr)) return kExitError;
       continue;
     }
-    // A sequence folder, or some of its frames (SEQDIR:N, SEQDIR:A-B, SEQDIR/frame-NNNNNN).
-    const io::SequenceOptions sequence_options = cli::sequence_options(depth_scale_m);
-    auto span = cli::sequence_span(path, sequence_options);
+    // A sequence folder or a bag, or some of its frames (SEQDIR:N, SEQDIR:A-B, SEQDIR/frame-NNNNNN, BAG:A-B).
+    cli::InputOptions inputs(cli::sequence_options(depth_scale_m));
+    inputs.bag = bag;
+    auto span = cli::sequence_span(path, inputs);
     if (!span) {
       fail(naming(path, span.error().message));
       ++failures;
@@ -259,7 +261,7 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
     }
     if (*span) {
       const cli::SequenceSpan& seq = **span;
-      if (auto skipped = io::skipped_summary(seq.sequence, sequence_options); !skipped.empty()) {
+      if (auto skipped = seq.skipped(inputs); !skipped.empty()) {
         std::cerr << "scenewatch: " << seq.folder << ": " << skipped << "\n";
       }
       // Two frames in flight: the next frame is read from disk, sent and decoded by the daemon
@@ -273,9 +275,9 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
         return take(client->wait_for(id, options.timeout_s), source, &bar, stamp_s);
       };
       for (std::size_t i = seq.first; i <= seq.last; ++i) {
-        const std::string source = (fs::path(seq.folder) / seq.sequence.frames[i].name).string();
-        bar.draw(i - seq.first, total, seq.sequence.frames[i].name);
-        auto frame = io::load_sequence_frame(seq.sequence, i);
+        const std::string source = seq.frame_name(i);
+        bar.draw(i - seq.first, total, fs::path(source).filename().string());
+        auto frame = seq.load(i);
         if (!frame) {
           bar.clear();
           fail(naming(source, frame.error().message));
@@ -326,7 +328,7 @@ int run_localization(const RemoteOptions& options) {
 }
 
 int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,
-                    const std::optional<double>& depth_scale_m) {
+                    const std::optional<double>& depth_scale_m, const io::BagOptions& bag) {
   const std::string camera = camera_name(options.camera, paths);
   auto client = connect(options);
   if (!client) return fail(client.error().message);
@@ -355,14 +357,16 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
   };
   const auto start = std::chrono::steady_clock::now();
   for (const std::string& path : paths) {
-    auto span = cli::sequence_span(path, cli::sequence_options(depth_scale_m));
-    if (!span) return fail(naming(path, span.error().message + " (--live takes RGB-D sequence folders)"));
-    if (!*span) return fail(naming(path, "not a sequence folder (--live takes RGB-D sequence folders)"));
+    cli::InputOptions inputs(cli::sequence_options(depth_scale_m));
+    inputs.bag = bag;
+    auto span = cli::sequence_span(path, inputs);
+    if (!span) return fail(naming(path, span.error().message + " (--live takes RGB-D sequence folders and bags)"));
+    if (!*span) return fail(naming(path, "not a sequence folder nor a bag (--live takes RGB-D sequence folders and bags)"));
     const cli::SequenceSpan& seq = **span;
     for (std::size_t i = seq.first; i <= seq.last; ++i) {
-      auto frame = io::load_sequence_frame(seq.sequence, i);
+      auto frame = seq.load(i);
       if (!frame) {
-        fail(naming((fs::path(seq.folder) / seq.sequence.frames[i].name).string(), frame.error().message));
+        fail(naming(seq.frame_name(i), frame.error().message));
         ++failures;
         continue;
       }
@@ -374,7 +378,7 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
       request.mutable_ingest_frame()->set_live(true);
       request.set_token(client->token());
       request.set_id(++sent);
-      sources.push_back((fs::path(seq.folder) / seq.sequence.frames[i].name).string());
+      sources.push_back(seq.frame_name(i));
       if (auto st = client->send(request); !st) return fail(st.error().message);
       while (answered < sent && take_reply(0.001)) {
       }

@@ -137,9 +137,8 @@ int run_replay(const ReplayOptions& options) {
   std::vector<double> frame_ms;
   const auto wall0 = std::chrono::steady_clock::now();
   for (const auto& spec : options.inputs) {
-    const io::SequenceOptions sequence = sequence_options(options.depth_scale_m);
-    auto n = count_frames(spec, sequence);
-    if (!n) return fail(n.error().message);
+    InputOptions sequence(sequence_options(options.depth_scale_m));
+    sequence.bag = options.bag;
     std::size_t index = 0;
     auto st = for_each_frame(spec, std::nullopt, [&](Frame frame) -> Status {
       const std::size_t k = index++;
