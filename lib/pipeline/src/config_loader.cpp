@@ -112,6 +112,7 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
 Status read_pipeline_config(const YAML::Node& root, Config& c) {
   if (auto st = read_sensor(root["sensor"], c.sensor); !st) return st;
   c.change.sensor = c.sensor;  // what reads config.change alone (scenewatch diff) sees the same sensor
+  c.segmentation.sensor = c.sensor;
   {
     YamlSection s(root["background"], "background");
     auto& b = c.background;
@@ -150,7 +151,9 @@ Status read_pipeline_config(const YAML::Node& root, Config& c) {
                            [&] { return s.read("crease_angle_deg", g.crease_angle_deg); },
                            [&] { return s.read("join_occluded", g.join_occluded); },
                            [&] { return s.read("recover_image_grid", g.recover_image_grid); },
-                           [&] { return s.read("bridge_hidden_support", g.bridge_hidden_support); });
+                           [&] { return s.read("bridge_hidden_support", g.bridge_hidden_support); },
+                           [&] { return s.read("split_depth_steps", g.split_depth_steps); },
+                           [&] { return s.read("split_colour_edges", g.split_colour_edges); });
         !st)
       return st;
     if (!up.empty()) {

@@ -555,6 +555,7 @@ Frame placed(const Frame& frame, const localization::Localization& where) {
 // The one sensor model, handed to every stage that weighs evidence.
 Config with_sensor(Config c) {
   c.change.sensor = c.sensor;
+  c.segmentation.sensor = c.sensor;
   return c;
 }
 }  // namespace

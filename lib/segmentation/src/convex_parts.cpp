@@ -12,11 +12,12 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <map>
 #include <set>
 
+#include "apart_sets.h"
+#include "part_shape.h"
 #include "union_find.h"
 #include "voxel_index.h"
 
@@ -77,41 +78,6 @@ Link classify(const Patch& a, const Patch& b, const ConvexityParams& params) {
   return cos_angle >= std::cos(params.crease_angle_deg * M_PI / 180.0) ? Link::kConvex : Link::kConcave;
 }
 
-// The 13 forward offsets of the 26-neighbourhood: each unordered pair of patches once.
-const std::vector<std::array<int, 3>>& forward_offsets() {
-  static const std::vector<std::array<int, 3>> offsets = [] {
-    std::vector<std::array<int, 3>> out;
-    for (int dx = -1; dx <= 1; ++dx)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dz = -1; dz <= 1; ++dz) {
-          if (dx > 0 || (dx == 0 && (dy > 0 || (dy == 0 && dz > 0)))) out.push_back({dx, dy, dz});
-        }
-    return out;
-  }();
-  return offsets;
-}
-
-// Point statistics of a part: its width is the extent across its second principal axis
-// (sqrt(12 var) for points spread evenly over that width).
-struct PartShape {
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d sum_sq = Eigen::Matrix3d::Zero();
-  double count = 0;
-  void add(const Eigen::Vector3d& q) {
-    sum += q;
-    sum_sq += q * q.transpose();
-    count += 1;
-  }
-  double width() const {
-    if (count < 3) return 0.0;
-    const Eigen::Vector3d mean = sum / count;
-    const Eigen::Matrix3d cov = sum_sq / count - mean * mean.transpose();
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es;
-    es.computeDirect(cov, Eigen::EigenvaluesOnly);
-    return std::sqrt(12.0 * std::max(0.0, es.eigenvalues()(1)));
-  }
-};
-
 }  // namespace
 
 std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std::vector<int>& cluster,
@@ -158,7 +124,7 @@ std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std
   // skip any that would join such a pair.
   std::vector<std::pair<std::pair<int, int>, std::pair<int, int>>> ranked(votes.begin(), votes.end());
   std::stable_sort(ranked.begin(), ranked.end(), [](const auto& x, const auto& y) { return x.second.first > y.second.first; });
-  std::map<int, std::set<int>> apart;  // per surface root: roots it must stay apart from
+  ApartSets apart;
   for (const auto& [pair, v] : ranked) {
     if (v.second >= v.first) {
       apart[pair.first].insert(pair.second);
@@ -166,15 +132,7 @@ std::vector<std::vector<int>> split_at_concavities(const Cloud& cloud, const std
     }
   }
   for (const auto& [pair, v] : ranked) {
-    if (v.first <= v.second) continue;
-    const int ra = patch_uf.find(pair.first), rb = patch_uf.find(pair.second);
-    if (ra == rb) continue;
-    bool blocked = false;
-    for (int x : apart[ra]) blocked = blocked || patch_uf.find(x) == rb;
-    if (blocked) continue;
-    patch_uf.unite(ra, rb);
-    const int root = patch_uf.find(ra), other = root == ra ? rb : ra;
-    apart[root].insert(apart[other].begin(), apart[other].end());
+    if (v.first > v.second) unite_unless_apart(patch_uf, apart, pair.first, pair.second);
   }
   // Patches without a normal take the part of their largest neighbour with one.
   std::vector<int> best_neighbour(n, -1);

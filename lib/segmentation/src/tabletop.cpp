@@ -16,8 +16,11 @@
 #include <random>
 
 #include "scenewatch/segmentation/tabletop.h"
+#include "boundary_cut.h"
+#include "colour_edges.h"
 #include "containers.h"
 #include "convex_parts.h"
+#include "depth_steps.h"
 #include "hull2d.h"
 #include "occlusion_join.h"
 #include "support.h"
@@ -247,6 +250,7 @@ Status validate(const Config& c) {
   if (!(c.concavity_tolerance_deg >= 0 && c.concavity_tolerance_deg < 90)) return bad("concavity_tolerance_deg", "must be in [0, 90)");
   if (!(c.crease_angle_deg >= c.concavity_tolerance_deg && c.crease_angle_deg <= 180))
     return bad("crease_angle_deg", "must be in [concavity_tolerance_deg, 180]");
+  if (auto st = validate(c.sensor); !st) return st;
   return {};
 }
 
@@ -457,6 +461,40 @@ std::vector<Piece> euclidean_clusters(const Cloud& cloud, const VoxelIndex& grid
   return clusters;
 }
 
+// Each convex part cut at closed depth steps and colour edges (boundary_cut.h, depth_steps.h,
+// colour_edges.h); their window is the bounding box of all the parts' pixels.
+std::vector<std::vector<int>> cut_parts_at_boundaries(const Cloud& cloud, std::vector<std::vector<int>> parts,
+                                                 const Eigen::Vector3d& sensor_origin, const Config& cfg) {
+  const int width = static_cast<int>(cloud.width);
+  int u0 = width, v0 = static_cast<int>(cloud.height), u1 = -1, v1 = -1;
+  for (const auto& part : parts)
+    for (int i : part) {
+      u0 = std::min(u0, i % width), u1 = std::max(u1, i % width);
+      v0 = std::min(v0, i / width), v1 = std::max(v1, i / width);
+    }
+  if (u1 < u0) return parts;
+  DepthStepParams step_params;
+  step_params.sensor = cfg.sensor;
+  std::optional<DepthSteps> steps;
+  if (cfg.split_depth_steps) steps.emplace(cloud, sensor_origin, step_params, u0, v0, u1, v1);
+  std::optional<ColourEdges> colour;
+  if (cfg.split_colour_edges) colour.emplace(cloud, u0, v0, u1, v1);
+  BoundaryCutParams cut;
+  cut.min_part_size_m = ConvexityParams{}.min_part_size_m;
+  cut.min_points = cfg.min_cluster_points;
+  cut.cluster_tolerance_m = cfg.cluster_tolerance_m;
+  const BoundaryTest is_boundary = [&](int a, int offset) {
+    return steps && steps->is_step(a, offset) ? Boundary::kDepthStep : Boundary::kNone;
+  };
+  EdgePixelTest is_edge;
+  if (colour) is_edge = [&](int i) { return colour->is_edge(i); };
+  std::vector<std::vector<int>> out;
+  for (auto& part : parts) {
+    for (auto& piece : cut_at_boundaries(cloud, part, sensor_origin, is_boundary, is_edge, cut)) out.push_back(std::move(piece));
+  }
+  return out;
+}
+
 }  // namespace
 
 Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3d& sensor_origin) {
@@ -481,6 +519,8 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     std::vector<std::vector<int>> parts;
     if (split) parts = split_at_concavities(cloud, cluster.indices, sensor_origin, convexity_params(cfg));
     else parts.push_back(std::move(cluster.indices));
+    if (split && (cfg.split_depth_steps || cfg.split_colour_edges))
+      parts = cut_parts_at_boundaries(cloud, std::move(parts), sensor_origin, cfg);
     for (auto& indices : parts) {
       const int n = static_cast<int>(indices.size());
       if (n >= cfg.min_cluster_points && n <= cfg.max_cluster_points) pieces.push_back({std::move(indices), cluster.plane});

@@ -4,6 +4,19 @@
 
 namespace scenewatch::segmentation {
 
+const std::vector<std::array<int, 3>>& forward_offsets() {
+  static const std::vector<std::array<int, 3>> offsets = [] {
+    std::vector<std::array<int, 3>> out;
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          if (dx > 0 || (dx == 0 && (dy > 0 || (dy == 0 && dz > 0)))) out.push_back({dx, dy, dz});
+        }
+    return out;
+  }();
+  return offsets;
+}
+
 VoxelIndex::VoxelIndex(const Cloud& cloud, double voxel_size_m) : size(voxel_size_m) {
   lookup.reserve(cloud.size() / 8 + 16);
   // Visited in index order: the visiting order's voxels are the points' voxels.

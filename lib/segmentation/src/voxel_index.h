@@ -48,4 +48,7 @@ struct VoxelIndex {
   tsl::robin_map<std::uint64_t, int, MixHash64> lookup;
 };
 
+/// The 13 forward offsets of the 26-neighbourhood: each unordered pair of neighbouring voxels once.
+const std::vector<std::array<int, 3>>& forward_offsets();
+
 }  // namespace scenewatch::segmentation

@@ -8,6 +8,7 @@
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
+#include "scenewatch/core/sensor_model.h"
 
 namespace scenewatch::segmentation {
 
@@ -64,6 +65,18 @@ struct Config {
   /// changed the segmentation of PCL's stereo mug scene, the simulator's tabletop and the
   /// foreground tracking on simulated carries (tests that pass with it off).
   bool bridge_hidden_support = false;
+  /// The depth camera (the pipeline's `sensor` section): its noise at each range and incidence
+  /// decides what is a depth step (split_depth_steps).
+  SensorModel sensor;
+  /// Organized clouds (and unorganized ones through their recovered image): cut the convex parts
+  /// at closed depth steps, a book lying on a book, a thin box on a box (1-3 cm). A step is a jump
+  /// between two pixels whose sides' surfaces, carried to the boundary, miss each other by more
+  /// than 3 sigma of the sensor's noise there; pixels in the noise band of a hole are no evidence.
+  bool split_depth_steps = false;
+  /// ... and at closed colour edges that run across a part (two boxes of different print pressed
+  /// together): OpenCV's Canny on the colour image, its thresholds at 3 sigma of the image's own
+  /// noise (segmentation/src/colour_edges.h).
+  bool split_colour_edges = false;
 };
 
 /// Validates ranges; the message names the key (e.g. "segmentation.voxel_size_m").
