@@ -250,7 +250,11 @@ Result<proto::Event> Client::next_event(double timeout_s) {
       if (left <= 0) return unavailable("no event from " + endpoint_ + " within " + std::to_string(timeout_s) + " s");
     }
     auto pushed = next_pushed(deadline ? left : 0);
-    if (!pushed) return pushed.error();
+    if (!pushed) {
+      if (deadline && Clock::now() >= *deadline)
+        return unavailable("no event from " + endpoint_ + " within " + std::to_string(timeout_s) + " s");
+      return pushed.error();
+    }
     if (pushed->has_event()) return std::move(*pushed->mutable_event());
   }
 }
