@@ -2,6 +2,19 @@
 
 namespace scenewatch::io::bag {
 
+std::string ChunkedFile::locate(const MessageRef& m) const {
+  if (m.where[0] == 0) return "byte " + std::to_string(m.where[1]);
+  return "the chunk at byte " + std::to_string(chunk_record_at(m.where[0])) + ", byte " + std::to_string(m.where[1]) + " of its " +
+         chunk_contents_;
+}
+
+std::uint32_t ChunkedFile::topic_index(const std::string& name, const std::string& type, WireFormat wire) {
+  std::uint32_t index = 0;
+  while (index < topics_.size() && topics_[index].name != name) ++index;
+  if (index == topics_.size()) topics_.push_back({name, type, wire});
+  return index;
+}
+
 Status ChunkedFile::open_file(const std::string& path) {
   file_.open(path, std::ios::binary);
   if (!file_) return io_error("cannot open the file");

@@ -30,14 +30,7 @@ Result<std::string> str(ByteReader& r, const char* what) {
 
 class McapFile final : public ChunkedFile {
  public:
-  const std::vector<Topic>& topics() const override { return topics_; }
-  const std::vector<MessageRef>& messages() const override { return messages_; }
-
-  std::string locate(const MessageRef& m) const override {
-    if (m.where[0] == 0) return "byte " + std::to_string(m.where[1]);
-    return "the chunk at byte " + std::to_string(chunks_[m.where[0] - 1].record_at) + ", byte " + std::to_string(m.where[1]) +
-           " of its records";
-  }
+  McapFile() : ChunkedFile("records") {}
 
   Status open(const std::string& path) {
     if (auto st = open_file(path); !st) return st;
@@ -74,6 +67,7 @@ class McapFile final : public ChunkedFile {
 
  protected:
   Result<std::vector<std::uint8_t>> chunk_data(std::uint64_t number) override { return load_chunk(chunks_[number - 1], false); }
+  std::uint64_t chunk_record_at(std::uint64_t number) const override { return chunks_[number - 1].record_at; }
 
  private:
   struct Chunk {
@@ -126,12 +120,8 @@ class McapFile final : public ChunkedFile {
       if (it == schema_name_.end()) {
         return fail(invalid_argument("channel " + *topic + " names schema " + std::to_string(*schema) + ", which no schema record before it declares"));
       }
-      std::uint32_t index = 0;
-      while (index < topics_.size() && topics_[index].name != *topic) ++index;
-      if (index == topics_.size()) {
-        topics_.push_back({*topic, normalise_type(it->second), *encoding == "cdr" ? WireFormat::kCdr : WireFormat::kRos1});
-      }
-      channel_topic_[*id] = index;
+      channel_topic_[*id] =
+          topic_index(*topic, normalise_type(it->second), *encoding == "cdr" ? WireFormat::kCdr : WireFormat::kRos1);
       return {};
     }
     Chunk c;
@@ -205,8 +195,6 @@ class McapFile final : public ChunkedFile {
     return {};
   }
 
-  std::vector<Topic> topics_;
-  std::vector<MessageRef> messages_;
   std::vector<Chunk> chunks_;
   std::map<std::uint16_t, std::string> schema_name_;
   std::map<std::uint16_t, std::uint32_t> channel_topic_;

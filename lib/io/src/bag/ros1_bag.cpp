@@ -54,14 +54,7 @@ Result<std::string> text_field(const Fields& f, const std::string& name, std::ui
 
 class Ros1Bag final : public ChunkedFile {
  public:
-  const std::vector<Topic>& topics() const override { return topics_; }
-  const std::vector<MessageRef>& messages() const override { return messages_; }
-
-  std::string locate(const MessageRef& m) const override {
-    if (m.where[0] == 0) return "byte " + std::to_string(m.where[1]);
-    return "the chunk at byte " + std::to_string(chunks_[m.where[0] - 1].record_at) + ", byte " + std::to_string(m.where[1]) +
-           " of its data";
-  }
+  Ros1Bag() : ChunkedFile("data") {}
 
   Status open(const std::string& path) {
     if (auto st = open_file(path); !st) return st;
@@ -86,6 +79,7 @@ class Ros1Bag final : public ChunkedFile {
 
  protected:
   Result<std::vector<std::uint8_t>> chunk_data(std::uint64_t number) override { return load_chunk(chunks_[number - 1]); }
+  std::uint64_t chunk_record_at(std::uint64_t number) const override { return chunks_[number - 1].record_at; }
 
  private:
   struct Chunk {
@@ -198,10 +192,7 @@ class Ros1Bag final : public ChunkedFile {
     if (!info) return info.error();
     auto type = text_field(*info, "type", record_at);
     if (!type) return type.error();
-    std::uint32_t index = 0;
-    while (index < topics_.size() && topics_[index].name != *topic) ++index;
-    if (index == topics_.size()) topics_.push_back({*topic, normalise_type(*type), WireFormat::kRos1});
-    connection_topic_[*id] = index;
+    connection_topic_[*id] = topic_index(*topic, normalise_type(*type), WireFormat::kRos1);
     return {};
   }
 
@@ -226,8 +217,6 @@ class Ros1Bag final : public ChunkedFile {
     return {};
   }
 
-  std::vector<Topic> topics_;
-  std::vector<MessageRef> messages_;
   std::vector<Chunk> chunks_;
   std::map<std::uint32_t, std::uint32_t> connection_topic_;
 };
