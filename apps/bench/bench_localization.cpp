@@ -3,6 +3,8 @@
 // frame-to-frame alignment side by side with OpenCV's RgbdICPOdometry and PCL's GICP on the same
 // pairs, on accuracy and time.
 #include <cstdio>
+#include <filesystem>
+#include <functional>
 #include <optional>
 #include <random>
 
@@ -17,6 +19,8 @@
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/localization/localizer.h"
+#include "scenewatch/sim/scenario_yaml.h"
+#include "scenewatch/sim/simulator.h"
 
 namespace scenewatch::bench {
 namespace {
@@ -55,13 +59,15 @@ struct Trajectory {
 // Runs the localizer over the recording as the pipeline does: each placed frame may become a
 // keyframe of the memory (AppearanceMemory's default spacing) at the pose it was placed at; a lost
 // camera is relocalized against the keyframes.
-Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& given, LocalizationMode mode,
+using FrameLoader = std::function<Result<Frame>(std::size_t)>;
+
+Trajectory run(const FrameLoader& load, const std::vector<std::optional<Pose>>& given, LocalizationMode mode,
                localization::Config lc = {}) {
   background::AppearanceMemory memory;
   localization::Localizer localizer(lc);
   Trajectory out;
-  for (std::size_t i = 0; i < seq.frames.size(); ++i) {
-    auto frame = io::load_sequence_frame(seq, i);
+  for (std::size_t i = 0; i < given.size(); ++i) {
+    auto frame = load(i);
     if (!frame) {
       std::fprintf(stderr, "  %s\n", frame.error().message.c_str());
       out.used.push_back(Pose::Identity());
@@ -98,6 +104,72 @@ double relative_rmse(const std::vector<Pose>& estimate, const std::vector<Pose>&
     sum += (e.translation() - g.translation()).squaredNorm();
   }
   return std::sqrt(sum / truth.size());
+}
+
+Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& given, LocalizationMode mode,
+               localization::Config lc = {}) {
+  return run([&](std::size_t i) { return io::load_sequence_frame(seq, i); }, given, mode, std::move(lc));
+}
+
+// The given poses with noise independent per frame (translation N(0, s_t^2 / 3) per axis, so its
+// RMS is s_t; rotation likewise), as a motion-capture marker's jitter or a pose estimate's scatter.
+std::vector<Pose> with_noise(const std::vector<Pose>& truth, double sigma_m, double sigma_deg, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> t(0.0, sigma_m / std::sqrt(3.0)), r(0.0, sigma_deg * M_PI / 180.0 / std::sqrt(3.0));
+  std::vector<Pose> out;
+  for (const Pose& p : truth) {
+    Eigen::Matrix<double, 6, 1> xi;
+    xi << t(rng), t(rng), t(rng), r(rng), r(rng), r(rng);
+    out.push_back(Pose(p * localization::twist_exp(xi)));
+  }
+  return out;
+}
+
+// The simulator, whose truth is exact (unlike a reconstruction's poses): the `clutter` table seen
+// by a camera moving on half a circle, 90 frames at 640x480.
+int run_simulated() {
+  auto loaded = sim::load_scenario(std::filesystem::path(SCENEWATCH_SOURCE_DIR) / "sample_clouds/scenarios/clutter.yaml");
+  if (!loaded) return std::fprintf(stderr, "localization: %s\n", loaded.error().message.c_str()), 1;
+  const sim::Scenario scenario = sim::with_frames(sim::with_resolution(*loaded, 640, 480), 90);
+  auto simulator = sim::Simulator::create(scenario);
+  if (!simulator) return std::fprintf(stderr, "localization: %s\n", simulator.error().message.c_str()), 1;
+  std::vector<Frame> frames;
+  std::vector<Pose> truth;
+  for (int f = 0; f < simulator->frame_count(0); ++f) {
+    const sim::SimFrame rendered = simulator->render(0, f);
+    auto frame = sim::as_frame(rendered, scenario.intrinsics, f / 30.0);
+    if (!frame) return std::fprintf(stderr, "localization: %s\n", frame.error().message.c_str()), 1;
+    frames.push_back(std::move(*frame));
+    truth.push_back(rendered.truth.T_world_camera);
+  }
+  const FrameLoader load = [&](std::size_t i) -> Result<Frame> { return frames[i]; };
+  const auto score = [&](const char* what, const std::vector<Pose>& given, std::optional<localization::Config> lc) {
+    Errors e;
+    Trajectory t{given, 0, {0.0}};
+    if (lc) t = run(load, std::vector<std::optional<Pose>>(given.begin(), given.end()), LocalizationMode::kRefine, *lc);
+    for (std::size_t i = 0; i < truth.size(); ++i) add_error(e, t.used[i], truth[i]);
+    print_errors(what, e, t);
+  };
+  std::printf("\nlocalization: the simulator's clutter table, %zu frames at 640x480 on half a circle, errors against the exact truth\n",
+              truth.size());
+  score("refine, exact poses given (its correction)", truth, localization::Config{});
+  localization::Config told_noise;
+  told_noise.noise_m = 0.005;
+  told_noise.noise_deg = 0.25;
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const auto noisy = with_noise(truth, 0.005, 0.25, seed);
+    const std::string label = "noise 5 mm + 0.25 deg per frame, seed " + std::to_string(seed);
+    score(("given: " + label).c_str(), noisy, std::nullopt);
+    score(("refine, default: " + label).c_str(), noisy, localization::Config{});
+    score(("refine, noise configured: " + label).c_str(), noisy, told_noise);
+  }
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const auto drifted = with_drift(truth, 0.001, 0.05, seed);
+    const std::string label = "drift 1 mm + 0.05 deg/frame, seed " + std::to_string(seed);
+    score(("given: " + label).c_str(), drifted, std::nullopt);
+    score(("refine, default: " + label).c_str(), drifted, localization::Config{});
+  }
+  return 0;
 }
 
 int run_trajectories(const io::Sequence& seq, const std::vector<Pose>& truth) {
@@ -295,14 +367,15 @@ int run_relocalization(const io::Sequence& seq, const std::vector<Pose>& truth) 
 }  // namespace
 
 int run_localization(const Options& o) {
+  int rc = run_simulated();
   auto seq = io::open_sequence(o.data_dir / "redkitchen_long");
   if (!seq) {
     std::printf("\nlocalization: skipped (%s)\n", seq.error().message.c_str());
-    return 0;
+    return rc;
   }
   std::vector<Pose> truth;
   for (const auto& f : seq->frames) truth.push_back(f.T_world_camera.value_or(Pose::Identity()));
-  int rc = run_pairs(*seq, truth);
+  rc |= run_pairs(*seq, truth);
   rc |= run_relocalization(*seq, truth);
   rc |= run_trajectories(*seq, truth);
   return rc;

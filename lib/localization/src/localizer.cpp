@@ -12,6 +12,10 @@ namespace {
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
 constexpr std::size_t kCachedReferences = 16;
+constexpr std::size_t kRememberedPlacements = 64;
+constexpr std::size_t kRememberedKeyframes = 4096;
+
+bool same_pose(const Pose& a, const Pose& b) { return (a.matrix() - b.matrix()).cwiseAbs().maxCoeff() < 1e-9; }
 
 bool organized_with_intrinsics(const Frame& f) {
   return f.cloud && f.intrinsics && f.intrinsics->valid() && f.cloud->height > 1 &&
@@ -47,6 +51,8 @@ Status validate(const Config& c) {
     return invalid_argument("localization.max_correction_m / max_correction_deg: must be > 0 (degrees at most 180)");
   if (!(c.drift_m_per_frame >= 0 && c.drift_m_per_frame <= 1) || !(c.drift_deg_per_frame >= 0 && c.drift_deg_per_frame <= 90))
     return invalid_argument("localization.drift_m_per_frame / drift_deg_per_frame: must be in [0, 1] m and [0, 90] degrees");
+  if (!(c.noise_m >= 0 && c.noise_m <= 1) || !(c.noise_deg >= 0 && c.noise_deg <= 90))
+    return invalid_argument("localization.noise_m / noise_deg: must be in [0, 1] m and [0, 90] degrees");
   if (c.reference_keyframes < 1 || c.reference_keyframes > 8)
     return invalid_argument("localization.reference_keyframes: must be in [1, 8]");
   if (c.rehome_after_lost_frames < 1 || c.rehome_after_lost_frames > 1000)
@@ -194,6 +200,12 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
                                : (track.started ? Pose(track.last * track.motion) : Pose::Identity());
   out.T_world_camera = prior;
   out.T_world_odom = track.T_world_odom;
+  // In `refine` mode: where the running correction puts this frame (the given pose's own noise
+  // left out), and how uncertain the frame's placement is; the prior's until an alignment says more.
+  std::optional<Pose> odom_pose;
+  const double noise_rad = config_.noise_deg * M_PI / 180.0;
+  double placed_var_m2 = track.var_m2 + config_.noise_m * config_.noise_m;
+  double placed_var_rad2 = track.var_rad2 + noise_rad * noise_rad;
   auto finish = [&](Localization r) {
     r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (r.placed()) {
@@ -205,7 +217,8 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
       track.lost_in_row = 0;
       if (use_given) {
         const Pose before = track.T_world_odom;
-        track.T_world_odom = r.T_world_camera * frame.T_world_camera->inverse();
+        track.T_world_odom = odom_pose.value_or(r.T_world_camera) * frame.T_world_camera->inverse();
+        if (r.mode == LocalizationMode::kRefine) remember_placement(r.T_world_camera, placed_var_m2, placed_var_rad2);
         const auto moved = background::view_distance(before, track.T_world_odom);
         r.odom_change_m = moved.translation_m;
         r.odom_change_deg = moved.rotation_deg;
@@ -244,6 +257,8 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
         // The relocalized pose starts the camera's correction anew: its error is the alignment's.
         track.var_m2 = r.residual_m * r.residual_m;
         track.var_rad2 = track.var_m2;
+        placed_var_m2 = track.var_m2;
+        placed_var_rad2 = track.var_rad2;
         const auto from_given = background::view_distance(r.T_world_camera, *frame.T_world_camera);
         r.correction_m = from_given.translation_m;
         r.correction_deg = from_given.rotation_deg;
@@ -292,7 +307,15 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
     return finish(best);
   }
   if (use_given) {
-    best.T_world_camera = fuse_with_prior(track, prior, best.T_world_camera, *aligned, best.alignment_rejected);
+    const auto* keyframe = &*candidates.front();
+    for (const auto& k : candidates)
+      if (k->id == best.reference_keyframe) keyframe = &*k;
+    const Fused f = fuse_with_prior(track, prior, best.T_world_camera, *aligned, *keyframe);
+    best.T_world_camera = f.pose;
+    best.alignment_rejected = f.rejected;
+    odom_pose = f.odom_pose;
+    placed_var_m2 = f.var_m2;
+    placed_var_rad2 = f.var_rad2;
     const auto from_given = background::view_distance(best.T_world_camera, *frame.T_world_camera);
     best.correction_m = from_given.translation_m;
     best.correction_deg = from_given.rotation_deg;
@@ -302,36 +325,74 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
       best.reason = "the alignment moved the given pose too far (" + std::to_string(moved.translation_m) + " m, " +
                     std::to_string(moved.rotation_deg) + " deg)";
       best.T_world_camera = prior;
+      odom_pose.reset();
     }
   }
   return finish(best);
 }
 
-// Refine mode: the camera's placement relative to the memory is a random walk (the pose source's
-// drift per frame) measured by each alignment, whose error is taken as its residual (a point's
+// Refine mode. The given pose G is the true one moved by the pose source's drift D (a random walk:
+// drift_m_per_frame, drift_deg_per_frame) and by its own noise W (independent per frame:
+// noise_m, noise_deg); the running correction T_world_odom estimates D^-1. The alignment places
+// the frame against a keyframe; its error is the alignment's (taken as its residual, a point's
 // noise: the covariance of the least-squares fit is far smaller than its real error, which
-// correlated noise, depth distortion and the keyframe's own error make). Translation and rotation
-// are filtered apart, each with a scalar Kalman gain; a measurement more than three sigmas from
-// the prediction is not believed.
-Pose Localizer::fuse_with_prior(Track& track, const Pose& prior, const Pose& measured, const Alignment& a, bool& rejected) const {
-  const double drift_rad = config_.drift_deg_per_frame * M_PI / 180.0;
+// correlated noise and depth distortion make) plus the keyframe's own placement error, so that
+// a chain of keyframes placed by alignments is not taken for ground truth. The frame is placed by
+// weighing the two (prior: drift and noise; measurement: alignment and keyframe); the correction
+// takes only the drift's share of the difference, so one frame's noise does not move the next
+// frames' prior. Translation and rotation are filtered apart, each with scalar gains; a
+// measurement more than three sigmas from the prior is not believed.
+Localizer::Fused Localizer::fuse_with_prior(Track& track, const Pose& prior, const Pose& measured, const Alignment& a,
+                                            const background::Keyframe& keyframe) {
+  const double drift_rad = config_.drift_deg_per_frame * M_PI / 180.0, noise_rad = config_.noise_deg * M_PI / 180.0;
   track.var_m2 += config_.drift_m_per_frame * config_.drift_m_per_frame;
   track.var_rad2 += drift_rad * drift_rad;
-  const double r_m2 = a.residual_m * a.residual_m;
+  const auto [keyframe_m2, keyframe_rad2] = keyframe_variance(keyframe);
   const double depth = a.mean_depth_m > 0 ? a.mean_depth_m : 1.0;
-  const double r_rad2 = r_m2 / (depth * depth);
+  const double prior_m2 = track.var_m2 + config_.noise_m * config_.noise_m, prior_rad2 = track.var_rad2 + noise_rad * noise_rad;
+  const double meas_m2 = a.residual_m * a.residual_m + keyframe_m2;
+  const double meas_rad2 = a.residual_m * a.residual_m / (depth * depth) + keyframe_rad2;
+  const double sum_m2 = prior_m2 + meas_m2, sum_rad2 = prior_rad2 + meas_rad2;
   const Eigen::Vector3d dt = measured.translation() - prior.translation();
   const Eigen::Quaterniond qp(prior.linear()), qm(measured.linear());
   const double dr = qp.angularDistance(qm);
-  rejected = dt.norm() > 3.0 * std::sqrt(track.var_m2 + r_m2) || dr > 3.0 * std::sqrt(track.var_rad2 + r_rad2);
-  if (rejected) return prior;
-  const double k_t = track.var_m2 / (track.var_m2 + r_m2), k_r = track.var_rad2 / (track.var_rad2 + r_rad2);
-  track.var_m2 *= 1.0 - k_t;
-  track.var_rad2 *= 1.0 - k_r;
-  Pose fused = Pose::Identity();
-  fused.linear() = qp.slerp(k_r, qm).normalized().toRotationMatrix();
-  fused.translation() = prior.translation() + k_t * dt;
-  return fused;
+  Fused f;
+  f.pose = f.odom_pose = prior;
+  f.var_m2 = prior_m2;
+  f.var_rad2 = prior_rad2;
+  f.rejected = dt.norm() > 3.0 * std::sqrt(sum_m2) || dr > 3.0 * std::sqrt(sum_rad2);
+  if (f.rejected) return f;
+  const auto moved = [&](double k_t, double k_r) {
+    Pose p = Pose::Identity();
+    p.linear() = qp.slerp(k_r, qm).normalized().toRotationMatrix();
+    p.translation() = prior.translation() + k_t * dt;
+    return p;
+  };
+  f.pose = moved(prior_m2 / sum_m2, prior_rad2 / sum_rad2);
+  f.odom_pose = moved(track.var_m2 / sum_m2, track.var_rad2 / sum_rad2);
+  f.var_m2 = prior_m2 * meas_m2 / sum_m2;
+  f.var_rad2 = prior_rad2 * meas_rad2 / sum_rad2;
+  track.var_m2 -= track.var_m2 * track.var_m2 / sum_m2;
+  track.var_rad2 -= track.var_rad2 * track.var_rad2 / sum_rad2;
+  return f;
+}
+
+std::pair<double, double> Localizer::keyframe_variance(const background::Keyframe& keyframe) {
+  if (auto it = keyframe_variances_.find(keyframe.id); it != keyframe_variances_.end()) return it->second;
+  std::pair<double, double> v{0.0, 0.0};
+  for (auto it = placements_.rbegin(); it != placements_.rend(); ++it)
+    if (same_pose(it->pose, keyframe.T_world_camera)) {
+      v = {it->var_m2, it->var_rad2};
+      break;
+    }
+  if (keyframe_variances_.size() >= kRememberedKeyframes) keyframe_variances_.erase(keyframe_variances_.begin());
+  keyframe_variances_[keyframe.id] = v;
+  return v;
+}
+
+void Localizer::remember_placement(const Pose& pose, double var_m2, double var_rad2) {
+  placements_.push_back({pose, var_m2, var_rad2});
+  if (placements_.size() > kRememberedPlacements) placements_.pop_front();
 }
 
 std::optional<Localization> Localizer::last(std::uint32_t camera) const {
@@ -345,6 +406,8 @@ void Localizer::forget_camera(std::uint32_t camera) { tracks_.erase(camera); }
 void Localizer::reset() {
   tracks_.clear();
   references_.clear();
+  placements_.clear();
+  keyframe_variances_.clear();
   relocalizer_.reset();
 }
 

@@ -93,6 +93,8 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
                          [&] { return s.read("reference_keyframes", l.reference_keyframes); },
                          [&] { return s.read("drift_m_per_frame", l.drift_m_per_frame); },
                          [&] { return s.read("drift_deg_per_frame", l.drift_deg_per_frame); },
+                         [&] { return s.read("noise_m", l.noise_m); },
+                         [&] { return s.read("noise_deg", l.noise_deg); },
                          [&] { return s.read("rehome_after_lost_frames", l.rehome_after_lost_frames); },
                          [&] { return s.read("max_features", l.relocalization.features.max_features); },
                          [&] { return s.read("candidate_keyframes", l.relocalization.candidate_keyframes); },

@@ -5,6 +5,7 @@
 /// and drift undone), in `track` mode (or a frame without a pose) the last pose moved on by the
 /// camera's last motion. A poor alignment leaves the camera `lost`: its frame must change nothing.
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <map>
 #include <memory>
@@ -49,6 +50,12 @@ struct Config {
   /// three sigmas is not believed (the prior is used).
   double drift_m_per_frame = 0.001;
   double drift_deg_per_frame = 0.05;
+  /// In `refine` mode, the given poses' own noise, 1 sigma, independent from frame to frame (a
+  /// motion-capture marker's jitter, an arm's encoder noise, a pose estimate's scatter): it weighs
+  /// each given pose against its alignment but, unlike the drift, is not carried into the
+  /// running correction of the next frames. 0: the given poses carry drift only.
+  double noise_m = 0.0;
+  double noise_deg = 0.0;
   /// Relocalization from keyframe features (homing): a camera's first frames when the memory
   /// already has keyframes (a loaded model), every lost frame in `track` mode, and in `refine`
   /// mode after this many lost frames in a row (the pose source jumped for good).
@@ -134,7 +141,20 @@ class Localizer {
  private:
   struct Track;
   std::shared_ptr<const RgbdPyramid> reference(const background::Keyframe& keyframe);
-  Pose fuse_with_prior(Track& track, const Pose& prior, const Pose& measured, const Alignment& alignment, bool& rejected) const;
+  /// A refine-mode alignment weighed against the given pose (localizer.cpp says how).
+  struct Fused {
+    Pose pose = Pose::Identity();       ///< where the frame is placed
+    Pose odom_pose = Pose::Identity();  ///< where the updated running correction puts it
+    double var_m2 = 0, var_rad2 = 0;    ///< the placement's variance
+    bool rejected = false;
+  };
+  Fused fuse_with_prior(Track& track, const Pose& prior, const Pose& measured, const Alignment& alignment,
+                        const background::Keyframe& keyframe);
+  /// How uncertain a keyframe's pose is (m^2, rad^2): the placement variance of the frame it was
+  /// made from, when this localizer placed that frame in `refine` mode; 0 otherwise (a keyframe
+  /// at a given or loaded pose defines the memory's frame).
+  std::pair<double, double> keyframe_variance(const background::Keyframe& keyframe);
+  void remember_placement(const Pose& pose, double var_m2, double var_rad2);
   bool must_relocalize(const Track& track, LocalizationMode mode) const;
   /// Fills r's quality from an alignment with a keyframe; true when it passes the checks.
   bool accept(Localization& r, const Alignment& a, const background::Keyframe& keyframe) const;
@@ -146,6 +166,13 @@ class Localizer {
   /// Pyramids of recently used keyframes by id, with the use counter of each.
   std::map<std::uint64_t, std::pair<std::shared_ptr<const RgbdPyramid>, std::uint64_t>> references_;
   std::uint64_t uses_ = 0;
+  /// The last placements in `refine` mode with their variances, to find a new keyframe's.
+  struct Placement {
+    Pose pose;
+    double var_m2 = 0, var_rad2 = 0;
+  };
+  std::deque<Placement> placements_;
+  std::map<std::uint64_t, std::pair<double, double>> keyframe_variances_;
 };
 
 }  // namespace scenewatch::localization
