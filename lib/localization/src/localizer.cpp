@@ -2,6 +2,7 @@
 #include "scenewatch/localization/localizer.h"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Geometry>
@@ -266,7 +267,14 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
       return finish(r);
     }
   }
-  const auto candidates = keyframes ? keyframes(prior, config_.reference_keyframes) : decltype(keyframes(prior, 1)){};
+  auto candidates = keyframes ? keyframes(prior, config_.reference_keyframes) : decltype(keyframes(prior, 1)){};
+  if (use_given) {
+    // Of the keyframes near the prior, the one placed most surely is tried first: an older one,
+    // placed before the chain of refined keyframes grew, anchors the frame better than the newest.
+    std::stable_sort(candidates.begin(), candidates.end(), [&](const auto& a, const auto& b) {
+      return keyframe_variance(*a).first < keyframe_variance(*b).first;
+    });
+  }
   if (candidates.empty()) {
     out.state = State::kStarting;
     out.reason = "no keyframe near the prior to align with";
