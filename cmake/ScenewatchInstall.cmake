@@ -19,6 +19,10 @@ get_property(scenewatch_modules GLOBAL PROPERTY SCENEWATCH_MODULES)
 
 # --- runtime ---------------------------------------------------------------------------------
 install(TARGETS scenewatchd scenewatch scenewatch-sim RUNTIME DESTINATION bin COMPONENT runtime)
+# The ROS 2 bridge, when Cyclone DDS was found (apps/scenewatch-ros).
+if(TARGET scenewatch-ros)
+  install(TARGETS scenewatch-ros RUNTIME DESTINATION bin COMPONENT runtime)
+endif()
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/sample_clouds/scenarios/ DESTINATION share/scenewatch/scenarios
         COMPONENT runtime)
 # The wire protocol, for clients in other languages (docs/protocol.md: its compatibility rules).

@@ -21,6 +21,7 @@
 #include "scenewatch/sim/simulator.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/service/frame_parser.h"
+#include "shipped_scenario.h"
 
 namespace scenewatch::test {
 namespace {
@@ -340,11 +341,10 @@ TEST_F(DaemonTest, SimulatedChangesReachTheSubscriberOnceEach) {
   };
   for (const Case& c : {Case{"cup_added", proto::Event::OBJECT_ADDED}, Case{"object_moved", proto::Event::OBJECT_MOVED}}) {
     SCOPED_TRACE(c.scenario);
-    auto loaded = sim::load_scenario(source_dir() / "sample_clouds/scenarios" / (std::string(c.scenario) + ".yaml"));
-    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
-    const sim::Scenario scenario = sim::with_frames(sim::with_resolution(*loaded, 320, 240), 12);
-    auto simulator = sim::Simulator::create(scenario);
-    ASSERT_TRUE(simulator.ok()) << simulator.error().message;
+    ShippedScenario shipped = shipped_scenario(c.scenario, 320, 240, 12);
+    ASSERT_TRUE(shipped.simulator);
+    const sim::Scenario& scenario = shipped.scenario;
+    auto& simulator = shipped.simulator;
     const auto truth = simulator->changes();
     ASSERT_EQ(truth.size(), 1u);
     const Eigen::Vector2d where = c.kind == proto::Event::OBJECT_ADDED

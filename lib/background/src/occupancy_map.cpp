@@ -12,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <sstream>
 #include <system_error>
 
 #include "bulk_update.h"
@@ -423,6 +424,15 @@ Status OccupancyMap::load(const fs::path& path) {
 
 double OccupancyMap::resolution() const { return impl_->tree.getResolution(); }
 std::size_t OccupancyMap::num_leaf_nodes() const { return impl_->tree.getNumLeafNodes(); }
+
+std::string OccupancyMap::binary_data() const {
+  // ColorOcTree and OcTree share the binary format (two bits per child), so an OcTree reads it.
+  std::ostringstream out(std::ios::binary);
+  impl_->tree.writeBinaryData(out);
+  return std::move(out).str();
+}
+
+std::size_t OccupancyMap::num_nodes() const { return impl_->tree.size(); }
 std::size_t OccupancyMap::memory_bytes() const { return impl_->tree.memoryUsage(); }
 
 std::size_t OccupancyMap::num_occupied_leaves() const {

@@ -7,12 +7,14 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 
 #include <yaml-cpp/yaml.h>
 
 #include "bag/container.h"
-#include "bag/image_conversion.h"
-#include "bag/tf_tree.h"
+#include "bag/ros_messages.h"
+#include "scenewatch/io/bag/image_conversion.h"
+#include "scenewatch/io/bag/tf_tree.h"
 #include "bag/topic_choice.h"
 #include "scenewatch/io/rgbd.h"
 
@@ -143,16 +145,8 @@ Result<Intrinsics> read_intrinsics(Container& c, int topic) {
     if (!bytes) return at(c, i, 0, bytes.error());
     auto info = bag::decode_camera_info(*bytes, c.topics()[static_cast<std::size_t>(topic)].format);
     if (!info) return at(c, i, 0, info.error());
-    Intrinsics K;
-    K.fx = info->K[0];
-    K.fy = info->K[4];
-    K.cx = info->K[2];
-    K.cy = info->K[5];
-    K.width = static_cast<int>(info->width);
-    K.height = static_cast<int>(info->height);
-    if (!(K.fx > 0 && K.fy > 0 && std::isfinite(K.fx) && std::isfinite(K.fy) && std::isfinite(K.cx) && std::isfinite(K.cy))) {
-      return at(c, i, 0, invalid_argument("K has no positive, finite focal lengths (fx " + std::to_string(K.fx) + ", fy " + std::to_string(K.fy) + ")"));
-    }
+    auto K = bag::to_intrinsics(*info);
+    if (!K) return at(c, i, 0, K.error());
     return K;
   }
   return not_found("topic " + c.topics()[static_cast<std::size_t>(topic)].name + " has no message");
@@ -303,41 +297,23 @@ Result<Frame> load_bag_frame(Recording& rec, std::size_t index) {
   }
   auto msg = bag::decode_image(*depth_bytes, c.topics()[dm.topic].format);
   if (!msg) return fail(f.depth_message, msg.error());
-  auto depth = bag::to_depth(*msg);
-  if (!depth) return fail(f.depth_message, depth.error());
-  ColorImage color;
+  std::vector<std::uint8_t> color_bytes;  // the colour message points into it
+  std::optional<bag::ImageMessage> color;
   if (f.color_message) {
     const MessageRef& cm = c.messages()[*f.color_message];
     auto bytes = c.read(cm);
     if (!bytes) return fail(*f.color_message, bytes.error());
-    auto cmsg = bag::decode_image(*bytes, c.topics()[cm.topic].format);
+    color_bytes = std::move(*bytes);
+    auto cmsg = bag::decode_image(color_bytes, c.topics()[cm.topic].format);
     if (!cmsg) return fail(*f.color_message, cmsg.error());
-    auto decoded = bag::to_color(*cmsg);
-    if (!decoded) return fail(*f.color_message, decoded.error());
-    if (decoded->width != depth->width || decoded->height != depth->height) {
-      return fail(*f.color_message, invalid_argument("the colour image is " + std::to_string(decoded->width) + "x" +
-                                                     std::to_string(decoded->height) + ", the depth image " + std::to_string(depth->width) +
-                                                     "x" + std::to_string(depth->height) + " (use a depth topic registered to colour)"));
-    }
-    color = std::move(*decoded);
-  } else {
-    color.width = depth->width;
-    color.height = depth->height;
-    color.rgb.assign(std::size_t(color.width) * color.height * 3, 128);
-    frame.has_color = false;
+    color = std::move(*cmsg);
   }
-  Intrinsics K = *rec.intrinsics;
-  if ((K.width != 0 && K.width != depth->width) || (K.height != 0 && K.height != depth->height)) {
-    return fail(f.depth_message, invalid_argument("the depth image is " + std::to_string(depth->width) + "x" + std::to_string(depth->height) +
-                                                  ", the camera info on " + rec.info_topic + " is for " + std::to_string(K.width) + "x" +
-                                                  std::to_string(K.height)));
-  }
-  K.width = depth->width;
-  K.height = depth->height;
-  auto cloud = rgbd_to_cloud(color, *depth, K, kDepthMillimetres);
-  if (!cloud) return fail(f.depth_message, cloud.error());
-  frame.cloud = *cloud;
-  frame.intrinsics = K;
+  bool color_at_fault = false;
+  auto rgbd = bag::to_rgbd_cloud(*msg, color ? &*color : nullptr, *rec.intrinsics, rec.info_topic, &color_at_fault);
+  if (!rgbd) return fail(color_at_fault ? *f.color_message : f.depth_message, rgbd.error());
+  frame.cloud = rgbd->cloud;
+  frame.intrinsics = rgbd->intrinsics;
+  frame.has_color = rgbd->has_color;
   return frame;
 }
 

@@ -703,6 +703,16 @@ OccupiedVoxels WorkingMemory::occupied_voxels(std::size_t max_count) const {
   return out;
 }
 
+BinaryMap WorkingMemory::binary_map() const {
+  BinaryMap out;
+  std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
+  out.data = impl_->map.binary_data();
+  out.resolution_m = impl_->map.resolution();
+  out.nodes = impl_->map.num_nodes();
+  out.leaf_nodes = impl_->map.num_leaf_nodes();
+  return out;
+}
+
 background::BoxOccupancy WorkingMemory::query_box(const Aabb& box) const {
   std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
   return impl_->map.query_box(box);

@@ -47,6 +47,7 @@ Route route_of(proto::Request::CallCase call) {
     case proto::Request::kGetLocalization:
     case proto::Request::kGetSurpriseMap:
     case proto::Request::kNextBestView:
+    case proto::Request::kGetMap:
       return Route::kQuery;
     case proto::Request::kIngestFrame:
     case proto::Request::kIngestFile:
@@ -223,6 +224,7 @@ struct RequestHandler::Impl {
       case proto::Request::kDefineClass: return define_class(request.define_class(), response);
       case proto::Request::kListClasses: return list_classes(response);
       case proto::Request::kGetLocalization: return get_localization(request.get_localization(), response);
+      case proto::Request::kGetMap: return get_map(response);
       case proto::Request::kNextBestView:
         return service::next_best_view(memory, request.next_best_view(), response.mutable_next_best_view());
       case proto::Request::CALL_NOT_SET: break;
@@ -432,6 +434,18 @@ struct RequestHandler::Impl {
     out->set_frames_processed(snapshot->frames_processed);
     out->set_last_stamp_s(snapshot->last_stamp_s);
     for (const auto& plane : snapshot->planes) convert::to_proto(plane, out->add_planes());
+    return {};
+  }
+
+  Status get_map(proto::Response& response) {
+    const std::uint64_t frames = memory.snapshot()->frames_processed;
+    pipeline::BinaryMap map = memory.binary_map();
+    auto* out = response.mutable_map();
+    out->set_resolution_m(map.resolution_m);
+    out->set_binary_data(std::move(map.data));
+    out->set_nodes(map.nodes);
+    out->set_leaf_nodes(map.leaf_nodes);
+    out->set_frames_processed(frames);
     return {};
   }
 

@@ -8,17 +8,12 @@
 #include <string>
 
 #include "byte_reader.h"
+#include "scenewatch/io/bag/messages.h"
 
 namespace scenewatch::io::bag {
 
 /// How a bag's messages are serialized.
 enum class WireFormat { kRos1, kCdr };
-
-/// std_msgs/Header as both formats carry it (ROS 1's seq is read and dropped).
-struct MessageHeader {
-  double stamp_s = 0.0;
-  std::string frame_id;
-};
 
 class FieldReader {
  public:

@@ -1,9 +1,11 @@
-#include "image_conversion.h"
+#include "scenewatch/io/bag/image_conversion.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+
+#include "scenewatch/io/rgbd.h"
 
 namespace scenewatch::io::bag {
 namespace {
@@ -149,6 +151,58 @@ Result<CloudPtr> to_cloud(const PointCloud2Message& m) {
     }
   }
   return cloud;
+}
+
+Result<Intrinsics> to_intrinsics(const CameraInfoMessage& m) {
+  Intrinsics K;
+  K.fx = m.K[0];
+  K.fy = m.K[4];
+  K.cx = m.K[2];
+  K.cy = m.K[5];
+  K.width = static_cast<int>(m.width);
+  K.height = static_cast<int>(m.height);
+  if (!(K.fx > 0 && K.fy > 0 && std::isfinite(K.fx) && std::isfinite(K.fy) && std::isfinite(K.cx) && std::isfinite(K.cy))) {
+    return invalid_argument("K has no positive, finite focal lengths (fx " + std::to_string(K.fx) + ", fy " + std::to_string(K.fy) + ")");
+  }
+  return K;
+}
+
+Result<RgbdCloud> to_rgbd_cloud(const ImageMessage& depth_message, const ImageMessage* color_message, Intrinsics K,
+                                const std::string& info_name, bool* color_at_fault) {
+  *color_at_fault = false;
+  auto depth = to_depth(depth_message);
+  if (!depth) return depth.error();
+  RgbdCloud out;
+  ColorImage color;
+  if (color_message) {
+    auto decoded = to_color(*color_message);
+    if (decoded && (decoded->width != depth->width || decoded->height != depth->height)) {
+      decoded = invalid_argument("the colour image is " + std::to_string(decoded->width) + "x" + std::to_string(decoded->height) +
+                                 ", the depth image " + std::to_string(depth->width) + "x" + std::to_string(depth->height) +
+                                 " (use a depth topic registered to colour)");
+    }
+    if (!decoded) {
+      *color_at_fault = true;
+      return decoded.error();
+    }
+    color = std::move(*decoded);
+  } else {
+    color.width = depth->width;
+    color.height = depth->height;
+    color.rgb.assign(std::size_t(color.width) * color.height * 3, 128);
+    out.has_color = false;
+  }
+  if ((K.width != 0 && K.width != depth->width) || (K.height != 0 && K.height != depth->height)) {
+    return invalid_argument("the depth image is " + std::to_string(depth->width) + "x" + std::to_string(depth->height) +
+                            ", the camera info on " + info_name + " is for " + std::to_string(K.width) + "x" + std::to_string(K.height));
+  }
+  K.width = depth->width;
+  K.height = depth->height;
+  auto cloud = rgbd_to_cloud(color, *depth, K, kDepthMillimetres);
+  if (!cloud) return cloud.error();
+  out.cloud = *cloud;
+  out.intrinsics = K;
+  return out;
 }
 
 }  // namespace scenewatch::io::bag

@@ -1,4 +1,4 @@
-#include "tf_tree.h"
+#include "scenewatch/io/bag/tf_tree.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -32,6 +32,15 @@ void TfTree::add(const StampedTransform& t, bool is_static) {
   if (!e.sorted) {
     std::stable_sort(e.samples.begin(), e.samples.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     e.sorted = true;
+  }
+}
+
+void TfTree::forget_before(double stamp_s) {
+  for (Edge& e : edges_) {
+    if (e.is_static || e.samples.size() < 2) continue;
+    auto first_kept = std::lower_bound(e.samples.begin(), e.samples.end(), stamp_s, [](const auto& a, double v) { return a.first < v; });
+    if (first_kept != e.samples.begin()) --first_kept;  // the one before the time, for interpolation
+    e.samples.erase(e.samples.begin(), first_kept);
   }
 }
 

@@ -1,7 +1,7 @@
 #include "topic_choice.h"
 
 #include "ros_messages.h"
-#include "image_conversion.h"
+#include "scenewatch/io/bag/image_conversion.h"
 
 namespace scenewatch::io::bag {
 namespace {

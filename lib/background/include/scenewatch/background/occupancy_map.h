@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "scenewatch/core/cloud.h"
@@ -121,6 +122,12 @@ class OccupancyMap {
   Status save(const std::filesystem::path& path) const;
   /// Reads .ot (ColorOcTree or OcTree) or .bt; the resolution comes from the file.
   Status load(const std::filesystem::path& path);
+
+  /// The tree as OctoMap's binary stream (OcTree::writeBinaryData: occupancy only, no header),
+  /// the `data` of an octomap_msgs/Octomap with binary = true.
+  std::string binary_data() const;
+  /// Nodes of the tree, inner and leaves (what OcTree::size() says of a tree read from binary_data()).
+  std::size_t num_nodes() const;
 
   double resolution() const;
   std::size_t num_leaf_nodes() const;

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
+#include <string>
 #include <vector>
 
 #include "scenewatch/background/appearance.h"
@@ -154,6 +155,15 @@ struct OccupiedVoxels {
   double resolution_m = 0.0;
 };
 
+/// The map as OctoMap's binary stream (background::OccupancyMap::binary_data), for
+/// octomap_msgs/Octomap.
+struct BinaryMap {
+  std::string data;
+  double resolution_m = 0.0;
+  std::size_t nodes = 0;       ///< inner and leaf nodes of the tree
+  std::size_t leaf_nodes = 0;
+};
+
 /// Which snapshot load_newest_good() loaded, and why newer ones were refused.
 struct LoadedSnapshot {
   std::filesystem::path folder;
@@ -182,6 +192,8 @@ class WorkingMemory {
   /// The occupied voxels' centres (finest resolution); when there are more than `max_count`,
   /// every k-th of them in the map's order, k the smallest stride that fits.
   OccupiedVoxels occupied_voxels(std::size_t max_count) const;
+  /// The whole map as OctoMap binary data; a consistent copy while frames go on being processed.
+  BinaryMap binary_map() const;
   /// A dense copy of the map in a box (background::OccupancyMap::dense_grid), for the view
   /// planner. Thread safe: a consistent copy while frames go on being processed.
   Result<background::DenseGrid> dense_grid(const Aabb& box_world, std::size_t max_voxels) const;

@@ -8,13 +8,16 @@
 #include <string>
 #include <vector>
 
-#include "ros_messages.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/io/bag/messages.h"
 
 namespace scenewatch::io::bag {
 
 class TfTree {
  public:
   void add(const StampedTransform& t, bool is_static);
+  /// Drops the /tf samples older than `stamp_s` except the newest of them (a live stream's buffer).
+  void forget_before(double stamp_s);
   bool empty() const { return edges_.empty(); }
   bool has_frame(const std::string& frame) const;
   /// The root above `frame` (following parents); `frame` itself when it has none.

@@ -1,0 +1,231 @@
+#include "daemon_link.h"
+
+#include <algorithm>
+#include <cstdio>
+
+#include "scenewatch/io/bag/image_conversion.h"
+#include "scenewatch/service/access_token.h"
+
+namespace scenewatch::ros {
+namespace {
+
+double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+
+std::string seconds(double t) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6f", t);
+  return b;
+}
+
+}  // namespace
+
+DaemonLink::DaemonLink(const BridgeConfig& config, BridgeStats& stats, Outputs outputs)
+    : config_(config), stats_(stats), out_(std::move(outputs)), queue_(config.queue_frames) {}
+
+DaemonLink::~DaemonLink() { stop(); }
+
+void DaemonLink::start() {
+  ingest_thread_ = std::thread([this] { ingest_loop(); });
+  subscribe_thread_ = std::thread([this] { subscribe_loop(); });
+}
+
+void DaemonLink::stop() {
+  stopping_ = true;
+  queue_.close();
+  if (ingest_thread_.joinable()) ingest_thread_.join();
+  if (subscribe_thread_.joinable()) subscribe_thread_.join();
+}
+
+void DaemonLink::push(FrameJob job) {
+  auto dropped = queue_.push(std::move(job));
+  if (!dropped) return;
+  const auto n = stats_.count("dropped.queue_full");
+  if (worth_logging(n)) {
+    out_.log("dropped the frame of " + seconds(dropped->depth.stamp_s) + " s (queue_full, " + std::to_string(n) +
+             " so far): the daemon is slower than the camera; " + std::to_string(config_.queue_frames) +
+             " newer frames wait (--queue-frames)");
+  }
+}
+
+bool DaemonLink::sleep_for(double s) {
+  const auto until = Clock::now() + std::chrono::duration<double>(s);
+  while (!stopping_ && Clock::now() < until) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  return !stopping_;
+}
+
+std::optional<service::Client> DaemonLink::connect(const char* purpose) {
+  double backoff_s = 0.1;
+  for (std::uint64_t attempt = 1; !stopping_; ++attempt) {
+    auto client = service::Client::connect(config_.host, config_.port, std::min(2.0, config_.call_timeout_s));
+    if (client) {
+      if (token_.empty()) {
+        const auto path = config_.token_file.empty() ? service::default_token_path() : std::filesystem::path(config_.token_file);
+        auto token = service::read_token_file(path);
+        if (token) {
+          token_ = *token;
+        } else {
+          out_.log("no access token (" + token.error().message + "): the daemon will refuse the frames");
+        }
+      }
+      client->set_token(token_);
+      out_.log(std::string("connected to ") + client->endpoint() + " (" + purpose + ")");
+      return std::move(*client);
+    }
+    const auto n = stats_.count(std::string("reconnects.") + purpose);
+    if (worth_logging(n)) {
+      out_.log(std::string(purpose) + ": " + client.error().message + "; retrying in " + seconds(backoff_s) + " s (attempt " +
+               std::to_string(attempt) + ")");
+    }
+    if (!sleep_for(backoff_s)) break;
+    backoff_s = std::min(backoff_s * 2, config_.max_backoff_s);
+  }
+  return std::nullopt;
+}
+
+void DaemonLink::ingest_loop() {
+  while (!stopping_) {
+    auto client = connect("ingest");
+    if (!client) return;
+    while (!stopping_ && client->is_open()) {
+      auto job = queue_.pop(0.2);
+      if (!job) {
+        // The stream paused: the map of its last frame goes out now.
+        if (map_dirty_) publish_map(*client, map_stamp_s_);
+        continue;
+      }
+      if (!send_frame(*client, *job)) break;
+    }
+    client->close();
+  }
+}
+
+bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
+  const auto dequeued = Clock::now();
+  const auto depth = image_view(job.depth);
+  std::optional<io::bag::ImageMessage> color;
+  if (job.color) color = image_view(*job.color);
+  bool color_at_fault = false;
+  auto rgbd = io::bag::to_rgbd_cloud(depth, color ? &*color : nullptr, job.intrinsics, config_.info_topic, &color_at_fault);
+  if (!rgbd) {
+    const auto n = stats_.count("dropped.bad_image");
+    if (worth_logging(n)) {
+      out_.log("dropped the frame of " + seconds(job.depth.stamp_s) + " s (bad_image, " + std::to_string(n) + " so far): " +
+               (color_at_fault ? config_.color_topic : config_.depth_topic) + ": " + rgbd.error().message);
+    }
+    return true;
+  }
+  Frame frame;
+  frame.cloud = rgbd->cloud;
+  frame.intrinsics = rgbd->intrinsics;
+  frame.has_color = rgbd->has_color;
+  frame.T_world_camera = job.T_world_camera;
+  frame.stamp_s = job.depth.stamp_s;
+  frame.source = config_.depth_topic;
+  frame.camera = config_.camera_name;
+  if (!job.T_world_camera) frame.localization = LocalizationMode::kTrack;  // --without-tf track
+  proto::Request request;
+  auto* ingest = request.mutable_ingest_frame();
+  *ingest = service::make_ingest_frame(frame);
+  ingest->set_live(true);
+  const auto encoded = Clock::now();
+  auto id = client.start(std::move(request));
+  const auto sent = Clock::now();
+  if (!id) {
+    out_.log("ingest: " + id.error().message + "; reconnecting");
+    stats_.count("connection_lost");
+    client.close();
+    return false;
+  }
+  stats_.sample_ms("in.arrival_to_request", ms_between(job.arrived, sent));
+  stats_.sample_ms("in.1_queued", ms_between(job.arrived, dequeued));
+  stats_.sample_ms("in.2_converted", ms_between(dequeued, encoded));
+  stats_.sample_ms("in.3_written", ms_between(encoded, sent));
+  auto reply = client.wait_for(*id, config_.call_timeout_s);
+  if (!reply) {
+    out_.log("ingest: " + reply.error().message + "; reconnecting");
+    stats_.count("connection_lost");
+    client.close();
+    return false;
+  }
+  const auto replied = Clock::now();
+  stats_.sample_ms("daemon.request_to_reply", ms_between(sent, replied));
+  if (auto st = service::status_of(*reply); !st) {
+    const auto n = stats_.count("refused");
+    if (worth_logging(n)) out_.log("the daemon refused the frame of " + seconds(frame.stamp_s) + " s: " + st.error().message);
+    return true;
+  }
+  if (reply->ingest().skipped()) {
+    stats_.count("skipped_by_daemon");
+    return true;
+  }
+  stats_.count("frames_sent");
+  proto::Request objects;
+  objects.mutable_get_objects();
+  auto answer = call(client, std::move(objects), "objects");
+  if (!answer) return false;
+  if (service::status_of(*answer)) {
+    out_.objects(answer->objects(), frame.stamp_s);
+    stats_.sample_ms("out.reply_to_objects_written", ms_between(replied, Clock::now()));
+  }
+  map_stamp_s_ = frame.stamp_s;
+  map_dirty_ = true;
+  if (Clock::now() - map_published_ >= std::chrono::duration<double>(config_.map_period_s)) publish_map(client, frame.stamp_s);
+  return true;
+}
+
+std::optional<proto::Response> DaemonLink::call(service::Client& client, proto::Request request, const char* what) {
+  auto answer = client.call(std::move(request), config_.call_timeout_s);
+  if (answer) return std::move(*answer);
+  out_.log(std::string(what) + ": " + answer.error().message + "; reconnecting");
+  stats_.count("connection_lost");
+  client.close();
+  return std::nullopt;
+}
+
+void DaemonLink::publish_map(service::Client& client, double stamp_s) {
+  proto::Request request;
+  request.mutable_get_map();
+  auto answer = call(client, std::move(request), "map");
+  if (!answer) return;
+  if (auto st = service::status_of(*answer); !st) {
+    const auto n = stats_.count("map_refused");
+    if (worth_logging(n)) out_.log("the daemon refused GetMap: " + st.error().message);
+    map_dirty_ = false;
+    return;
+  }
+  out_.map(answer->map(), stamp_s);
+  stats_.count("maps_sent");
+  map_published_ = Clock::now();
+  map_dirty_ = false;
+}
+
+void DaemonLink::subscribe_loop() {
+  while (!stopping_) {
+    auto client = connect("events");
+    if (!client) return;
+    proto::Request subscribe;
+    subscribe.mutable_subscribe();
+    auto subscribed = client->call(std::move(subscribe), config_.call_timeout_s);
+    if (!subscribed || !service::status_of(*subscribed)) {
+      out_.log("events: Subscribe failed: " + (subscribed ? service::status_of(*subscribed).error().message : subscribed.error().message));
+      if (!sleep_for(config_.max_backoff_s)) return;
+      continue;
+    }
+    while (!stopping_) {
+      auto pushed = client->next_pushed(0.5);
+      if (!pushed) {
+        if (client->is_open()) continue;  // nothing within the wait
+        out_.log("events: " + pushed.error().message + "; reconnecting");
+        stats_.count("connection_lost");
+        break;
+      }
+      if (!pushed->has_event()) continue;  // a localization notice
+      const auto received = Clock::now();
+      out_.events({pushed->event()});
+      stats_.count("events_sent");
+      stats_.sample_ms("out.event_to_written", ms_between(received, Clock::now()));
+    }
+  }
+}
+
+}  // namespace scenewatch::ros

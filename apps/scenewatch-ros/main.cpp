@@ -1,0 +1,148 @@
+// scenewatch-ros: the ROS 2 bridge of scenewatchd over DDS (issue 32). A Cyclone DDS participant
+// that speaks ROS 2's conventions on one side, a client of the daemon's TCP API on the other.
+#include <CLI/CLI.hpp>
+
+#include <csignal>
+#include <cstdlib>
+#include <iostream>
+#include <mutex>
+
+#include "bridge_config.h"
+#include "daemon_link.h"
+#include "dds_node.h"
+#include "frame_assembler.h"
+
+namespace {
+
+using namespace scenewatch::ros;
+
+std::atomic<bool> g_stop{false};
+
+void on_signal(int) { g_stop = true; }
+
+constexpr const char* kDescription =
+    "scenewatch-ros - the ROS 2 bridge of scenewatchd over DDS (Eclipse Cyclone DDS).\n"
+    "\n"
+    "A DDS participant that is a ROS 2 peer (topics rt/<name>, types <pkg>::msg::dds_::<Type>_, CDR\n"
+    "little-endian): run it beside a camera driver whose ROS 2 uses rmw_cyclonedds_cpp, on the same\n"
+    "ROS_DOMAIN_ID. It reads sensor_msgs/Image depth (16UC1 mm or 32FC1 m) and colour (rgb8, bgr8,\n"
+    "rgba8, bgra8, mono8) with sensor_msgs/CameraInfo, and the camera pose from /tf and /tf_static,\n"
+    "sends each frame to scenewatchd (IngestFrame), and publishes under --namespace:\n"
+    "  events          scenewatch_msgs/msg/EventArray      reliable, keep last 10\n"
+    "  objects         vision_msgs/msg/Detection3DArray    reliable, keep last 10 (after every frame)\n"
+    "  octomap_binary  octomap_msgs/msg/Octomap            reliable, transient local (binary, id OcTree)\n"
+    "Images and camera info are read best effort, keep last 5; /tf reliable; /tf_static transient local.\n"
+    "Prints 'ready' on stdout once its DDS entities exist, and a stats line on exit (SIGINT, SIGTERM).\n"
+    "Exit codes: 0 stopped by a signal, 1 error (message on stderr), 2 usage.";
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  BridgeConfig config;
+  if (const char* domain = std::getenv("ROS_DOMAIN_ID"); domain != nullptr && *domain != '\0') {
+    config.domain_id = static_cast<std::uint32_t>(std::strtoul(domain, nullptr, 10));
+  }
+  CLI::App app{kDescription};
+  app.set_version_flag("--version", "scenewatch-ros " SCENEWATCH_VERSION);
+  app.add_option("--domain", config.domain_id, "DDS domain = ROS_DOMAIN_ID (default: $ROS_DOMAIN_ID, else 0)")
+      ->check(CLI::Range(0, 232))
+      ->capture_default_str();
+  app.add_option("--depth-topic", config.depth_topic, "depth sensor_msgs/Image, registered to colour: 16UC1 in mm or 32FC1 in m")
+      ->capture_default_str();
+  app.add_option("--color-topic", config.color_topic, "colour sensor_msgs/Image of the same size and stamps; \"\" for depth only (grey points)")
+      ->capture_default_str();
+  app.add_option("--info-topic", config.info_topic, "sensor_msgs/CameraInfo of the depth images (K and size are used)")
+      ->capture_default_str();
+  // A duration in seconds, >= 0 (> 0 when `positive`).
+  auto seconds_option = [&](const char* flag, double& value, const char* help, bool positive = false) {
+    app.add_option(flag, value, help)->check(positive ? CLI::Validator(CLI::PositiveNumber) : CLI::Validator(CLI::NonNegativeNumber))->capture_default_str();
+  };
+  app.add_option("--world-frame", config.world_frame, "TF frame of the daemon's world: poses are T_world_camera")->capture_default_str();
+  app.add_option("--camera-frame", config.camera_frame, "the depth camera's optical TF frame (default: the depth images' header.frame_id)");
+  seconds_option("--tf-tolerance", config.tf_tolerance_s,
+                 "seconds between an image stamp and the nearest /tf sample that still give its pose (between two samples: interpolated)");
+  seconds_option("--sync-tolerance", config.sync_tolerance_s,
+                 "seconds between a colour and a depth stamp that still make one frame");
+  seconds_option("--tf-wait", config.tf_wait_s,
+                 "seconds a frame waits for its TF to arrive before it is dropped");
+  std::string without_tf = "drop";
+  app.add_option("--without-tf", without_tf,
+                 "a frame with no TF in time: 'drop' it (counted, logged), or 'track': send it without a pose for the daemon's "
+                 "tracking to place (localization TRACK; the daemon must have a memory to track against)")
+      ->check(CLI::IsMember({"drop", "track"}))
+      ->capture_default_str();
+  app.add_option("--namespace", config.output_namespace, "ROS namespace of the published topics")->capture_default_str();
+  app.add_option("--camera-name", config.camera_name, "IngestFrame.camera: which camera the frames come from (\"\": the daemon's default)");
+  app.add_option("--host", config.host, "scenewatchd's host")->capture_default_str();
+  app.add_option("--port", config.port, "scenewatchd's TCP port")->check(CLI::Range(1, 65535))->capture_default_str();
+  app.add_option("--token-file", config.token_file, "the daemon's access token (default: ~/.scenewatch/token)");
+  seconds_option("--call-timeout", config.call_timeout_s,
+                 "seconds a daemon reply may take before the connection is made again", true);
+  seconds_option("--max-backoff", config.max_backoff_s,
+                 "longest wait between reconnection attempts, seconds (from 0.1 s, doubling)", true);
+  app.add_option("--queue-frames", config.queue_frames,
+                 "frames waiting for the daemon; beyond, the oldest is dropped (counted, logged) so small topics never wait behind big images")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
+  seconds_option("--map-period", config.map_period_s,
+                 "seconds between two octomap messages at most (the last frame's map is sent once the stream pauses)");
+  seconds_option("--stats-period", config.stats_period_s,
+                 "seconds between two stats lines on stdout (0: only at exit)");
+  CLI11_PARSE(app, argc, argv);
+  config.without_tf = without_tf == "track" ? WithoutTf::kTrack : WithoutTf::kDrop;
+  for (const auto& [flag, topic] : {std::pair<const char*, const std::string*>{"--depth-topic", &config.depth_topic},
+                                    {"--info-topic", &config.info_topic}, {"--color-topic", &config.color_topic}}) {
+    if (topic->empty() && topic == &config.color_topic) continue;  // depth only
+    if (auto name = dds_topic_name(*topic); !name) {
+      std::cerr << "scenewatch-ros: " << flag << ": " << name.error().message << "\n";
+      return 2;
+    }
+  }
+  if (config.world_frame.empty()) {
+    std::cerr << "scenewatch-ros: --world-frame must name a TF frame\n";
+    return 2;
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::signal(SIGPIPE, SIG_IGN);
+
+  BridgeStats stats;
+  std::mutex log_mutex;
+  auto log = [&](const std::string& line) {
+    std::lock_guard<std::mutex> lock(log_mutex);
+    std::cerr << "scenewatch-ros: " << line << std::endl;
+  };
+  auto node = DdsNode::create(config, stats);
+  if (!node) {
+    std::cerr << "scenewatch-ros: " << node.error().message << "\n";
+    return 1;
+  }
+  DdsNode& dds = **node;
+  Outputs outputs;
+  outputs.events = [&](const std::vector<scenewatch::proto::Event>& events) { dds.write_events(events); };
+  outputs.objects = [&](const scenewatch::proto::ObjectsReply& objects, double stamp_s) { dds.write_objects(objects, stamp_s); };
+  outputs.map = [&](const scenewatch::proto::MapReply& map, double stamp_s) { dds.write_map(map, stamp_s); };
+  outputs.log = log;
+  DaemonLink link(config, stats, outputs);
+  FrameAssembler assembler(config, stats, [&](FrameJob job) { link.push(std::move(job)); }, log);
+  link.start();
+  std::cout << "ready" << std::endl;
+
+  std::thread stats_thread;
+  if (config.stats_period_s > 0) {
+    stats_thread = std::thread([&] {
+      auto next = Clock::now() + std::chrono::duration<double>(config.stats_period_s);
+      while (!g_stop) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        if (Clock::now() < next) continue;
+        std::cout << stats.line() << std::endl;
+        next += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(config.stats_period_s));
+      }
+    });
+  }
+  dds.run(assembler, g_stop);
+  link.stop();
+  if (stats_thread.joinable()) stats_thread.join();
+  std::cout << stats.line() << std::endl;
+  return 0;
+}

@@ -1,0 +1,394 @@
+// scenewatch-ros (issue 32) end to end, no mocks: the real scenewatchd on loopback, the real
+// bridge started as a user starts it, and a DDS participant of the test that is a ROS 2 peer. It
+// publishes the simulator's cup_added (320x240 RGB-D, a hand-held camera, 12 frames per phase) as
+// a camera driver does (sensor_msgs/Image rgb8 + 16UC1, CameraInfo) with the camera pose on /tf
+// under a /tf_static link, and receives what the bridge publishes: the change's one event, the
+// objects as vision_msgs/Detection3DArray and the map as octomap_msgs/Octomap, checked against the
+// daemon's own answers and its saved map read back by OctoMap.
+#include <arpa/inet.h>
+#include <gtest/gtest.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <octomap/ColorOcTree.h>
+#include <octomap/OcTree.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <sstream>
+#include <cstring>
+
+#include "daemon_harness.h"
+#include "dds_peer.h"
+#include "shipped_scenario.h"
+
+namespace scenewatch::test {
+namespace {
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+fs::path bridge_binary() { return binary_dir() / "apps" / "scenewatch-ros" / "scenewatch-ros"; }
+
+constexpr double kStamp0 = 1700000000.0;   ///< ROS time of the first frame (epoch seconds, as a driver stamps)
+constexpr double kFrameWaitS = 15.0;       ///< bounds a hung test only
+
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+geometry_msgs_msg_dds__TransformStamped_ transform(const Pose& T, double stamp_s, const char* parent, const char* child) {
+  geometry_msgs_msg_dds__TransformStamped_ t{};
+  t.header.stamp = ros::ros_time(stamp_s);
+  t.header.frame_id = const_cast<char*>(parent);
+  t.child_frame_id = const_cast<char*>(child);
+  const Eigen::Quaterniond q(T.linear());
+  t.transform.translation = {T.translation().x(), T.translation().y(), T.translation().z()};
+  t.transform.rotation = {q.x(), q.y(), q.z(), q.w()};
+  return t;
+}
+
+sensor_msgs_msg_dds__Image_ image(double stamp_s, int width, int height, const char* encoding, std::uint32_t step, std::uint8_t* data,
+                                  std::size_t size) {
+  sensor_msgs_msg_dds__Image_ m{};
+  m.header.stamp = ros::ros_time(stamp_s);
+  m.header.frame_id = const_cast<char*>("camera_optical");
+  m.width = static_cast<std::uint32_t>(width);
+  m.height = static_cast<std::uint32_t>(height);
+  m.encoding = const_cast<char*>(encoding);
+  m.step = step;
+  m.data._length = m.data._maximum = static_cast<std::uint32_t>(size);
+  m.data._buffer = data;
+  return m;
+}
+
+/// The test's ROS 2 side: a camera driver (depth 16UC1 + rgb8 + CameraInfo), TF (world -> rig on
+/// /tf_static, rig -> camera_optical on /tf per frame) and a subscriber of the bridge's topics.
+class CameraPeer {
+ public:
+  explicit CameraPeer(std::uint32_t domain) : peer_(domain) {
+    depth_w_ = peer_.entity("/camera/depth/image_rect_raw", &sensor_msgs_msg_dds__Image__desc, false, false, 5);
+    color_w_ = peer_.entity("/camera/color/image_raw", &sensor_msgs_msg_dds__Image__desc, false, false, 5);
+    info_w_ = peer_.entity("/camera/depth/camera_info", &sensor_msgs_msg_dds__CameraInfo__desc, false, false, 5);
+    tf_w_ = peer_.entity("/tf", &tf2_msgs_msg_dds__TFMessage__desc, false, true, 100);
+    tf_static_w_ = peer_.entity("/tf_static", &tf2_msgs_msg_dds__TFMessage__desc, false, true, 1, true);
+    events_r_ = peer_.entity("/scenewatch/events", &scenewatch_msgs_msg_dds__EventArray__desc, true, true, 100);
+    objects_r_ = peer_.entity("/scenewatch/objects", &vision_msgs_msg_dds__Detection3DArray__desc, true, true, 100);
+    map_r_ = peer_.entity("/scenewatch/octomap_binary", &octomap_msgs_msg_dds__Octomap__desc, true, true, 1, true);
+    // world -> rig: fixed and not the identity, so the bridge must chain a static and a timed link.
+    T_world_rig_.translation() = Eigen::Vector3d(0.3, -0.2, 0.1);
+    T_world_rig_.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  }
+
+  /// Waits for the bridge's participant (every writer and reader matched), then sends /tf_static.
+  bool connect(double timeout_s) {
+    if (!DdsPeer::wait_matched({depth_w_, color_w_, info_w_, tf_w_, tf_static_w_}, {events_r_, objects_r_, map_r_}, timeout_s)) return false;
+    auto t = transform(T_world_rig_, kStamp0, "world", "rig");
+    tf2_msgs_msg_dds__TFMessage_ m{};
+    m.transforms._length = m.transforms._maximum = 1;
+    m.transforms._buffer = &t;
+    return dds_write(tf_static_w_, &m) == DDS_RETCODE_OK;
+  }
+
+  /// Publishes one frame as a driver does: TF (unless `with_tf` is false), CameraInfo, colour, depth.
+  void publish(const sim::SimFrame& rendered, const Intrinsics& K, double stamp, bool with_tf = true) {
+    const Pose T_rig_camera = T_world_rig_.inverse() * rendered.truth.T_world_camera_reported;
+    std::vector<std::uint8_t> rgb = rendered.color.rgb;
+    std::vector<std::uint8_t> depth(rendered.depth.depth_mm.size() * 2);
+    std::memcpy(depth.data(), rendered.depth.depth_mm.data(), depth.size());  // 16UC1, little-endian like the host
+    sensor_msgs_msg_dds__CameraInfo_ info{};
+    info.header.stamp = ros::ros_time(stamp);
+    info.header.frame_id = const_cast<char*>("camera_optical");
+    info.width = static_cast<std::uint32_t>(K.width);
+    info.height = static_cast<std::uint32_t>(K.height);
+    info.distortion_model = const_cast<char*>("plumb_bob");
+    const double k[9] = {K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1};
+    std::copy(k, k + 9, info.k);
+    info.r[0] = info.r[4] = info.r[8] = 1;
+    const double p[12] = {K.fx, 0, K.cx, 0, 0, K.fy, K.cy, 0, 0, 0, 1, 0};
+    std::copy(p, p + 12, info.p);
+    auto tf = transform(T_rig_camera, stamp, "rig", "camera_optical");
+    tf2_msgs_msg_dds__TFMessage_ tf_message{};
+    tf_message.transforms._length = tf_message.transforms._maximum = 1;
+    tf_message.transforms._buffer = &tf;
+    auto color_message = image(stamp, K.width, K.height, "rgb8", static_cast<std::uint32_t>(3 * K.width), rgb.data(), rgb.size());
+    auto depth_message = image(stamp, K.width, K.height, "16UC1", static_cast<std::uint32_t>(2 * K.width), depth.data(), depth.size());
+    if (with_tf) EXPECT_EQ(dds_write(tf_w_, &tf_message), DDS_RETCODE_OK);
+    EXPECT_EQ(dds_write(info_w_, &info), DDS_RETCODE_OK);
+    EXPECT_EQ(dds_write(color_w_, &color_message), DDS_RETCODE_OK);
+    EXPECT_EQ(dds_write(depth_w_, &depth_message), DDS_RETCODE_OK);
+  }
+
+  /// The Detection3DArray of the frame stamped `stamp`, waiting at most timeout_s: its objects' ids
+  /// and box centres (nothing on timeout).
+  std::optional<std::vector<std::pair<std::string, Eigen::Vector3d>>> objects_of(double stamp, double timeout_s) {
+    std::optional<std::vector<std::pair<std::string, Eigen::Vector3d>>> out;
+    const auto start = Clock::now();
+    while (!out && ms_since(start) < timeout_s * 1000) {
+      DdsPeer::take<vision_msgs_msg_dds__Detection3DArray_>(objects_r_, [&](const vision_msgs_msg_dds__Detection3DArray_& m) {
+        if (std::abs(ros::seconds(m.header.stamp) - stamp) > 1e-6) return;
+        out.emplace();
+        for (std::uint32_t i = 0; i < m.detections._length; ++i) {
+          const auto& d = m.detections._buffer[i];
+          EXPECT_STREQ(d.header.frame_id, "world");
+          EXPECT_EQ(d.results._length, 1u);
+          out->emplace_back(d.id, Eigen::Vector3d(d.bbox.center.position.x, d.bbox.center.position.y, d.bbox.center.position.z));
+        }
+      });
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return out;
+  }
+
+  dds_entity_t events_reader() const { return events_r_; }
+  dds_entity_t map_reader() const { return map_r_; }
+
+ private:
+  DdsPeer peer_;
+  dds_entity_t depth_w_ = 0, color_w_ = 0, info_w_ = 0, tf_w_ = 0, tf_static_w_ = 0, events_r_ = 0, objects_r_ = 0, map_r_ = 0;
+  Pose T_world_rig_ = Pose::Identity();
+};
+
+class RosBridgeTest : public ::testing::Test {
+ protected:
+  void TearDown() override {
+    if (HasFailure()) {
+      std::cerr << "---- scenewatchd log ----\n" << daemon_.log() << "---- scenewatch-ros log ----\n"
+                << (bridge_ ? bridge_->stderr_text() : std::string()) << "-------------------------\n";
+    }
+    bridge_.reset();
+    daemon_ = Daemon();
+    std::error_code ec;
+    fs::remove_all(tmp_, ec);
+  }
+
+  /// Starts the bridge against the daemon and waits for its "ready".
+  void start_bridge(std::vector<std::string> extra = {}) {
+    std::vector<std::string> argv{bridge_binary().string(), "--port", std::to_string(daemon_.port()), "--token-file",
+                                  daemon_.token_file().string(), "--world-frame", "world", "--camera-frame", "camera_optical",
+                                  "--depth-topic", "/camera/depth/image_rect_raw", "--color-topic", "/camera/color/image_raw",
+                                  "--info-topic", "/camera/depth/camera_info"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    auto child = ChildProcess::start(argv, tmp_ / "scenewatch-ros.log");
+    ASSERT_TRUE(child.has_value());
+    bridge_ = std::make_unique<ChildProcess>(std::move(*child));
+    const auto line = bridge_->read_line(kStartTimeoutS);
+    ASSERT_TRUE(line.has_value()) << "scenewatch-ros did not say ready; its log:\n" << bridge_->stderr_text();
+    ASSERT_EQ(*line, "ready");
+  }
+
+  /// SIGTERM to the bridge: its exit code and its last stats line.
+  std::pair<std::optional<int>, std::string> stop_bridge() {
+    bridge_->signal(SIGTERM);
+    std::string stats;
+    while (auto line = bridge_->read_line(kStartTimeoutS)) {
+      if (line->rfind("stats:", 0) == 0) stats = *line;
+    }
+    return {bridge_->wait(kStartTimeoutS), stats};
+  }
+
+  fs::path tmp_ = make_temp_dir("ros_bridge");
+  Daemon daemon_;
+  std::unique_ptr<ChildProcess> bridge_;
+};
+
+TEST_F(RosBridgeTest, CupAddedOverDdsGivesOneEventTheObjectsAndTheMap) {
+  const std::uint32_t domain = configure_loopback_dds();
+  ShippedScenario shipped = shipped_scenario("cup_added", 320, 240, 12);
+  ASSERT_TRUE(shipped.simulator);
+  const sim::Scenario& scenario = shipped.scenario;
+  auto& simulator = shipped.simulator;
+  const auto truth = simulator->changes();
+  ASSERT_EQ(truth.size(), 1u);
+  const Eigen::Vector2d where = truth[0].added.at(0).T_world_object.translation().head<2>();
+
+  const fs::path model_dir = tmp_ / "model";
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "  model_dir: " + model_dir.string() + "\nsegmentation:\n  up_vector: [0, 0, 1]\n"));
+  ASSERT_NO_FATAL_FAILURE(start_bridge({"--map-period", "0.5"}));
+
+  CameraPeer camera(domain);
+  ASSERT_TRUE(camera.connect(30.0)) << "the bridge's DDS participant was not discovered";
+
+  // Lock step, as a test must not depend on speed: the next frame goes out once the bridge
+  // published the objects of this one (a best-effort image lost on the way is sent again).
+  std::vector<double> round_trip_ms, stamps;
+  std::vector<std::pair<std::string, Eigen::Vector3d>> last_objects;
+  std::size_t retries = 0;
+  for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
+    for (int f = 0; f < simulator->frame_count(phase); ++f) {
+      const sim::SimFrame rendered = simulator->render(phase, f);
+      const double stamp = kStamp0 + static_cast<double>(stamps.size()) / 30.0;
+      stamps.push_back(stamp);
+      std::optional<std::vector<std::pair<std::string, Eigen::Vector3d>>> objects;
+      for (int attempt = 0; attempt < 3 && !objects; ++attempt) {
+        retries += attempt > 0;
+        const auto published = Clock::now();
+        camera.publish(rendered, scenario.intrinsics, stamp);
+        objects = camera.objects_of(stamp, kFrameWaitS / 3);
+        if (objects) round_trip_ms.push_back(ms_since(published));
+      }
+      ASSERT_TRUE(objects) << "no Detection3DArray for the frame of " << stamp - kStamp0 << " s";
+      last_objects = *objects;
+    }
+  }
+
+  // The change, once: exactly one event, OBJECT_ADDED, where the truth put the cup.
+  std::vector<std::tuple<std::uint8_t, std::string, Eigen::Vector2d>> events;
+  const auto waited = Clock::now();
+  while (ms_since(waited) < (events.empty() ? kFrameWaitS * 1000 : 1500)) {
+    DdsPeer::take<scenewatch_msgs_msg_dds__EventArray_>(camera.events_reader(), [&](const scenewatch_msgs_msg_dds__EventArray_& m) {
+      for (std::uint32_t i = 0; i < m.events._length; ++i) {
+        const auto& e = m.events._buffer[i];
+        events.emplace_back(e.kind, e.kind_name, Eigen::Vector2d(e.centroid.x, e.centroid.y));
+      }
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(events.size(), 1u) << "one fact, one event";
+  EXPECT_EQ(std::get<0>(events[0]), scenewatch_msgs_msg_dds__Event_Constants_OBJECT_ADDED);
+  EXPECT_EQ(std::get<1>(events[0]), "OBJECT_ADDED");
+  EXPECT_LT((std::get<2>(events[0]) - where).norm(), 0.10);
+
+  // The objects: the last Detection3DArray is the daemon's object list, object for object.
+  service::Client client = daemon_.connect();
+  const auto objects = call(client, request([](proto::Request& r) { r.mutable_get_objects(); }));
+  ASSERT_GT(objects.objects().objects_size(), 0);
+  ASSERT_EQ(last_objects.size(), static_cast<std::size_t>(objects.objects().objects_size()));
+  for (int i = 0; i < objects.objects().objects_size(); ++i) {
+    const auto& o = objects.objects().objects(i);
+    const auto& [id, center] = last_objects[static_cast<std::size_t>(i)];
+    EXPECT_EQ(id, std::to_string(o.id()));
+    EXPECT_LT((center - Eigen::Vector3d(o.box().center().x(), o.box().center().y(), o.box().center().z())).norm(), 1e-9);
+  }
+
+  // The map: the Octomap of the last frame, read by OctoMap's readBinaryData, is the tree the daemon
+  // saves (same resolution, same nodes, same occupancy leaf for leaf).
+  std::unique_ptr<octomap::OcTree> received;
+  std::string map_id;
+  const auto map_wait = Clock::now();
+  while (!received && ms_since(map_wait) < kFrameWaitS * 1000) {
+    DdsPeer::take<octomap_msgs_msg_dds__Octomap_>(camera.map_reader(), [&](const octomap_msgs_msg_dds__Octomap_& m) {
+      if (std::abs(ros::seconds(m.header.stamp) - stamps.back()) > 1e-6) return;
+      EXPECT_TRUE(m.binary);
+      map_id = m.id;
+      received = std::make_unique<octomap::OcTree>(m.resolution);
+      std::istringstream data(std::string(reinterpret_cast<const char*>(m.data._buffer), m.data._length));
+      EXPECT_TRUE(received->readBinaryData(data).good());
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(received) << "no Octomap of the last frame";
+  EXPECT_EQ(map_id, "OcTree");
+  ASSERT_EQ(call(client, request([](proto::Request& r) { r.mutable_save_model(); })).status().code(), proto::Status::OK);
+  std::ifstream saved_file(model_dir / "current" / "background.ot", std::ios::binary);
+  ASSERT_TRUE(saved_file) << "no saved map in " << model_dir;
+  std::unique_ptr<octomap::AbstractOcTree> read(octomap::AbstractOcTree::read(saved_file));
+  auto* saved = dynamic_cast<octomap::ColorOcTree*>(read.get());
+  ASSERT_NE(saved, nullptr);
+  EXPECT_EQ(received->getResolution(), saved->getResolution());
+  EXPECT_EQ(received->size(), saved->size());
+  EXPECT_EQ(received->getNumLeafNodes(), saved->getNumLeafNodes());
+  std::size_t occupied = 0, mismatched = 0;
+  for (auto it = saved->begin_leafs(), end = saved->end_leafs(); it != end; ++it) {
+    const octomap::OcTreeNode* node = received->search(it.getKey(), it.getDepth());
+    const bool occupied_here = saved->isNodeOccupied(*it);
+    occupied += occupied_here;
+    if (node == nullptr || received->isNodeOccupied(node) != occupied_here) ++mismatched;
+  }
+  EXPECT_GT(occupied, 100u);
+  EXPECT_EQ(mismatched, 0u);
+
+  const auto [code, stats] = stop_bridge();
+  EXPECT_EQ(code, std::optional<int>(0)) << bridge_->stderr_text();
+  const auto sent_at = stats.find("frames_sent=");
+  ASSERT_NE(sent_at, std::string::npos) << stats;
+  EXPECT_GE(std::stoul(stats.substr(sent_at + 12)), stamps.size()) << stats;
+  EXPECT_EQ(stats.find("dropped."), std::string::npos) << "lock step: nothing to drop; " << stats;
+  std::printf("scenewatch-ros on %zu frames of 320x240 (%zu sent again): %s\n", stamps.size(), retries, stats.c_str());
+  std::printf("publish -> Detection3DArray back, through DDS, the bridge and the daemon: median %.1f ms\n", median(round_trip_ms));
+}
+
+// The daemon vanishes (killed) and comes back on the same port: the bridge keeps running,
+// reconnects with backoff and carries on. A frame whose TF never comes is dropped with its reason
+// counted, not sent.
+TEST_F(RosBridgeTest, AVanishedDaemonIsReconnectedToAndAFrameWithoutTfIsDropped) {
+  const std::uint32_t domain = configure_loopback_dds();
+  ShippedScenario shipped = shipped_scenario("cup_added", 320, 240, 4);
+  ASSERT_TRUE(shipped.simulator);
+  const sim::SimFrame rendered = shipped.simulator->render(0, 0);
+  const Intrinsics& K = shipped.scenario.intrinsics;
+
+  // A port of our own (the daemon must come back on it): one the kernel just gave out.
+  std::uint16_t port = 0;
+  {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    socklen_t len = sizeof a;
+    ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+    ASSERT_EQ(::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len), 0);
+    port = ntohs(a.sin_port);
+    ::close(fd);
+  }
+  const fs::path config = tmp_ / "scenewatchd.yaml";
+  std::ofstream(config) << "server:\n  address: 127.0.0.1\n  port: " << port << "\n  token_file: " << (tmp_ / "token").string()
+                        << "\nsegmentation:\n  up_vector: [0, 0, 1]\n";
+  auto start_daemon = [&](int n) {
+    auto child = ChildProcess::start({daemon_binary().string(), "--config", config.string()}, tmp_ / ("scenewatchd-" + std::to_string(n) + ".log"));
+    EXPECT_TRUE(child.has_value());
+    auto line = child->read_line(kStartTimeoutS);
+    EXPECT_TRUE(line && line->rfind("listening on", 0) == 0) << child->stderr_text();
+    return std::make_unique<ChildProcess>(std::move(*child));
+  };
+  auto daemon = start_daemon(1);
+  std::vector<std::string> argv{bridge_binary().string(), "--port", std::to_string(port), "--token-file", (tmp_ / "token").string(),
+                                "--world-frame", "world", "--camera-frame", "camera_optical", "--depth-topic",
+                                "/camera/depth/image_rect_raw", "--color-topic", "/camera/color/image_raw", "--info-topic",
+                                "/camera/depth/camera_info", "--max-backoff", "0.5", "--tf-wait", "0.2"};
+  auto child = ChildProcess::start(argv, tmp_ / "scenewatch-ros.log");
+  ASSERT_TRUE(child.has_value());
+  bridge_ = std::make_unique<ChildProcess>(std::move(*child));
+  ASSERT_EQ(bridge_->read_line(kStartTimeoutS).value_or(""), "ready") << bridge_->stderr_text();
+  CameraPeer camera(domain);
+  ASSERT_TRUE(camera.connect(30.0));
+
+  double stamp = kStamp0;
+  auto sent_and_answered = [&](double timeout_s) {
+    const auto start = Clock::now();
+    while (ms_since(start) < timeout_s * 1000) {
+      camera.publish(rendered, K, stamp += 1.0);
+      if (camera.objects_of(stamp, 1.0)) return true;
+    }
+    return false;
+  };
+  ASSERT_TRUE(sent_and_answered(kFrameWaitS));
+
+  // No TF at this stamp (the last /tf sample is 1 s older, --tf-tolerance 0.05 s): dropped. The
+  // next frame, with its TF, goes through and drops the one that waited.
+  camera.publish(rendered, K, stamp += 1.0, /*with_tf=*/false);
+  EXPECT_FALSE(camera.objects_of(stamp, 1.0));
+  ASSERT_TRUE(sent_and_answered(kFrameWaitS));
+
+  daemon->kill_now();
+  camera.publish(rendered, K, stamp += 1.0);  // into a broken connection: lost, the bridge reconnects
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  EXPECT_EQ(bridge_->wait(0.0), std::nullopt) << "the bridge keeps running without its daemon";
+  daemon = start_daemon(2);
+  EXPECT_TRUE(sent_and_answered(kFrameWaitS)) << "no objects after the daemon came back";
+
+  const auto [code, stats] = stop_bridge();
+  EXPECT_EQ(code, std::optional<int>(0)) << bridge_->stderr_text();
+  EXPECT_NE(stats.find("dropped.no_tf=1"), std::string::npos) << stats;
+  EXPECT_NE(stats.find("reconnects.ingest="), std::string::npos) << stats;
+  EXPECT_NE(bridge_->stderr_text().find("(no_tf, 1 so far)"), std::string::npos) << bridge_->stderr_text();
+  std::printf("%s\n", stats.c_str());
+}
+
+}  // namespace
+}  // namespace scenewatch::test
