@@ -9,7 +9,8 @@
 #include <shared_mutex>
 
 #include "scenewatch/background/appearance.h"
-#include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/core/result.h"
+#include "scenewatch/pipeline/surprise_result.h"
 #include "scenewatch/surprise/surprise_map.h"
 
 namespace scenewatch::pipeline {

@@ -12,7 +12,8 @@
 
 #include "scenewatch/core/frame.h"
 #include "scenewatch/foreground/foreground_tracker.h"
-#include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/pipeline/frame_result.h"
+#include "scenewatch/pipeline/scene_snapshot.h"
 
 namespace scenewatch::pipeline {
 

@@ -1,5 +1,6 @@
 #include "model_store.h"
 
+#include "scenewatch/core/event_json.h"
 #include "scenewatch/core/files.h"
 
 #include <fcntl.h>
@@ -7,6 +8,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <memory>
 #include <system_error>
 
 namespace scenewatch::pipeline {
@@ -187,6 +189,193 @@ std::vector<fs::path> snapshots_newest_first(const fs::path& model_dir) {
   std::vector<fs::path> out;
   for (const auto& n : names) out.push_back(model_dir / n);
   return out;
+}
+
+namespace {
+
+// The keyframes' features in a snapshot folder (localization::save_features).
+constexpr const char* kFeaturesFile = "keyframe-features.bin";
+
+// Loads the background map and checks it against what scene.json recorded when it was saved (its
+// size in bytes and its leaf count): a damaged file is refused, not loaded in part and then saved
+// over the model. Models saved before the record existed are loaded unchecked.
+Status load_background(background::OccupancyMap& map, const fs::path& path, const nlohmann::json& scene) {
+  const auto record = scene.is_object() ? scene.find("background") : scene.end();
+  if (record != scene.end() && !record->is_object()) {
+    return invalid_argument("'" + path.string() + "': the model's scene.json records its background as " +
+                            std::string(record->type_name()) + ", not an object with bytes and leaf_nodes");
+  }
+  if (record != scene.end()) {
+    std::error_code ec;
+    const auto bytes = fs::file_size(path, ec);
+    if (ec) return io_error("'" + path.string() + "': " + ec.message());
+    const auto expected = record->value("bytes", std::uint64_t{0});
+    if (bytes != expected) {
+      return invalid_argument("'" + path.string() + "': damaged: " + std::to_string(bytes) + " bytes, the model recorded " +
+                              std::to_string(expected) + " when it was saved");
+    }
+  }
+  if (auto st = map.load(path); !st) return st;
+  if (record != scene.end()) {
+    const auto leaves = record->value("leaf_nodes", std::uint64_t{0});
+    if (map.num_leaf_nodes() != leaves) {
+      return invalid_argument("'" + path.string() + "': damaged: " + std::to_string(map.num_leaf_nodes()) +
+                              " leaf nodes, the model recorded " + std::to_string(leaves));
+    }
+  }
+  return {};
+}
+
+// scene.json's objects, foreground objects and counters into `out` (not yet the events nor the features).
+Status read_scene_json(const nlohmann::json& scene, const fs::path& dir, SceneRecord& out) {
+  try {
+    out.last_stamp_s = scene.value("last_stamp_s", 0.0);
+    out.frames = scene.at("frames_processed").get<std::uint64_t>();
+    out.points = scene.value("points_processed", std::uint64_t{0});
+    out.next_object_id = scene.at("next_object_id").get<std::uint64_t>();
+    out.next_event_id = scene.value("next_event_id", std::uint64_t{1});
+    for (const auto& j : scene.at("objects")) {
+      auto o = object_from_json(j);
+      if (!o) return o.error();
+      for (const auto& p : j.value("samples", nlohmann::json::array()))
+        out.samples[o->id].emplace_back(p.at(0).get<double>(), p.at(1).get<double>(), p.at(2).get<double>());
+      out.objects.push_back(*o);
+    }
+    for (const auto& j : scene.value("foreground", nlohmann::json::array())) {
+      auto o = object_from_json(j);
+      if (!o) return o.error();
+      if (!o->foreground) return invalid_argument("'" + (dir / "scene.json").string() + "': foreground object " + std::to_string(o->id) + " has no foreground state");
+      auto model = std::make_shared<Cloud>();
+      for (const auto& p : j.at("model")) {
+        PointT q;
+        q.x = p.at(0).get<float>(), q.y = p.at(1).get<float>(), q.z = p.at(2).get<float>();
+        q.r = p.at(3).get<std::uint8_t>(), q.g = p.at(4).get<std::uint8_t>(), q.b = p.at(5).get<std::uint8_t>();
+        model->push_back(q);
+      }
+      if (model->empty()) return invalid_argument("'" + (dir / "scene.json").string() + "': foreground object " + std::to_string(o->id) + " has an empty model");
+      out.foreground.emplace_back(*o, std::move(model));
+    }
+    for (const auto& j : scene.at("planes")) {
+      auto p = plane_from_json(j);
+      if (!p) return p.error();
+      out.planes.push_back(*p);
+    }
+  } catch (const std::exception& e) {
+    return invalid_argument("'" + (dir / "scene.json").string() + "': malformed: " + e.what());
+  }
+  return {};
+}
+
+}  // namespace
+
+Result<BackgroundRecord> save_background(const background::OccupancyMap& map, const fs::path& dir) {
+  BackgroundRecord record;
+  if (auto st = map.save(dir / "background.ot"); !st) return st.error();
+  record.leaf_nodes = map.num_leaf_nodes();
+  // What the map file must be on load: OctoMap reads a truncated .ot without complaint.
+  std::error_code ec;
+  record.bytes = fs::file_size(dir / "background.ot", ec);
+  if (ec) return io_error("'" + (dir / "background.ot").string() + "': " + ec.message());
+  return record;
+}
+
+Status write_scene(const fs::path& dir, const SceneRecord& s) {
+  json scene = {{"format", "scenewatch-model"}, {"version", 1}, {"frames_processed", s.frames},
+                {"points_processed", s.points}, {"next_object_id", s.next_object_id},
+                {"last_stamp_s", s.last_stamp_s},
+                {"background", {{"bytes", s.background.bytes}, {"leaf_nodes", s.background.leaf_nodes}}}};
+  scene["objects"] = json::array();
+  for (const auto& o : s.objects) {
+    json j = to_json(o);
+    json pts = json::array();
+    if (const auto samples = s.samples.find(o.id); samples != s.samples.end())
+      for (const auto& p : samples->second) pts.push_back({p.x(), p.y(), p.z()});
+    j["samples"] = pts;
+    scene["objects"].push_back(j);
+  }
+  // Foreground objects with their point models (object frame: x y z r g b).
+  scene["foreground"] = json::array();
+  for (const auto& [o, model] : s.foreground) {
+    json j = to_json(o);
+    json pts = json::array();
+    if (model)
+      for (const auto& p : model->points) pts.push_back({p.x, p.y, p.z, p.r, p.g, p.b});
+    j["model"] = pts;
+    scene["foreground"].push_back(j);
+  }
+  scene["planes"] = json::array();
+  for (const auto& p : s.planes) scene["planes"].push_back(to_json(p));
+  scene["next_event_id"] = s.next_event_id;
+  std::string log;
+  for (const auto& e : s.events) {
+    json j = to_json(e);
+    j.erase("indices_before");  // indices into frames the model no longer holds
+    j.erase("indices_after");
+    log += j.dump() + "\n";
+  }
+  if (auto st = localization::save_features(dir / kFeaturesFile, s.features); !st) return st;
+  if (auto st = write_file_synced(dir / "scene.json", scene.dump(2)); !st) return st;
+  return write_file_synced(dir / "events.jsonl", log);
+}
+
+Result<SceneRecord> read_snapshot(const fs::path& dir, background::OccupancyMap& map) {
+  std::ifstream in(dir / "scene.json");
+  if (!in) return io_error("'" + (dir / "scene.json").string() + "': cannot open");
+  json scene;
+  try {
+    scene = json::parse(in);
+  } catch (const std::exception& e) {
+    return invalid_argument("'" + (dir / "scene.json").string() + "': " + e.what());
+  }
+  try {
+    if (auto st = load_background(map, dir / "background.ot", scene); !st) return st.error();
+  } catch (const std::exception& e) {  // a record of the wrong type: json's type_error
+    return invalid_argument("'" + (dir / "scene.json").string() + "': malformed background record: " + e.what());
+  }
+  SceneRecord out;
+  if (auto st = read_scene_json(scene, dir, out); !st) return st.error();
+  std::ifstream log(dir / "events.jsonl");
+  std::string line;
+  while (std::getline(log, line)) {
+    if (line.empty()) continue;
+    try {
+      auto e = event_from_json(json::parse(line));
+      if (!e) return e.error();
+      out.events.push_back(*e);
+    } catch (const std::exception& ex) {
+      return invalid_argument("'" + (dir / "events.jsonl").string() + "': " + ex.what());
+    }
+  }
+  // Keyframe features (absent in models saved before them: extracted again on first use).
+  if (std::error_code ec; fs::exists(dir / kFeaturesFile, ec)) {
+    auto loaded = localization::load_features(dir / kFeaturesFile);
+    if (!loaded) return loaded.error();
+    out.features = std::move(*loaded);
+  }
+  return out;
+}
+
+Result<std::pair<fs::path, std::vector<std::string>>> load_newest_good(
+    const fs::path& model_dir, const std::function<Status(const fs::path&)>& load) {
+  auto current = current_snapshot(model_dir);
+  if (!current && current.error().code == ErrorCode::kNotFound) return current.error();
+  std::vector<std::string> refused;  // one message per snapshot tried before the one that loads
+  std::vector<fs::path> candidates;
+  if (current) candidates.push_back(*current);
+  for (const auto& snap : snapshots_newest_first(model_dir)) {
+    if (!current || snap.filename() != current->filename()) candidates.push_back(snap);
+  }
+  for (const auto& snap : candidates) {
+    if (auto st = load(snap); !st) {
+      refused.push_back(st.error().message);
+      continue;
+    }
+    return std::make_pair(snap, std::move(refused));
+  }
+  if (!current) refused.insert(refused.begin(), current.error().message);
+  std::string why;
+  for (const auto& r : refused) why += (why.empty() ? "" : "; ") + r;
+  return invalid_argument("'" + model_dir.string() + "': no snapshot loads: " + why);
 }
 
 }  // namespace scenewatch::pipeline

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "scenewatch/core/result.h"
-#include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/pipeline/config.h"
 
 namespace scenewatch::pipeline {
 

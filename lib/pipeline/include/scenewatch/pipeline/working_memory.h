@@ -1,9 +1,11 @@
 #pragma once
-/// The facade: WorkingMemory::process(frame) validates the frame, segments it, keeps the object
-/// list (ObjectTracker), detects geometric changes against the background and appearance changes
-/// against the keyframes, emits each change once and updates the background. It owns the modules; the service
-/// talks to it and knows nothing of their insides.
+/// The facade: WorkingMemory::process(frame) validates the frame (io::validate_frame), segments it,
+/// keeps the object list (ObjectTracker), detects geometric changes against the background and
+/// appearance changes against the keyframes, emits each change once and updates the background.
+/// It owns the stages (lib/pipeline/src: map_stage, appearance_stage, foreground_stage, ...) and
+/// saves and loads through model_store; the service talks to it and knows nothing of their insides.
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -13,126 +15,23 @@
 #include <optional>
 #include <shared_mutex>
 #include <string>
+#include <utility>
 #include <vector>
 
-#include "scenewatch/background/appearance.h"
 #include "scenewatch/background/occupancy_map.h"
-#include "scenewatch/change/mismatch.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
-#include "scenewatch/core/sensor_model.h"
-#include "scenewatch/foreground/foreground_tracker.h"
 #include "scenewatch/localization/localizer.h"
-#include "scenewatch/pipeline/event_fusion.h"
-#include "scenewatch/pipeline/object_tracker.h"
-#include "scenewatch/segmentation/tabletop.h"
 #include "scenewatch/surprise/surprise_map.h"
+// What users of the facade's API take from it, each in a header of its own.
+#include "scenewatch/pipeline/config.h"
+#include "scenewatch/pipeline/frame_result.h"
+#include "scenewatch/pipeline/scene_snapshot.h"
+#include "scenewatch/pipeline/surprise_result.h"
 
 namespace scenewatch::pipeline {
-
-/// Everything the pipeline needs; loaded from YAML by load_config().
-struct Config {
-  /// The depth camera and the pose source (the `sensor:` section): every stage that weighs
-  /// evidence takes it from here (WorkingMemory copies it into change.sensor).
-  SensorModel sensor;
-  /// Where each frame was taken: its given pose trusted, refined against the memory (default),
-  /// or tracked without poses (the `localization:` section, issue 29).
-  localization::Config localization;
-  background::Config background;
-  segmentation::Config segmentation;
-  TrackingConfig tracking;
-  /// Geometric change detection (OBJECT_ADDED / OBJECT_REMOVED / OBJECT_MOVED) against the map
-  /// as it stood before each frame, with a persistence filter.
-  bool change_enabled = true;
-  change::Config change;
-  background::AppearanceConfig appearance;  ///< keyframes and mesh (posed RGB-D frames only)
-  surprise::SurpriseConfig surprise;        ///< image-based Bayesian surprise
-  std::size_t max_event_log = 10000;  ///< events kept in memory for GetEvents
-  FusionConfig fusion;                ///< one fact, one event (the `events:` section)
-  foreground::ForegroundConfig foreground;  ///< hands, promotion, tracking, DoFs (issue 12)
-  /// Frames whose camera or points lie farther than this from the world origin are refused, metres
-  /// (the `workspace:` section's radius_m).
-  double workspace_radius_m = 1000.0;
-};
-
-/// The image-based surprise of one observation against the appearance memory.
-struct SurpriseResult {
-  surprise::SurpriseMap map;
-  std::vector<Event> events;  ///< APPEARANCE_CHANGE regions (ids set only when emitted by process())
-  std::size_t reference_views = 0;
-  /// The memory knows this view from an earlier visit: a keyframe within twice the keyframe
-  /// spacing, taken at least `surprise.familiar_after_frames` frames before. Only then may appearance alone
-  /// report a change (a view seen for the first time differs in ways that are not change:
-  /// reflections, transparency, what was hidden before).
-  bool familiar_view = false;
-  /// Pixels of the expected view that described objects' completed surfaces set (nearer than the
-  /// mesh or where it had none; WorkingMemory::set_known_surface).
-  std::size_t known_surface_pixels = 0;
-  Pose T_world_camera = Pose::Identity();
-  Intrinsics intrinsics;
-  double stamp_s = 0.0;
-  double ms = 0.0;
-};
-
-Status validate(const Config& config);
-
-/// What one frame produced.
-struct FrameResult {
-  std::uint64_t frame_index = 0;
-  std::size_t points = 0;               ///< valid points in the frame (all of them, whatever was inserted)
-  /// The pose the memory used and how it was found. A frame whose camera is lost changed nothing
-  /// and raised no event.
-  localization::Localization localization;
-  std::vector<Plane> planes;            ///< world frame
-  std::vector<ObjectCluster> objects;   ///< world frame, indices into the frame's cloud
-  std::vector<Event> events;
-  /// What went into the map: fewer points than the frame's while a change is pending (its points
-  /// wait until it is confirmed or dropped).
-  background::InsertStats insert_stats;
-  std::shared_ptr<const SurpriseResult> surprise;  ///< null: the frame had no pose or no keyframes existed yet
-  double segment_ms = 0, insert_ms = 0, surprise_ms = 0, change_ms = 0, total_ms = 0;
-  double hands_ms = 0, foreground_ms = 0;  ///< hand detection; foreground registration and promotion
-  /// Wall time of the three parts side by side (segmentation, surprise, change + insertion), and
-  /// of what follows them on one core (foreground, fusion, tracker, snapshot publication).
-  double parallel_ms = 0, after_ms = 0;
-  std::size_t hands = 0;                   ///< hands found in the frame
-  std::size_t change_candidates = 0;  ///< changes seen but not yet confirmed
-};
-
-/// An immutable view of the scene, swapped atomically after each frame: readers never wait for
-/// a frame being processed.
-/// A hand (with its forearm) as a planner sees it: where not to reach.
-struct HandSeen {
-  Aabb box_world;
-  Eigen::Vector3d tip_world = Eigen::Vector3d::Zero();
-  double score = 0.0;
-  std::size_t pixels = 0;
-  bool enters_from_border = false;
-};
-
-/// The hands and the person of the last frame that had colour.
-struct HandsSeen {
-  std::uint64_t frame_index = 0;
-  double stamp_s = 0.0;
-  std::vector<HandSeen> hands;
-  std::size_t person_pixels = 0;
-  std::optional<Aabb> person_box_world;
-};
-
-struct SceneSnapshot {
-  std::uint64_t frames_processed = 0;
-  std::vector<Plane> planes;            ///< from the last frame, world frame
-  std::vector<TrackedObject> objects;   ///< background objects, then foreground ones (foreground set), world frame
-  HandsSeen hands;
-  /// Each object's points (world, thinned) by id: the last observation of a background object, the
-  /// posed model of a foreground one. For what describes objects (the ontology's describe()).
-  std::map<std::uint64_t, std::shared_ptr<const std::vector<Eigen::Vector3d>>> points;
-  Eigen::Vector3d up_world = Eigen::Vector3d::UnitZ();      ///< the support's up (config or largest plane)
-  Eigen::Vector3d camera_world = Eigen::Vector3d::Zero();   ///< where the last frame was taken
-  double last_stamp_s = 0.0;
-};
 
 struct Stats {
   std::uint64_t frames_processed = 0;

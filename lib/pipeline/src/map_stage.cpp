@@ -1,0 +1,140 @@
+// The background map's part of a frame: change detection, then insertion (map_stage.h).
+#include "map_stage.h"
+
+#include <limits>
+
+#include "frame_sampling.h"
+#include "timing.h"
+#include "scenewatch/change/objects.h"
+
+namespace scenewatch::pipeline {
+
+namespace {
+
+// The frame without the points of unconfirmed change candidates: an added candidate's own points,
+// and every pixel in the region where a removed candidate was seen through (a few pixels wider).
+// Without this the insertion would erode a removed object's voxels frame by frame, and the
+// candidate would change shape (and lose its move partner) before it is confirmed.
+CloudConstPtr without_pending(const Cloud& cloud, const std::vector<change::ChangeCluster>& pending,
+                              const Intrinsics& K) {
+  auto masked = std::make_shared<Cloud>(cloud);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  auto blank = [&](std::size_t i) { masked->points[i].x = masked->points[i].y = masked->points[i].z = nan; };
+  constexpr int kMarginPx = 3;
+  for (const auto& c : pending) {
+    if (c.kind == change::ChangeKind::kAdded) {
+      for (int i : c.indices) blank(static_cast<std::size_t>(i));
+      continue;
+    }
+    const int u0 = c.region.x - kMarginPx, v0 = c.region.y - kMarginPx;
+    const int u1 = c.region.x + c.region.width + kMarginPx, v1 = c.region.y + c.region.height + kMarginPx;
+    for (std::size_t i = 0; i < cloud.size(); ++i) {
+      const PointT& p = cloud.points[i];
+      if (!is_valid(p) || p.z <= 0) continue;
+      const bool organized = cloud.height > 1;
+      const int u = organized ? static_cast<int>(i % cloud.width) : static_cast<int>(std::lround(K.fx * p.x / p.z + K.cx));
+      const int v = organized ? static_cast<int>(i / cloud.width) : static_cast<int>(std::lround(K.fy * p.y / p.z + K.cy));
+      if (u >= u0 && u <= u1 && v >= v0 && v <= v1) blank(i);
+    }
+  }
+  return masked;
+}
+
+}  // namespace
+
+MapStage::MapStage(const Config& c) : map_(c.background), witness_(c.background.resolution_m), changes_(c.change) {}
+
+// Geometric change detection against the map as it stands before this frame. Candidates stay
+// out of the map until the persistence filter confirms them, so the comparison keeps being made
+// against the model that predates them (OctoMap's log-odds would absorb a new object, or erode
+// a removed one, within a few frames). A frame whose region is too large for a dense grid is
+// left without change detection.
+ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
+                                       const change::Config& config, std::uint32_t camera) {
+  ChangeOutcome out;
+  if (!K) return out;
+  out.K = *K;
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  auto mismatch = change::mismatch_against_map(map_, *frame.cloud, T, *K, config, &map_grid_,
+                                               config.witness_per_camera ? &witness_ : nullptr, camera);
+  if (!mismatch) return out;
+  change::ClusterInput input;
+  input.after_camera = frame.cloud.get();
+  input.T_world_after = T;
+  input.K_after = *K;
+  out.confirmed = changes_.update(change::cluster_mismatch(*mismatch, input, config), &out.pending, &out.absorbed, camera);
+  return out;
+}
+
+ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                               bool detect, FrameResult& result, std::uint32_t camera) {
+  ChangeOutcome changed;
+  if (detect) {
+    const auto t_change = Clock::now();
+    changed = detect_changes(frame, T, K, config.change, camera);
+    result.change_ms = ms_since(t_change);
+    result.change_candidates = changes_.candidates();
+  }
+  CloudConstPtr to_insert = frame.cloud;
+  if (!changed.pending.empty()) to_insert = without_pending(*frame.cloud, changed.pending, changed.K);
+  const auto t_ins = Clock::now();
+  const background::Config& b = config.background;
+  const int stride = sample_stride(frame, K, b.resolution_m, b.max_range_m, b.insert_stride_px);
+  std::unique_lock<std::shared_mutex> write(mutex_);
+  result.insert_stats = map_.insert(*to_insert, T, stride);
+  witness_.witness(*to_insert, T, camera, stride);
+  for (const auto& c : changed.confirmed) {
+    if (c.before) {
+      map_.set_voxels(c.before->points_world, background::Occupancy::kFree);
+      witness_.forget(c.before->points_world);
+    }
+    if (c.after) map_.set_voxels(c.after->points_world, background::Occupancy::kOccupied);
+  }
+  for (const auto& c : changed.absorbed) {
+    map_.set_voxels(c.points_world, c.kind == change::ChangeKind::kAdded ? background::Occupancy::kOccupied
+                                                                        : background::Occupancy::kFree);
+  }
+  result.insert_ms = ms_since(t_ins);
+  return changed;
+}
+
+std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d&)> MapStage::occupied_fraction(
+    const change::Config& change_config) {
+  return [this, change_config](const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& camera) {
+    std::shared_lock<std::shared_mutex> read(mutex_);
+    const double step = 0.5 * map_.resolution();
+    std::size_t n = 0;
+    for (const auto& p : pts) {
+      const Eigen::Vector3d ray = p - camera;
+      const double range = ray.norm();
+      const double reach = change::map_tolerance_m(change_config, range);
+      bool on = map_.query(p) == background::Occupancy::kOccupied;
+      for (double t = step; !on && range > 0 && t <= reach + 1e-9; t += step) {
+        const Eigen::Vector3d d = (t / range) * ray;
+        on = map_.query(p + d) == background::Occupancy::kOccupied || map_.query(p - d) == background::Occupancy::kOccupied;
+      }
+      n += on ? 1 : 0;
+    }
+    return pts.empty() ? 0.0 : static_cast<double>(n) / pts.size();
+  };
+}
+
+void MapStage::reset() {
+  {
+    std::unique_lock<std::shared_mutex> write(mutex_);
+    map_.reset();
+    witness_.reset();
+  }
+  changes_.reset();
+}
+
+void MapStage::replace(background::OccupancyMap map) {
+  {
+    std::unique_lock<std::shared_mutex> write(mutex_);
+    map_ = std::move(map);
+    witness_ = change::SurfaceWitness(map_.resolution());  // the loaded surfaces: seen by none of this session
+  }
+  changes_.reset();
+}
+
+}  // namespace scenewatch::pipeline

@@ -1,0 +1,78 @@
+#pragma once
+// The background map's part of a frame: geometric change detection against the map as it stands
+// before the frame, then the frame into the map (without the points of unconfirmed candidates),
+// and the confirmed changes written into it. Owns the map, the surface witness and the persistence
+// filter. Thread safe as the working memory uses it: update() and the writers run under its
+// writer lock; read() takes the map's shared lock and may run beside update()'s change detection.
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <shared_mutex>
+#include <vector>
+
+#include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/change/mismatch.h"
+#include "scenewatch/change/persistence.h"
+#include "scenewatch/core/frame.h"
+#include "scenewatch/pipeline/config.h"
+#include "scenewatch/pipeline/frame_result.h"
+
+namespace scenewatch::pipeline {
+
+/// What geometric change detection made of one frame.
+struct ChangeOutcome {
+  std::vector<change::ChangeCluster> pending;   ///< unconfirmed candidates seen in this frame
+  std::vector<change::ChangeCluster> absorbed;  ///< more of changes already confirmed
+  std::vector<change::ObjectChange> confirmed;  ///< confirmed by this frame
+  Intrinsics K;                                 ///< the camera the frame was compared with
+};
+
+class MapStage {
+ public:
+  explicit MapStage(const Config& config);
+
+  /// Change detection (when `detect`) against the map as it stands before this frame, then the
+  /// frame into the map; fills the result's change and insertion figures. Runs beside the
+  /// segmentation and the image surprise, which do not read the map.
+  ChangeOutcome update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                       bool detect, FrameResult& result, std::uint32_t camera);
+
+  /// The share of world points on surfaces the map remembers (occupied, within the change
+  /// detector's tolerance along the ray from `camera`), for the foreground.
+  std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d& camera)> occupied_fraction(
+      const change::Config& change_config);
+
+  /// `fn(map)` under the map's shared lock.
+  template <typename F>
+  auto read(F&& fn) const {
+    std::shared_lock<std::shared_mutex> lock(mutex_);
+    return fn(static_cast<const background::OccupancyMap&>(map_));
+  }
+  /// `fn(map)` under the map's exclusive lock.
+  template <typename F>
+  auto write(F&& fn) {
+    std::unique_lock<std::shared_mutex> lock(mutex_);
+    return fn(map_);
+  }
+
+  /// Forgets what is kept of a camera that is no longer followed.
+  void forget_camera(std::uint32_t camera) { changes_.forget_camera(camera); }
+  /// An empty map; no candidates.
+  void reset();
+  /// A loaded map in place of this one (its surfaces seen by no camera of this session); no candidates.
+  void replace(background::OccupancyMap map);
+
+ private:
+  ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
+                               const change::Config& config, std::uint32_t camera);
+
+  // Guards `map_` and `witness_` between writers and concurrent occupancy readers.
+  mutable std::shared_mutex mutex_;
+  background::OccupancyMap map_;
+  background::DenseGrid map_grid_;  // the change detector's dense copy of the map, its buffers kept between frames
+  change::SurfaceWitness witness_;  // which cameras saw each surface of the map (guarded with it)
+  change::PersistenceFilter changes_;  // owned by the writer
+};
+
+}  // namespace scenewatch::pipeline

@@ -1,0 +1,110 @@
+// The object tracker's input from one frame (object_observations.h).
+#include "object_observations.h"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "foreground_stage.h"
+
+namespace scenewatch::pipeline {
+
+namespace {
+
+constexpr std::size_t kSamplesPerObject = 200;
+constexpr std::size_t kPointsPerObject = 4000;  // kept per object for the ontology's describe()
+
+// World sample points of each cluster, for the tracker's free-space evidence; clusters the
+// foreground claimed are left out.
+std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectCluster>& objects, const Cloud& cloud,
+                                                     const Pose& T, const std::vector<std::size_t>& claimed) {
+  std::vector<TrackerObservation> observations;
+  for (std::size_t i = 0; i < objects.size(); ++i) {
+    if (std::find(claimed.begin(), claimed.end(), i) != claimed.end()) continue;
+    TrackerObservation o;
+    const auto& idx = objects[i].indices;
+    const std::size_t step = std::max<std::size_t>(1, idx.size() / kSamplesPerObject);
+    for (std::size_t k = 0; k < idx.size(); k += step)
+      o.samples.push_back(T * cloud.points[static_cast<std::size_t>(idx[k])].getVector3fMap().cast<double>());
+    auto points = std::make_shared<std::vector<Eigen::Vector3d>>();
+    const std::size_t every = std::max<std::size_t>(1, idx.size() / kPointsPerObject);
+    for (std::size_t k = 0; k < idx.size(); k += every)
+      points->push_back(T * cloud.points[static_cast<std::size_t>(idx[k])].getVector3fMap().cast<double>());
+    o.points = std::move(points);
+    o.cluster = objects[i];
+    o.range_m = (objects[i].centroid - T.translation()).norm();
+    observations.push_back(std::move(o));
+  }
+  return observations;
+}
+
+// A box that lies for the most part (half its volume or more) in one of the frame's hands or arms,
+// each grown by `margin_m`: a finger or a sleeve, not an object the hand reaches for.
+bool touches_hand(const Aabb& box, const HandsSeen& hands, double margin_m) {
+  const double volume = (box.max - box.min).cwiseMax(1e-6).prod();
+  for (const auto& h : hands.hands) {
+    const Eigen::Vector3d lo = (h.box_world.min.array() - margin_m).max(box.min.array());
+    const Eigen::Vector3d hi = (h.box_world.max.array() + margin_m).min(box.max.array());
+    if ((hi.array() > lo.array()).all() && (hi - lo).prod() >= 0.5 * volume) return true;
+  }
+  return false;
+}
+
+// Objects stand on tables, shelves and floors, not on walls: the clusters whose supporting plane
+// faces more than 45 degrees away from the world's up (up_direction's own bound) are a wall's
+// relief (a whiteboard, a poster, a socket), not objects to list. Their space is never seen free,
+// so the list would only grow: hrt1's pick_toy_2 ended with 60 objects, most of them pieces of
+// the wall behind the table.
+void keep_on_level_supports(std::vector<TrackerObservation>& observations, const std::vector<Plane>& planes,
+                            const Eigen::Vector3d& up, const Eigen::Vector3d& camera) {
+  const auto level = [&](int plane_id) {
+    for (const auto& p : planes)
+      if (p.id == plane_id) return faces_within_45_degrees(p, camera, up);
+    return true;  // no plane to judge by
+  };
+  observations.erase(std::remove_if(observations.begin(), observations.end(),
+                                    [&](const TrackerObservation& o) { return !level(o.cluster.plane_id); }),
+                     observations.end());
+}
+
+}  // namespace
+
+std::vector<TrackerObservation> tracker_input(const FrameResult& result, const Cloud& cloud, const Pose& T,
+                                              const std::vector<std::size_t>& claimed, const HandsSeen& hands,
+                                              std::uint64_t frame_index, const Config& config) {
+  const std::optional<Eigen::Vector3d>& configured_up = config.segmentation.up;
+  std::vector<TrackerObservation> observations = tracker_observations(result.objects, cloud, T, claimed);
+  for (auto& o : observations) {
+    o.resolution_m = std::max(config.segmentation.voxel_size_m, 2 * config.sensor.sigma_z(o.range_m));
+    if (hands.frame_index == frame_index) o.touches_person = touches_hand(o.cluster.box.aabb(), hands, config.segmentation.cluster_tolerance_m);
+  }
+  // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
+  if (const auto up = level_up(configured_up, result.planes, T)) keep_on_level_supports(observations, result.planes, *up, T.translation());
+  return observations;
+}
+
+double free_fraction(const background::OccupancyMap& map, const std::vector<Eigen::Vector3d>& pts) {
+  if (pts.empty()) return 0.0;
+  std::size_t n = 0;
+  for (const auto& p : pts) n += (map.freed_by_last_insert(p) || map.query(p) == background::Occupancy::kFree) ? 1 : 0;
+  return static_cast<double>(n) / pts.size();
+}
+
+double seen_in_place(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                     const std::vector<Eigen::Vector3d>& points) {
+  if (!K || cloud.height <= 1 || points.empty() || static_cast<int>(cloud.width) != K->width) return 0.0;
+  const Pose T_camera_world = T.inverse();
+  std::size_t n = 0;
+  for (const auto& p : points) {
+    const Eigen::Vector3d q = T_camera_world * p;
+    if (q.z() <= 0) continue;
+    const long u = std::lround(K->fx * q.x() / q.z() + K->cx), v = std::lround(K->fy * q.y() / q.z() + K->cy);
+    if (u < 0 || v < 0 || u >= static_cast<long>(cloud.width) || v >= static_cast<long>(cloud.height)) continue;
+    const PointT& f = cloud.points[static_cast<std::size_t>(v) * cloud.width + static_cast<std::size_t>(u)];
+    if (!is_valid(f)) continue;
+    n += std::abs(f.z - q.z()) < 3 * config.sensor.sigma_z(q.z()) + config.segmentation.voxel_size_m;
+  }
+  return static_cast<double>(n) / static_cast<double>(points.size());
+}
+
+}  // namespace scenewatch::pipeline
