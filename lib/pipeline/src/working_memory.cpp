@@ -243,11 +243,12 @@ OccupiedVoxels WorkingMemory::occupied_voxels(std::size_t max_count) const {
 
 BinaryMap WorkingMemory::binary_map() const {
   BinaryMap out;
-  std::shared_lock<std::shared_mutex> read(impl_->map_mutex);
-  out.data = impl_->map.binary_data();
-  out.resolution_m = impl_->map.resolution();
-  out.nodes = impl_->map.num_nodes();
-  out.leaf_nodes = impl_->map.num_leaf_nodes();
+  impl_->map.read([&](const background::OccupancyMap& map) {
+    out.data = map.binary_data();
+    out.resolution_m = map.resolution();
+    out.nodes = map.num_nodes();
+    out.leaf_nodes = map.num_leaf_nodes();
+  });
   return out;
 }
 
