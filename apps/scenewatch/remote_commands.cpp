@@ -170,7 +170,7 @@ int run_stats(const RemoteOptions& options) {
     std::cout << "frames processed   " << s.frames_processed() << "\n"
               << "frames skipped     " << s.frames_skipped() << " (live frames a newer one superseded)\n"
               << "points processed   " << s.points_processed() << "\n"
-              << "events emitted     " << s.events_emitted() << "\n"
+              << "events emitted     " << s.events_emitted() << " (since the daemon started; reset does not restart it)\n"
               << "tracked objects    " << s.tracked_objects() << "\n"
               << "map                " << s.map_occupied_leaves() << " occupied of " << s.map_leaf_nodes()
               << " leaves at " << s.map_resolution_m() << " m, " << s.map_memory_bytes() / 1024 << " KiB\n"
