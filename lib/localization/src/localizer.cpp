@@ -291,6 +291,7 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
   Localization best = out;
   best.state = State::kLost;
   std::optional<Alignment> aligned;
+  const background::Keyframe* aligned_to = nullptr;  // the keyframe of `aligned`
   for (const auto& keyframe : candidates) {
     const auto ref = reference(*keyframe);
     Alignment a = align(*ref, current, keyframe->T_world_camera.inverse() * prior, sensor_, config_.alignment);
@@ -305,6 +306,7 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
     if (accept(r, a, *keyframe)) {
       best = r;
       aligned = a;
+      aligned_to = keyframe.get();
       break;
     }
     if (best.reference_keyframe == 0 || r.inlier_fraction > best.inlier_fraction) best = r;
@@ -315,10 +317,7 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
     return finish(best);
   }
   if (use_given) {
-    const auto* keyframe = &*candidates.front();
-    for (const auto& k : candidates)
-      if (k->id == best.reference_keyframe) keyframe = &*k;
-    const Fused f = fuse_with_prior(track, prior, best.T_world_camera, *aligned, *keyframe);
+    const Fused f = fuse_with_prior(track, prior, best.T_world_camera, *aligned, *aligned_to);
     best.T_world_camera = f.pose;
     best.alignment_rejected = f.rejected;
     odom_pose = f.odom_pose;
