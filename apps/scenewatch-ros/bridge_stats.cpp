@@ -5,6 +5,12 @@
 
 namespace scenewatch::ros {
 
+std::string seconds(double t) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6f", t);
+  return b;
+}
+
 std::uint64_t BridgeStats::count(const std::string& name, std::uint64_t n) {
   std::lock_guard<std::mutex> lock(mutex_);
   return counters_[name] += n;

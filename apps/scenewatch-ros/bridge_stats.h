@@ -29,4 +29,7 @@ class BridgeStats {
 /// without flooding the log.
 inline bool worth_logging(std::uint64_t n) { return n <= 10 || (n & (n - 1)) == 0; }
 
+/// A time or stamp in seconds for a log line, to the microsecond ("12.345678").
+std::string seconds(double t);
+
 }  // namespace scenewatch::ros

@@ -1,7 +1,6 @@
 #include "daemon_link.h"
 
 #include <algorithm>
-#include <cstdio>
 
 #include "scenewatch/io/bag/image_conversion.h"
 #include "scenewatch/service/access_token.h"
@@ -10,12 +9,6 @@ namespace scenewatch::ros {
 namespace {
 
 double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
-
-std::string seconds(double t) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.6f", t);
-  return b;
-}
 
 }  // namespace
 
@@ -130,23 +123,13 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
   const auto encoded = Clock::now();
   auto id = client.start(std::move(request));
   const auto sent = Clock::now();
-  if (!id) {
-    out_.log("ingest: " + id.error().message + "; reconnecting");
-    stats_.count("connection_lost");
-    client.close();
-    return false;
-  }
+  if (!id) return lose(client, "ingest", id.error().message);
   stats_.sample_ms("in.arrival_to_request", ms_between(job.arrived, sent));
   stats_.sample_ms("in.1_queued", ms_between(job.arrived, dequeued));
   stats_.sample_ms("in.2_converted", ms_between(dequeued, encoded));
   stats_.sample_ms("in.3_written", ms_between(encoded, sent));
   auto reply = client.wait_for(*id, config_.call_timeout_s);
-  if (!reply) {
-    out_.log("ingest: " + reply.error().message + "; reconnecting");
-    stats_.count("connection_lost");
-    client.close();
-    return false;
-  }
+  if (!reply) return lose(client, "ingest", reply.error().message);
   const auto replied = Clock::now();
   stats_.sample_ms("daemon.request_to_reply", ms_between(sent, replied));
   if (auto st = service::status_of(*reply); !st) {
@@ -176,10 +159,15 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
 std::optional<proto::Response> DaemonLink::call(service::Client& client, proto::Request request, const char* what) {
   auto answer = client.call(std::move(request), config_.call_timeout_s);
   if (answer) return std::move(*answer);
-  out_.log(std::string(what) + ": " + answer.error().message + "; reconnecting");
+  lose(client, what, answer.error().message);
+  return std::nullopt;
+}
+
+bool DaemonLink::lose(service::Client& client, const char* what, const std::string& why) {
+  out_.log(std::string(what) + ": " + why + "; reconnecting");
   stats_.count("connection_lost");
   client.close();
-  return std::nullopt;
+  return false;
 }
 
 void DaemonLink::publish_map(service::Client& client, double stamp_s) {

@@ -54,6 +54,9 @@ class DaemonLink {
   /// One call; a transport error (down, or slower than call_timeout_s) is logged and closes the
   /// connection, and gives nothing.
   std::optional<proto::Response> call(service::Client& client, proto::Request request, const char* what);
+  /// A transport error on `client`: logged, counted as connection_lost, the connection closed.
+  /// Returns false (send_frame's "the connection broke").
+  bool lose(service::Client& client, const char* what, const std::string& why);
   /// Waits up to seconds unless stopping; false when stopping.
   bool sleep_for(double seconds);
 

@@ -1,19 +1,12 @@
 #include "frame_assembler.h"
 
 #include <cmath>
-#include <cstdio>
 
 namespace scenewatch::ros {
 namespace {
 
 constexpr std::size_t kMaxUnpaired = 8;  ///< images kept per stream while their partner is awaited
 constexpr double kTfHistoryS = 10.0;     ///< /tf kept this long behind the newest image
-
-std::string seconds(double t) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.6f", t);
-  return b;
-}
 
 }  // namespace
 
@@ -40,6 +33,11 @@ void FrameAssembler::drop(const std::string& reason, double stamp_s, const std::
   if (worth_logging(n)) log_("dropped the frame of " + seconds(stamp_s) + " s (" + reason + ", " + std::to_string(n) + " so far): " + why);
 }
 
+void FrameAssembler::drop_without_color(double stamp_s) {
+  drop("no_color", stamp_s, "no colour image on " + config_.color_topic + " within " + seconds(config_.sync_tolerance_s) +
+                                " s of its stamp");
+}
+
 void FrameAssembler::set_intrinsics(Result<Intrinsics> intrinsics) {
   if (!intrinsics) {
     const auto n = stats_.count("bad_camera_info");
@@ -53,8 +51,7 @@ void FrameAssembler::add_depth(RawImage image) {
   stats_.count("depth_in");
   depths_.push_back(std::move(image));
   if (depths_.size() > kMaxUnpaired) {
-    drop("no_color", depths_.front().stamp_s, "no colour image on " + config_.color_topic + " within " +
-                                                  seconds(config_.sync_tolerance_s) + " s of its stamp");
+    drop_without_color(depths_.front().stamp_s);
     depths_.pop_front();
   }
   try_pair();
@@ -81,8 +78,7 @@ void FrameAssembler::try_pair() {
         // Its colour may still come; a newer colour image than this depth says it will not.
         const bool passed = !colors_.empty() && colors_.back().stamp_s > depth.stamp_s + config_.sync_tolerance_s;
         if (!passed) return;
-        drop("no_color", depth.stamp_s, "no colour image on " + config_.color_topic + " within " + seconds(config_.sync_tolerance_s) +
-                                            " s of its stamp");
+        drop_without_color(depth.stamp_s);
         depths_.pop_front();
         continue;
       }
@@ -106,8 +102,7 @@ void FrameAssembler::try_pair() {
 void FrameAssembler::place(FrameJob job) {
   const double stamp = job.depth.stamp_s;
   tf_.forget_before(stamp - kTfHistoryS);
-  const std::string& camera = config_.camera_frame.empty() ? job.depth.frame_id : config_.camera_frame;
-  auto pose = tf_.lookup(config_.world_frame, camera, stamp, config_.tf_tolerance_s);
+  auto pose = lookup_pose(job);
   if (pose) {
     job.T_world_camera = *pose;
     if (waiting_) drop("no_tf", waiting_->depth.stamp_s, waiting_error_ + " (a newer frame found its TF first)");
@@ -132,8 +127,7 @@ void FrameAssembler::retry_waiting() {
     waiting_.reset();
     return;
   }
-  const std::string& camera = config_.camera_frame.empty() ? waiting_->depth.frame_id : config_.camera_frame;
-  auto pose = tf_.lookup(config_.world_frame, camera, waiting_->depth.stamp_s, config_.tf_tolerance_s);
+  auto pose = lookup_pose(*waiting_);
   if (!pose) {
     waiting_error_ = pose.error().message;
     return;
@@ -142,6 +136,11 @@ void FrameAssembler::retry_waiting() {
   FrameJob job = std::move(*waiting_);
   waiting_.reset();
   emit_(std::move(job));
+}
+
+Result<Pose> FrameAssembler::lookup_pose(const FrameJob& job) const {
+  const std::string& camera = config_.camera_frame.empty() ? job.depth.frame_id : config_.camera_frame;
+  return tf_.lookup(config_.world_frame, camera, job.depth.stamp_s, config_.tf_tolerance_s);
 }
 
 void FrameAssembler::add_transform(const io::bag::StampedTransform& t, bool is_static) {

@@ -59,6 +59,11 @@ class FrameAssembler {
  private:
   void try_pair();
   void place(FrameJob job);
+  /// A depth image whose colour partner never came.
+  void drop_without_color(double stamp_s);
+  /// T_world_camera of a frame from the TF tree (the camera frame: --camera-frame, else the
+  /// depth image's frame_id).
+  Result<Pose> lookup_pose(const FrameJob& job) const;
   void retry_waiting();
   void drop(const std::string& reason, double stamp_s, const std::string& why);
 
