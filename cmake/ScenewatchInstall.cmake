@@ -62,7 +62,7 @@ install(CODE [[
 # --- python ----------------------------------------------------------------------------------
 # The package as the build made it (clients/python/CMakeLists.txt), on Debian's python3 path for
 # the prefix /usr; for another prefix, PYTHONPATH=PREFIX/lib/python3/dist-packages (or pip install
-# build/clients/python, README "Install on a robot").
+# build/clients/python, docs/install.md).
 install(DIRECTORY ${PROJECT_BINARY_DIR}/clients/python/scenewatch DESTINATION lib/python3/dist-packages
         COMPONENT python FILES_MATCHING PATTERN "*.py" PATTERN "__pycache__" EXCLUDE)
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/copyright DESTINATION share/doc/python3-scenewatch COMPONENT python)

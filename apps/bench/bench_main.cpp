@@ -1,4 +1,4 @@
-// scenewatch-bench: prints the figures the README quotes, each next to its baseline in the same run.
+// scenewatch-bench: prints the figures docs/benchmarks.md quotes, each next to its baseline in the same run.
 #include <CLI/CLI.hpp>
 
 #include "bench.h"

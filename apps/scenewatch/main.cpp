@@ -290,8 +290,8 @@ int main(int argc, char** argv) {
       "  scenewatch replay kitchen.bag:0-99 --depth-topic /camera/aligned_depth_to_color/image_raw   (a ROS bag)\n"
       "Scenario scripts: `scenewatch replay SCRIPT.yaml [--check] [--port P] [--token-file F]` streams what the\n"
       "script names (a simulator scenario or a sequence folder) through a RUNNING daemon over TCP, prints the\n"
-      "events and the foreground objects, and compares them with the script's expectations (README, 'Scenario\n"
-      "scripts'); with --check it exits 1 when one is not met.\n"
+      "events and the foreground objects, and compares them with the script's expectations (docs/testing.md,\n"
+      "'Scenario scripts'); with --check it exits 1 when one is not met.\n"
       "  scenewatch replay tests/scenarios/hand_tilts_cup.yaml --check --port 7501");
   replay->add_option("inputs", replay_options.inputs, "sequence folders, ROS bags, frame ranges or cloud files")->required();
   replay->add_option("--config", replay_options.config, "YAML config, as the daemon's (its pipeline sections are used)");

@@ -1,7 +1,7 @@
 // `scenewatch replay SCRIPT.yaml [--check]`: a scripted foreground-extraction test. The script names
 // what to replay (a simulator scenario rendered on the fly, or a recorded sequence folder) and what
 // must happen; the frames go to a running daemon over TCP, as a client sends them, and what the
-// daemon answered is compared with the script. The format is documented in the README.
+// daemon answered is compared with the script. The format is documented in docs/testing.md ("Scenario scripts").
 #include <yaml-cpp/yaml.h>
 
 #include <cstdio>

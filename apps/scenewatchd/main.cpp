@@ -162,7 +162,7 @@ int main(int argc, char** argv) {
     return 1;
   }
 
-  // Calls that change the model need the token of this file (README "Access token").
+  // Calls that change the model need the token of this file (docs/daemon.md, "Access token").
   auto token = scenewatch::service::ensure_token_file(config.server.token_file);
   if (!token) {
     log(LogLevel::kError, "access token: " + token.error().message);

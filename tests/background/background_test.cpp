@@ -131,7 +131,7 @@ TEST(OccupancyMap, BoxQueries) {
 // (the default until issue 11's last change): 28 of the 2000 voxels 1 m in front of the wall
 // (1.4 %; 22 when the frame was cast as one, 37 with a larger hash table). At 32, the default: none
 // here, and 2469 instead of 33423 holes among the 5.6 M free voxels of the 31 mOSD before-frames
-// at 1 cm (README, "Geometric change detection").
+// at 1 cm (docs/change.md).
 TEST(OccupancyMap, RayShortcutLeavesFewHoles) {
   ASSERT_EQ(Config{}.ray_stop_after, 32) << "the default the figures below are for";
   for (const auto& [stop, most_holes] : {std::pair{16, 30u}, std::pair{32, 0u}}) {

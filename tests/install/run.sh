@@ -315,7 +315,7 @@ run_deb() {
   done
   check "left: the model directory /var/lib/scenewatch with the saved model" test -L /var/lib/scenewatch/current
   check "no scenewatch package left in dpkg's database" sh -c "! dpkg -l 'scenewatch*' 'python3-scenewatch' 2>/dev/null | grep -q '^[a-z][a-z] '"
-  # Left by design, not by the test: the user (README "Install on a robot"). This machine gets back
+  # Left by design, not by the test: the user (docs/install.md). This machine gets back
   # what it had before the test.
   [ "$had_state" -eq 0 ] && rm -rf /var/lib/scenewatch
   [ "$had_user" -eq 0 ] && userdel scenewatch 2>/dev/null || true

@@ -150,7 +150,7 @@ TEST(Relocalizer, PlacesTheHeldOutHalfOfTheKitchenWithoutAPrior) {
   for (const auto& [why, count] : reasons) std::cout << "  not placed, " << count << "x: " << why << "\n";
   // Measured: 47 of the 125 frames within 5 cm / 5 deg (37.6 %), none placed wrong, median error
   // 25.4 mm / 0.66 deg (the dense alignment's disagreement with the recording's poses at such
-  // baselines, README), 25-38 ms per relocalization. The model's 29 keyframes see little of what
+  // baselines, docs/localization.md), 25-38 ms per relocalization. The model's 29 keyframes see little of what
   // this half sees: of the 17 frames with a keyframe within 0.3 m / 20 deg, all 17 were placed
   // within 5 cm / 5 deg; the other frames mostly share too few features with any keyframe.
   EXPECT_GE(good, 45u);

@@ -1,7 +1,7 @@
 // Classification against ground truth: simulated objects of exactly known shape and size (the
 // simulator's labels pick their points, world frame, the table's normal is z), and real views
 // (../shared/data: the YCB cans, the PCL mug). Floors a little beyond the figures measured
-// (README, "Object classes").
+// (docs/ontology.md, "Object classes").
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -345,13 +345,13 @@ std::optional<MosdScene> load_mosd_scene(int n) {
 }
 
 // mOSD (../shared/data/mosd/learn): every labelled object of 500 points or more, described with
-// the table's normal (the segmentation's largest plane) as up. A survey printed for the README:
+// the table's normal (the segmentation's largest plane) as up. A survey printed for docs/ontology.md:
 // the dataset has no per-object category, only the scenes' (learn0-16 boxes, learn17-24 stacked
 // boxes, learn25-32 occluded objects, learn33-44 cylindric objects). Classes are not tuned to it.
 // Floors at what was measured: no object of the box scenes is a can or a cup, and 9 of the 38
 // objects of the cylindric scenes are (4 cans, 5 cups; most others are tins of r 90-100 mm, wider
 // than a can, or lying; learn38's two mugs stand upside down, their closed bases up, and are cans
-// for this view: ClassifyMosdMugs below, README "Primitive fitting").
+// for this view: ClassifyMosdMugs below, docs/ontology.md "Primitive fitting").
 TEST(ClassifyMosdSurvey, LabelledObjects) {
   SCENEWATCH_REQUIRE_DATA("mosd/learn/learn0.pcd");
   const ClassLibrary library = shipped_classes();

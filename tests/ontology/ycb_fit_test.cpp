@@ -80,7 +80,7 @@ class YcbFitTest : public ::testing::Test {
   void SetUp() override { SCENEWATCH_REQUIRE_DATA("ycb/frame-000003.depth.png"); }
 };
 
-// Tolerances a little above the errors measured (README, `scenewatch fit`): frame 3 -1.4 mm,
+// Tolerances a little above the errors measured (docs/ontology.md, "Primitive fitting"): frame 3 -1.4 mm,
 // frame 1 +1.0 mm, frame 4 -0.4 mm. Frame 1's can was 7.7 mm too wide while the points within a
 // few pixels of its silhouette and of the mustard bottle pulled the fit: the Xtion flattens the
 // depth there (FitConfig::edge_margin_deg); leaving them out costs frame 3 2.1 mm (+0.7 before)

@@ -85,7 +85,7 @@ TEST(Mosd, TableFoundAndObjectsRecalled) {
     std::printf("  %-18s recall %zu/%zu, precision %zu/%zu\n", names[g], by_group_matched[g], by_group_objects[g],
                 by_group_correct[g], by_group_clusters[g]);
   EXPECT_EQ(tables, scenes) << "the table plane must be found in every scene";
-  // Floors at what the run they were set on measured (README, "Segmentation"): recall and
+  // Floors at what the run they were set on measured (docs/testing.md, "Real data"): recall and
   // precision 111/112 = 0.991; boxes 38/38, stacked boxes 19/20, occluded objects 16/16 and
   // cylindric objects 38/38, each both ways (before the occlusion join fitted one profile to both
   // pieces: 110/112 and 110/115; Euclidean clusters alone: 0.821 / 0.773). What is left: a stack
@@ -235,7 +235,7 @@ TEST(Mosd, TestDevMixedScenesAndPiles) {
 }
 
 // Cuts at closed depth steps and colour edges (issue 30, item 1), both off by default: the same
-// split and scoring. Floors and ceilings are what was measured (README, "Objects in clutter"):
+// split and scoring. Floors and ceilings are what was measured (docs/clutter.md):
 // the depth-step cut changes no figure on test_dev (its steps almost never close around an
 // object-sized region); colour edges find 2 more objects in all (mixed +1 tuning, +2 held out;
 // piles -1 tuning) but make 34 more clusters.

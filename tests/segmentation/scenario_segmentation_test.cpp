@@ -79,7 +79,7 @@ SceneRun run_scenario(const std::string& name, int frame_step = 1, Config config
   return run;
 }
 
-// Floors sit at what this method reached when they were set (README, "Segmentation"): the big
+// Floors sit at what this method reached when they were set (docs/testing.md, "Simulator, exact labels"): the big
 // stack comes apart in every frame; the small box on the 5 cm flat box is often merged with it
 // (the flat box's front is less than three 2 cm patches high).
 TEST(ScenarioSegmentation, StackedBoxesComeApartAndRestOnEachOther) {

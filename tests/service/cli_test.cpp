@@ -444,7 +444,7 @@ TEST_F(CliTest, ReplayTellsTheStreamAndCountsIt) {
   EXPECT_NE(result.out.find("frame    0  2 objects:  #1 "), std::string::npos) << result.out;
 }
 
-// `ingest` takes the frame forms every other command takes (README, "Frames on the command line"):
+// `ingest` takes the frame forms every other command takes (docs/cli.md, "Frames on the command line"):
 // SEQDIR:N, SEQDIR:A-B and SEQDIR/frame-NNNNNN, not only whole folders and cloud files.
 TEST_F(CliTest, IngestTakesOneFrameOrARangeOfASequence) {
   const fs::path sample = source_dir() / "sample_clouds/tabletop";

@@ -26,7 +26,7 @@
 namespace scenewatch::localization {
 
 struct Config {
-  /// `given` by default: `refine` and `track` do not yet meet their accuracy on real data (README).
+  /// `given` by default: `refine` and `track` do not yet meet their accuracy on real data (docs/localization.md).
   LocalizationMode mode = LocalizationMode::kGiven;
   PyramidConfig pyramid;
   AlignmentConfig alignment;

@@ -32,7 +32,7 @@ struct FitConfig {
   NormalSearch normal_search = NormalSearch::kGrid;
   /// Objects with more valid points are subsampled to this many, evenly spaced, for the normals,
   /// the shape detection and the refinement (fit time stays bounded; 3000 keep the known cans'
-  /// radii within 0.5 mm of those from 6000, at about half the time: README, "Primitive fitting").
+  /// radii within 0.5 mm of those from 6000, at about half the time: docs/ontology.md, "Primitive fitting").
   int max_points = 3000;
   int min_points = 50;               ///< fewer valid points: an error, nothing to fit
   // Efficient RANSAC (CGAL::Shape_detection::Efficient_RANSAC::Parameters).
@@ -57,7 +57,7 @@ struct FitConfig {
   /// Points of an organized cloud (camera images) within this angle, seen from the sensor, of a
   /// depth discontinuity do not pull the refinement nor count as a vessel's inside wall (0: off):
   /// a structured-light sensor's correlation window straddles the edge there and biases their
-  /// depth towards the surface's interior, flattening the seen arc (README, "Primitive fitting").
+  /// depth towards the surface's interior, flattening the seen arc (docs/ontology.md, "Primitive fitting").
   /// An angle, as the window is a few of the sensor's own pixels whatever the image's resolution:
   /// 0.2 degrees are 4 pixels of YCB-Video's 1067 px focal length, 2 of a 525 px VGA camera's.
   double edge_margin_deg = 0.2;
