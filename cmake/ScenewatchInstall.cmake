@@ -29,6 +29,10 @@ install(DIRECTORY ${PROJECT_SOURCE_DIR}/sample_clouds/scenarios/ DESTINATION sha
 install(FILES ${PROJECT_SOURCE_DIR}/proto/scenewatch.proto DESTINATION share/scenewatch/proto COMPONENT runtime)
 install(FILES ${PROJECT_SOURCE_DIR}/README.md ${PROJECT_SOURCE_DIR}/CHANGELOG.md ${PROJECT_SOURCE_DIR}/docs/protocol.md
         DESTINATION share/doc/scenewatch COMPONENT runtime)
+# The README is a door to docs/: its pages and pictures go beside it, so its links resolve on a
+# robot too (share/doc/scenewatch/docs/events.md, ...).
+install(DIRECTORY ${PROJECT_SOURCE_DIR}/docs/ DESTINATION share/doc/scenewatch/docs COMPONENT runtime
+        FILES_MATCHING PATTERN "*.md" PATTERN "*.png")
 install(FILES ${PROJECT_SOURCE_DIR}/packaging/copyright DESTINATION share/doc/scenewatch COMPONENT runtime)
 # The live view's page is compiled into scenewatchd (lib/service embeds web/live_view.html); its one
 # asset, three.js, is Debian's libjs-three (server.http_three_js), which the package recommends.

@@ -239,7 +239,8 @@ run_deb() {
   dpkg-deb --contents "$runtime" >"$work/runtime.contents"
   sed 's/^/     /' "$work/runtime.contents"
   for f in ./usr/bin/scenewatchd ./etc/scenewatch/scenewatchd.yaml ./lib/systemd/system/scenewatchd.service \
-           ./usr/share/doc/scenewatch/copyright ./usr/share/scenewatch/proto/scenewatch.proto; do
+           ./usr/share/doc/scenewatch/copyright ./usr/share/scenewatch/proto/scenewatch.proto \
+           ./usr/share/doc/scenewatch/README.md ./usr/share/doc/scenewatch/docs/events.md; do
     check "scenewatch holds $f" grep -q " $f\$" "$work/runtime.contents"
   done
   check "conffiles list /etc/scenewatch/scenewatchd.yaml" sh -c "dpkg-deb --ctrl-tarfile '$runtime' | tar -xO ./conffiles | grep -qx /etc/scenewatch/scenewatchd.yaml"
