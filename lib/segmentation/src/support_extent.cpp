@@ -83,7 +83,7 @@ bool has_pieces(const CellGrid& grid) {
 std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
                                 const PlaneGrid& plane, const std::vector<int>& standing,
                                 const std::optional<Eigen::Vector3d>& sensor_origin, double min_height_m,
-                                double max_height_m) {
+                                double max_height_m, const std::function<double(double range_m)>& noise_floor_m) {
   CellGrid grid(plane);
   std::vector<int> voxel_cell(inliers.size());
   for (std::size_t i = 0; i < inliers.size(); ++i) voxel_cell[i] = grid.add(centroids[inliers[i]].cast<double>());
@@ -99,6 +99,8 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
       const Eigen::Vector3d q = centroids[w].cast<double>();
       const double h = plane.n.dot(q) + plane.d;
       if (h <= min_height_m || h > max_height_m || h >= o_height) continue;
+      // Within the sensor's noise of the plane (far floors), a voxel is the plane and hides nothing.
+      if (h < noise_floor_m((q - o).norm())) continue;
       // Only what stands on the visible support hides it: its foot is at a visible cell.
       if (!visible.near(q - h * plane.n)) continue;
       const std::uint64_t key = grid.key(q);

@@ -4,8 +4,10 @@
 // visible table falls into pieces around the pile; the pieces are one support when the table
 // continues, hidden, between them. The hidden cells are those each object voxel covers: from its
 // foot on the plane to where the ray from the sensor through it meets the plane (its shadow).
+// A voxel within the sensor's noise of the plane is the plane itself and hides nothing.
 #include <Eigen/Core>
 
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -21,10 +23,10 @@ struct PlaneGrid {
 /// The largest 8-connected group of the inlier voxels (indices into `centroids`) on the plane's
 /// grid, with cells hidden from `sensor_origin` counted as connecting (not as inliers) when
 /// `sensor_origin` is given: hidden by the voxels `standing`, those at a height above the plane
-/// in (min_height_m, max_height_m].
+/// in (min_height_m, max_height_m] and above noise_floor_m(their range from the sensor).
 std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
                                 const PlaneGrid& plane, const std::vector<int>& standing,
                                 const std::optional<Eigen::Vector3d>& sensor_origin, double min_height_m,
-                                double max_height_m);
+                                double max_height_m, const std::function<double(double range_m)>& noise_floor_m);
 
 }  // namespace scenewatch::segmentation

@@ -338,8 +338,9 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
     std::optional<Eigen::Vector3d> viewpoint;
     if (cfg.bridge_hidden_support && cloud.height > 1) viewpoint = sensor_origin;
     const PlaneGrid plane_grid{model.n, frame.u, frame.v, model.d, cfg.plane_connectivity_m};
-    const std::vector<int> part = support_extent(centroids, inliers, plane_grid, remaining, viewpoint, cfg.plane_distance_m,
-                                                 cfg.max_object_height_m);
+    const std::vector<int> part =
+        support_extent(centroids, inliers, plane_grid, remaining, viewpoint, cfg.plane_distance_m, cfg.max_object_height_m,
+                       [&cfg](double range_m) { return object_height_threshold(cfg, range_m); });
     std::vector<Vec2> pts2;
     pts2.reserve(part.size());
     for (int v : part) {
