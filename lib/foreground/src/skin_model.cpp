@@ -62,4 +62,12 @@ std::vector<std::uint8_t> skin_mask(const Cloud& cloud, const std::vector<int>& 
   return skin_mask(rgb, static_cast<int>(indices.size()), 1);
 }
 
+bool mostly_skin(const Cloud& cloud, const std::vector<int>& indices) {
+  if (indices.empty()) return false;
+  const auto skin = skin_mask(cloud, indices);
+  std::size_t n = 0;
+  for (auto v : skin) n += v ? 1 : 0;
+  return 2 * n > indices.size();
+}
+
 }  // namespace scenewatch::foreground

@@ -15,4 +15,7 @@ std::vector<std::uint8_t> skin_mask(const std::vector<std::uint8_t>& rgb, int wi
 /// The same for the points `indices` of a cloud: 1 per index whose colour is skin, in their order.
 std::vector<std::uint8_t> skin_mask(const Cloud& cloud, const std::vector<int>& indices);
 
+/// True when most of the points `indices` of a cloud (more than half) have skin colour.
+bool mostly_skin(const Cloud& cloud, const std::vector<int>& indices);
+
 }  // namespace scenewatch::foreground

@@ -8,6 +8,8 @@
 #include <Eigen/Eigenvalues>
 #include <opencv2/imgproc.hpp>
 
+#include "scenewatch/core/plane_fit.h"
+
 namespace scenewatch::foreground {
 namespace {
 
@@ -36,21 +38,14 @@ bool plane_through(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const Eig
   return true;
 }
 
-/// Least-squares plane through the points (smallest eigenvector of their covariance).
+/// Least-squares plane through the points (plane_fit.h). The solver's normal is taken as it is,
+/// not normalized again (segmentation's supports normalize theirs).
 bool refit(const std::vector<Eigen::Vector3f>& points, const std::vector<int>& members, SupportPlane* plane) {
   if (members.size() < 3) return false;
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int i : members) mean += points[i].cast<double>();
-  mean /= static_cast<double>(members.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (int i : members) {
-    const Eigen::Vector3d q = points[i].cast<double>() - mean;
-    cov += q * q.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
-  const Eigen::Vector3d n = solver.eigenvectors().col(0);
+  const PlaneFit fit = fit_plane_least_squares(points, members);
+  const Eigen::Vector3d& n = fit.normal;
   plane->normal = n.cast<float>();
-  plane->d = static_cast<float>(-n.dot(mean));
+  plane->d = static_cast<float>(-n.dot(fit.mean));
   return true;
 }
 

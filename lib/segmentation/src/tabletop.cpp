@@ -7,8 +7,6 @@
 //  3. convex hull of each plane (Andrew's monotone chain in the plane's 2D basis);
 //  4. voxels in the prism above a hull are clustered (Euclidean, union-find over grid
 //     neighbours), and every input point of a cluster voxel at object height joins the object.
-#include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -16,6 +14,7 @@
 #include <random>
 
 #include "scenewatch/segmentation/tabletop.h"
+#include "scenewatch/core/plane_fit.h"
 #include "boundary_cut.h"
 #include "colour_edges.h"
 #include "containers.h"
@@ -40,20 +39,12 @@ struct PlaneModel {
   double distance(const Eigen::Vector3f& p) const { return n.dot(p.cast<double>()) + d; }
 };
 
-// Least-squares plane through points (smallest eigenvector of the covariance).
+// Least-squares plane through points (plane_fit.h), its normal normalized.
 PlaneModel fit_plane(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& ids) {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (int v : ids) mean += centroids[v].cast<double>();
-  mean /= static_cast<double>(ids.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (int v : ids) {
-    const Eigen::Vector3d q = centroids[v].cast<double>() - mean;
-    cov += q * q.transpose();
-  }
-  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(cov);
+  const PlaneFit fit = fit_plane_least_squares(centroids, ids);
   PlaneModel m;
-  m.n = es.eigenvectors().col(0).normalized();
-  m.d = -m.n.dot(mean);
+  m.n = fit.normal.normalized();
+  m.d = -m.n.dot(fit.mean);
   return m;
 }
 
