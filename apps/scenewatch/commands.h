@@ -157,6 +157,8 @@ struct ReplayOptions {
   std::string localization;         ///< overrides localization.mode: given, refine or track (empty: the config's)
   std::string trajectory;           ///< when set: the poses the memory used, as a TUM trajectory
   bool objects = false;             ///< after each frame, the object list a planner would get
+  bool classes = false;             ///< with objects: each object's class and score (the ontology)
+  std::string classes_file;         ///< the classes for `classes` (empty: the shipped ontology.yaml)
 };
 /// Offline: recordings through the working memory as the daemon would run them; prints the
 /// event stream and a summary (events per 100 frames, time per frame and per stage).

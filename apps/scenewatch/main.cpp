@@ -285,6 +285,7 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  scenewatch replay ../shared/data/redkitchen\n"
       "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json\n"
+      "  scenewatch replay ../shared/data/pcl/table_scene_mug_stereo_textured.pcd --objects --classes\n"
       "  scenewatch replay rgbd_dataset_freiburg1_xyz          (a TUM RGB-D folder: rgb.txt, depth.txt, groundtruth.txt)\n"
       "  scenewatch replay ../shared/data/ycb --depth-scale 0.0001   (depth in units of 0.1 mm)\n"
       "  scenewatch replay kitchen.bag:0-99 --depth-topic /camera/aligned_depth_to_color/image_raw   (a ROS bag)\n"
@@ -309,8 +310,17 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"given", "refine", "track"}));
   replay->add_option("--trajectory", replay_options.trajectory,
                      "write the poses the memory used (aligned frames) as a TUM trajectory: t tx ty tz qx qy qz qw");
-  replay->add_flag("--objects", replay_options.objects,
-                   "after each frame, the object list a planner would get (GetObjects): id, size, points, sightings");
+  auto* objects_flag = replay->add_flag("--objects", replay_options.objects,
+                                        "after each frame, the object list a planner would get (GetObjects): id, size, "
+                                        "points, sightings");
+  auto* classes_flag =
+      replay->add_flag("--classes", replay_options.classes,
+                       "with --objects: each object's class and score, as GetObjects with describe gives them (the "
+                       "ontology; an object is described again when seen again and its description is older than 2 s)")
+          ->needs(objects_flag);
+  replay->add_option("--classes-file", replay_options.classes_file,
+                     "the object classes for --classes (default: the shipped ontology.yaml, in /etc/scenewatch when installed)")
+      ->needs(classes_flag);
   bool scenario_check = false;
   RemoteOptions scenario_remote;
   replay->add_flag("--check", scenario_check, "scenario scripts: exit 1 when an expectation is not met");

@@ -13,10 +13,12 @@
 #include "commands.h"
 #include "config_file.h"
 #include "frame_spec.h"
+#include "install_layout.h"
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/core/event_json.h"
 #include "scenewatch/io/image_io.h"
 #include "scenewatch/io/rgbd.h"
+#include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/pipeline/working_memory.h"
 
 namespace scenewatch::cli {
@@ -51,16 +53,25 @@ std::string event_line(std::size_t frame, const Event& e, double range_m) {
   return line;
 }
 
-// The object list after a frame, as GetObjects gives it: one line, or one JSON object.
-void print_objects(std::size_t frame, const pipeline::SceneSnapshot& snapshot, bool json) {
+using Described = std::vector<std::shared_ptr<const pipeline::ObjectClassInfo>>;
+
+// The object list after a frame, as GetObjects gives it: one line, or one JSON object. `described`:
+// empty, or one class per object (WorkingMemory::describe_objects; null: an object without points).
+void print_objects(std::size_t frame, const pipeline::SceneSnapshot& snapshot, const Described& described, bool json) {
+  const auto described_as = [&](std::size_t k) { return k < described.size() ? described[k].get() : nullptr; };
   if (json) {
     nlohmann::json list = nlohmann::json::array();
-    for (const auto& o : snapshot.objects) {
+    for (std::size_t k = 0; k < snapshot.objects.size(); ++k) {
+      const TrackedObject& o = snapshot.objects[k];
       const Eigen::Vector3d& c = o.cluster.centroid;
       const Eigen::Vector3d& e = o.cluster.box.extents;
       list.push_back({{"id", o.id}, {"centroid", {c.x(), c.y(), c.z()}}, {"extents", {e.x(), e.y(), e.z()}},
                       {"points", o.cluster.point_count}, {"observations", o.observations}, {"plane", o.cluster.plane_id},
                       {"foreground", o.foreground.has_value()}});
+      if (const auto* info = described_as(k)) {
+        list.back()["class"] = info->class_name;
+        list.back()["score"] = info->score;
+      }
     }
     nlohmann::json planes = nlohmann::json::array();
     for (const auto& p : snapshot.planes) {
@@ -73,10 +84,12 @@ void print_objects(std::size_t frame, const pipeline::SceneSnapshot& snapshot, b
     return;
   }
   std::printf("frame %4zu  %zu objects:", frame, snapshot.objects.size());
-  for (const auto& o : snapshot.objects) {
+  for (std::size_t k = 0; k < snapshot.objects.size(); ++k) {
+    const TrackedObject& o = snapshot.objects[k];
     const Eigen::Vector3d& e = o.cluster.box.extents;
     std::printf("  #%llu %.0fx%.0fx%.0f cm %zu pts %d seen%s", static_cast<unsigned long long>(o.id), 100 * e.x(), 100 * e.y(),
                 100 * e.z(), o.cluster.point_count, o.observations, o.foreground ? " fg" : "");
+    if (const auto* info = described_as(k)) std::printf(" %s (score %.2f)", info->class_name.c_str(), info->score);
   }
   std::printf("\n");
 }
@@ -130,6 +143,15 @@ int run_replay(const ReplayOptions& options) {
     std::filesystem::create_directories(options.heatmap_dir, ec);
     if (ec) return fail("--heatmaps '" + options.heatmap_dir + "': " + ec.message());
   }
+  // --classes: the daemon's classes file (no store: nothing learnt is kept).
+  std::unique_ptr<ontology::ClassCatalog> classes;
+  if (options.classes) {
+    const auto classes_file =
+        options.classes_file.empty() ? apps::config_dir() / "ontology.yaml" : std::filesystem::path(options.classes_file);
+    auto catalog = ontology::ClassCatalog::open(classes_file, {});
+    if (!catalog) return fail("--classes: " + catalog.error().message);
+    classes = std::move(*catalog);
+  }
   pipeline::WorkingMemory memory(*config);
   std::size_t frames = 0, total_events = 0, frames_with_hands = 0;
   std::map<std::string, std::size_t> by_kind;
@@ -181,7 +203,11 @@ int run_replay(const ReplayOptions& options) {
           std::cout << event_line(frames, e, range_from_camera(frame, e)) << "\n";
         }
       }
-      if (options.objects) print_objects(frames, *memory.snapshot(), options.json);
+      if (options.objects) {
+        const auto snapshot = memory.snapshot();
+        const Described described = classes ? memory.describe_objects(*snapshot, *classes) : Described{};
+        print_objects(frames, *snapshot, described, options.json);
+      }
       ++frames;
       if (options.progress && !options.json && frames % 25 == 0) {
         std::cerr << "  " << frames << " frames, " << total_events << " events\n";

@@ -444,6 +444,42 @@ TEST_F(CliTest, ReplayTellsTheStreamAndCountsIt) {
   EXPECT_NE(result.out.find("frame    0  2 objects:  #1 "), std::string::npos) << result.out;
 }
 
+// --classes: the object list with each object's class, from the pipeline's describer (no daemon).
+TEST_F(CliTest, ReplayShowsTheClassesOfTheObjects) {
+  SCENEWATCH_REQUIRE_DATA(kMug);
+  const std::string mug = (data_dir() / kMug).string();
+  auto result = cli({"replay", mug, "--objects", "--classes", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  std::istringstream lines(result.out);
+  std::string first;
+  ASSERT_TRUE(std::getline(lines, first));
+  const json list = parse(first);
+  ASSERT_GE(list.at("objects").size(), 1u) << first;
+  json largest;
+  for (const auto& o : list.at("objects")) {
+    ASSERT_TRUE(o.contains("class")) << o.dump();
+    if (largest.is_null() || o.at("points").get<int>() > largest.at("points").get<int>()) largest = o;
+  }
+  EXPECT_EQ(largest.at("class"), "cup") << first;
+  EXPECT_GT(largest.at("score").get<double>(), 0.5) << first;
+  // The text line names the class after each object.
+  result = cli({"replay", mug, "--objects", "--classes"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_NE(result.out.find(" seen cup (score 0."), std::string::npos) << result.out;
+  // Without --classes, no class.
+  result = cli({"replay", mug, "--objects", "--json"});
+  ASSERT_EQ(result.exit_code, 0) << result.err;
+  EXPECT_EQ(result.out.find("\"class\""), std::string::npos) << result.out;
+  // --classes needs --objects; a bad classes file is named.
+  result = cli({"replay", mug, "--classes"});
+  EXPECT_EQ(result.exit_code, 2) << "usage error";
+  EXPECT_NE(result.err.find("--objects"), std::string::npos) << result.err;
+  std::ofstream(tmp_ / "bad.yaml") << "classes:\n  - {name: x, shape: torus}\n";
+  result = cli({"replay", mug, "--objects", "--classes", "--classes-file", (tmp_ / "bad.yaml").string()});
+  EXPECT_EQ(result.exit_code, 1);
+  EXPECT_NE(result.err.find("bad.yaml: classes[0] (x).shape: 'torus'"), std::string::npos) << result.err;
+}
+
 // `ingest` takes the frame forms every other command takes (docs/cli.md, "Frames on the command line"):
 // SEQDIR:N, SEQDIR:A-B and SEQDIR/frame-NNNNNN, not only whole folders and cloud files.
 TEST_F(CliTest, IngestTakesOneFrameOrARangeOfASequence) {

@@ -18,6 +18,7 @@
 #include "known_surfaces.h"
 #include "map_stage.h"
 #include "model_store.h"
+#include "object_describer.h"
 #include "object_observations.h"
 #include "segmentation_stage.h"
 #include "timing.h"
@@ -70,6 +71,7 @@ struct WorkingMemory::Impl {
 
   std::shared_ptr<const SceneSnapshot> snapshot;  // read and written with std::atomic_load/store
   KnownSurfaces known;                            // of described objects (set_known_surface)
+  ObjectDescriber describer{known};               // the ontology, on request; locks itself
   EventLog events;
   std::optional<Eigen::Vector3d> up;  // the configured up direction (segmentation.up_vector)
 
@@ -391,6 +393,12 @@ Status WorkingMemory::write_mesh(const fs::path& path) const { return impl_->app
 
 void WorkingMemory::set_known_surface(std::uint64_t object_id, const Eigen::Vector3d& centroid_world, surprise::KnownSurface surface) {
   impl_->known.set(object_id, centroid_world, std::move(surface));
+}
+
+std::vector<std::shared_ptr<const ObjectClassInfo>> WorkingMemory::describe_objects(const SceneSnapshot& snapshot,
+                                                                                    const ontology::ClassCatalog& classes,
+                                                                                    const DescribedCallback& on_described) {
+  return impl_->describer.describe(snapshot, classes, on_described);
 }
 
 }  // namespace scenewatch::pipeline

@@ -46,7 +46,7 @@ void to_proto(const ontology::ObjectClass& c, const ontology::LearntMotions* lea
   out->set_description(c.description);
 }
 
-void to_proto(const ontology::ObjectDescription& d, proto::ObjectClassInfo* out) {
+void to_proto(const pipeline::ObjectClassInfo& d, proto::ObjectClassInfo* out) {
   out->set_class_name(d.class_name);
   out->set_score(d.score);
   if (d.primitive) {

@@ -5,8 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <exception>
-#include <map>
-#include <mutex>
 #include <optional>
 
 #include <google/protobuf/util/json_util.h>
@@ -15,7 +13,6 @@
 #include "localization_notices.h"
 #include "next_best_view_call.h"
 #include "ontology_convert.h"
-#include "scenewatch/ontology/describe.h"
 #include "proto_convert.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/core/files.h"
@@ -451,57 +448,32 @@ struct RequestHandler::Impl {
 
   Status get_objects(const proto::GetObjects& msg, proto::Response& response) {
     const auto snapshot = memory.snapshot();
+    const bool describe = msg.describe() && config.classes;
+    std::vector<std::shared_ptr<const pipeline::ObjectClassInfo>> described;
+    if (describe) {
+      described = memory.describe_objects(*snapshot, *config.classes,
+                                          [this](const TrackedObject& object, const pipeline::ObjectClassInfo& info) {
+                                            record(object, info);
+                                          });
+    }
     auto* out = response.mutable_objects();
     out->set_frames_processed(snapshot->frames_processed);
-    for (const auto& object : snapshot->objects) {
+    for (std::size_t k = 0; k < snapshot->objects.size(); ++k) {
       auto* o = out->add_objects();
-      convert::to_proto(object, o);
-      if (msg.describe() && config.classes) describe(*snapshot, object, o->mutable_ontology());
+      convert::to_proto(snapshot->objects[k], o);
+      if (!describe) continue;
+      auto* ontology = o->mutable_ontology();  // present, empty for an object without points
+      if (described[k]) convert::to_proto(*described[k], ontology);
     }
     return {};
-  }
-
-  // The ontology's description of one object, cached per object: described again only when it was
-  // seen again (new points) and its description is older than kDescribeAgainS.
-  void describe(const pipeline::SceneSnapshot& snapshot, const TrackedObject& object, proto::ObjectClassInfo* out) {
-    const std::uint64_t id = object.id;
-    const auto points = snapshot.points.find(id);
-    if (points == snapshot.points.end() || !points->second) return;
-    const double now = std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-    std::lock_guard<std::mutex> lock(described_mutex);
-    auto& cached = described[id];
-    const bool fresh = cached.points == points->second.get() || now - cached.at_s < kDescribeAgainS;
-    if (!fresh || !cached.info) {
-      ontology::DescribeConfig dc;  // the completed surface goes to the expected view, not on the wire
-      // Up is the normal of the plane the object stands on, turned towards the camera.
-      Eigen::Vector3d up = snapshot.up_world;
-      for (const auto& plane : snapshot.planes) {
-        if (plane.id != object.cluster.plane_id || object.foreground) continue;
-        up = plane.normal_towards(snapshot.camera_world);
-      }
-      auto d = ontology::describe(*points->second, up, config.classes->library(), snapshot.camera_world, dc);
-      cached.info = std::make_shared<proto::ObjectClassInfo>();
-      if (d) convert::to_proto(*d, cached.info.get());
-      else cached.info->set_class_name(ontology::kUnknownClass);
-      cached.points = points->second.get();
-      cached.at_s = now;
-      record(object, *cached.info);
-      // The completed primitive predicts the object's unseen side in later frames' expected view
-      // (none for unknown objects: that removes an earlier one).
-      surprise::KnownSurface surface;
-      if (d) surface.points_world = std::move(d->completed_points);
-      surface.spacing_m = dc.completion_spacing_m;
-      surface.rgb = object.cluster.mean_rgb;
-      surface.rgb_covariance = object.cluster.rgb_covariance;
-      memory.set_known_surface(id, object.cluster.centroid, std::move(surface));
-    }
-    *out = *cached.info;
   }
 
   // Each new description is an instance seen (class, the fitted primitive as JSON, when the object
   // was last seen); a handled object's learnt free DoFs also teach its class's motions. The catalog
   // queues the writes for its own thread: nothing here waits for the disk.
-  void record(const TrackedObject& object, const proto::ObjectClassInfo& info) {
+  void record(const TrackedObject& object, const pipeline::ObjectClassInfo& described) {
+    proto::ObjectClassInfo info;
+    convert::to_proto(described, &info);
     ontology::InstanceRecord instance;
     instance.class_name = info.class_name();
     instance.time_s = object.last_seen_s;
@@ -593,15 +565,6 @@ struct RequestHandler::Impl {
     response.mutable_save_model()->set_model_dir(config.model_dir.string());
     return {};
   }
-
-  struct Described {
-    const void* points = nullptr;  // the snapshot's points it was made from
-    double at_s = 0;
-    std::shared_ptr<proto::ObjectClassInfo> info;
-  };
-  static constexpr double kDescribeAgainS = 2.0;
-  std::mutex described_mutex;
-  std::map<std::uint64_t, Described> described;
 
   Status require_classes() const {
     if (!config.classes) return unavailable("this server has no object classes loaded");

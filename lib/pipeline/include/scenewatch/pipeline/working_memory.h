@@ -28,8 +28,13 @@
 // What users of the facade's API take from it, each in a header of its own.
 #include "scenewatch/pipeline/config.h"
 #include "scenewatch/pipeline/frame_result.h"
+#include "scenewatch/pipeline/object_class_info.h"
 #include "scenewatch/pipeline/scene_snapshot.h"
 #include "scenewatch/pipeline/surprise_result.h"
+
+namespace scenewatch::ontology {
+class ClassCatalog;
+}  // namespace scenewatch::ontology
 
 namespace scenewatch::pipeline {
 
@@ -133,6 +138,17 @@ class WorkingMemory {
   /// it was when described); a newer surface of the same object replaces it, an empty one removes
   /// it. Not saved with the model. Thread safe.
   void set_known_surface(std::uint64_t object_id, const Eigen::Vector3d& centroid_world, surprise::KnownSurface surface);
+
+  /// The ontology's description of each object of `snapshot` (one of this memory's snapshots) by
+  /// the classes of `classes`: one entry per snapshot.objects, in that order; null for an object
+  /// without points. Run on request, never by process(). Cached per object: described again only
+  /// when it was seen again (new points) and its description is older than 2 s. A new description
+  /// makes the completed primitive the object's known surface (set_known_surface; an unknown
+  /// object's is removed) and is handed to `on_described`, under the describer's lock: keep it
+  /// quick. Thread safe: one object is described at a time; beside process() and the queries.
+  std::vector<std::shared_ptr<const ObjectClassInfo>> describe_objects(const SceneSnapshot& snapshot,
+                                                                       const ontology::ClassCatalog& classes,
+                                                                       const DescribedCallback& on_described = {});
 
   const Config& config() const { return config_; }
 
