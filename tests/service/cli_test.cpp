@@ -321,11 +321,12 @@ TEST_F(CliTest, IngestLiveKeepsUpWithTheNewestFrame) {
   std::printf("--live 1000 on 50 kitchen frames: %s\n", last.c_str());
   EXPECT_EQ(summary.at("sent").get<int>(), 50);
   EXPECT_EQ(summary.at("processed").get<int>() + summary.at("skipped").get<int>(), 50);
-  // The CLI reads and decodes a kitchen frame in about 30 ms, the daemon with a 1 cm map takes
-  // well over that: measured 40-41 skipped alone, 39 with a second copy of this test beside it on
-  // the two cores (the ratio of the two, not the daemon, sets it). Queueing every frame would skip
-  // none.
-  EXPECT_GE(summary.at("skipped").get<int>(), 35) << "frames arrive faster than a room frame is processed";
+  // The CLI reads and decodes a kitchen frame faster than the daemon with a 1 cm map processes one,
+  // so most frames are skipped; queueing every frame would skip none. How many depends on the ratio
+  // of the two speeds, which differs between machines: 39-41 of 50 on earlier machines, 30-35 on
+  // the machine of 2026-11-27, both before and after that day's changes. The floor is "most":
+  // more than half.
+  EXPECT_GT(summary.at("skipped").get<int>(), 25) << "frames arrive faster than a room frame is processed";
   auto stats = remote({"stats", "--json"});
   ASSERT_EQ(stats.exit_code, 0) << stats.err;
   EXPECT_EQ(parse(stats.out).at("frames_processed").get<int>(), summary.at("processed").get<int>());
