@@ -61,9 +61,10 @@ struct Config {
   /// A pile cuts the visible table into pieces; bridge them through the cells the objects standing
   /// on it hide from the sensor, so everything on the table is on one support (one view only).
   /// Off by default: on mOSD's piles it finds 33 of 44 objects instead of 22 (tuning scenes), but
-  /// it also bridges a floor under a table and the pieces of a stereo camera's holey table, which
-  /// changed the segmentation of PCL's stereo mug scene, the simulator's tabletop and the
-  /// foreground tracking on simulated carries (tests that pass with it off).
+  /// it also bridges a real floor under a table (YCB's frames: a large false object on the floor)
+  /// and changes hrt1's object list and the foreground tracking on simulated carries (tests that
+  /// pass with it off; docs/clutter.md). Voxels within the sensor's noise of the plane do not
+  /// bridge it (the simulator's far floor did before).
   bool bridge_hidden_support = false;
   /// The depth camera (the pipeline's `sensor` section): its noise at each range and incidence
   /// decides what is a depth step (split_depth_steps).
