@@ -125,8 +125,8 @@ TEST(AppearancePipeline, CupAddedIsOneEventWithTheSurpriseAsEvidence) {
   EXPECT_EQ(none.error().code, ErrorCode::kNotFound);
 }
 
-// A described object's completed surface (WorkingMemory::set_known_surface, which the daemon's
-// GetObjects { describe } feeds with the ontology's completion) enters the expected view of later
+// A described object's completed surface (WorkingMemory::set_known_surface, which the pipeline's
+// describer feeds with the ontology's completion on GetObjects { describe }) enters the expected view of later
 // frames: a can seen from the front, then from 90 degrees to its side, where the keyframe's mesh
 // lacks its side. Here the surface is the can's true cylinder (the ontology's part is measured in
 // ontology_test's CompletionInTheExpectedView); an id that is not in the scene contributes nothing.

@@ -50,6 +50,13 @@ TEST(ObjectDescriberTest, AWorkingMemoryDescribesARealMugAsACup) {
   EXPECT_TRUE(told.empty());
   ASSERT_EQ(again.size(), described.size());
   for (std::size_t k = 0; k < again.size(); ++k) EXPECT_EQ(again[k], described[k]) << "object " << k;
+
+  // A reset forgets the known surfaces the descriptions made, and the descriptions with them:
+  // asked again at once, every object is described anew (ids are reused after a reset).
+  memory.reset();
+  told.clear();
+  memory.describe_objects(*snapshot, **classes, tell);
+  EXPECT_EQ(told.size(), with_points) << "the cache must not outlive a reset";
 }
 
 }  // namespace

@@ -17,6 +17,11 @@ std::vector<std::shared_ptr<const ObjectClassInfo>> ObjectDescriber::describe(co
   return out;
 }
 
+void ObjectDescriber::clear() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  described_.clear();
+}
+
 // Cached per object: described again only when it was seen again (new points) and its description
 // is older than kDescribeAgainS.
 std::shared_ptr<const ObjectClassInfo> ObjectDescriber::describe(const SceneSnapshot& snapshot, const TrackedObject& object,

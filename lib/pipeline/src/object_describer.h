@@ -26,6 +26,8 @@ class ObjectDescriber {
   std::vector<std::shared_ptr<const ObjectClassInfo>> describe(const SceneSnapshot& snapshot,
                                                                const ontology::ClassCatalog& classes,
                                                                const DescribedCallback& on_described);
+  /// Forgets every description (Reset clears the known surfaces they made: describe again).
+  void clear();
 
  private:
   std::shared_ptr<const ObjectClassInfo> describe(const SceneSnapshot& snapshot, const TrackedObject& object,

@@ -274,6 +274,7 @@ void WorkingMemory::reset() {
   m.appearance.reset();
   m.localizer.reset();
   m.known.clear();
+  m.describer.clear();  // its cache made those surfaces: a reused id is described anew
   m.tracker.reset();
   m.fusion.reset();
   m.foreground.reset();
