@@ -51,8 +51,9 @@ int run_ingest(const RemoteOptions& options, const std::vector<std::string>& pat
                const std::optional<double>& depth_scale_m, const std::string& trajectory_path = {},
                const io::BagOptions& bag = {});
 /// Sequence folders streamed as a live sensor would: `fps` frames per second without waiting for
-/// replies, each frame marked live (the daemon skips frames it cannot keep up with).
-int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps,
+/// replies, each frame marked live (the daemon skips frames it cannot keep up with). With `preload`
+/// every frame is decoded before the first is sent, so the send rate is not bounded by decoding.
+int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>& paths, double fps, bool preload,
                     const std::optional<double>& depth_scale_m, const io::BagOptions& bag = {});
 int run_planes(const RemoteOptions& options);
 /// `describe`: with each object's class, primitive and grasps (the ontology).
