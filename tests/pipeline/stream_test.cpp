@@ -39,8 +39,11 @@ void print_event(const std::string& name, const StreamEvent& s) {
 
 // `pose_noise`: the simulated sensor reports each frame's pose with this much noise (metres,
 // degrees; 1 sigma, independent per frame), as odometry or an arm's kinematics would.
+// `camera_per_phase`: each phase's frames come from a camera of their own (one camera joins after
+// each change), as two `scenewatch ingest` runs without --camera send them.
 SequenceRun run_scenario(const std::string& name, int frames, int width, int height,
-                         LocalizationMode mode = LocalizationMode::kGiven, std::pair<double, double> pose_noise = {0, 0}) {
+                         LocalizationMode mode = LocalizationMode::kGiven, std::pair<double, double> pose_noise = {0, 0},
+                         bool camera_per_phase = false) {
   SequenceRun run;
   auto loaded = sim::load_scenario(test::source_dir() / "sample_clouds/scenarios" / (name + ".yaml"));
   EXPECT_TRUE(loaded.ok());
@@ -62,6 +65,7 @@ SequenceRun run_scenario(const std::string& name, int frames, int width, int hei
       auto frame = sim::as_frame(simulator->render(phase, f), scenario.intrinsics, stamp += 1.0 / 30);
       EXPECT_TRUE(frame.ok());
       if (!frame.ok()) return run;
+      if (camera_per_phase) frame->camera = "camera" + std::to_string(phase);
       auto result = memory.process(*frame);
       EXPECT_TRUE(result.ok());
       if (!result.ok()) return run;
@@ -134,6 +138,24 @@ TEST(Stream, EachChangeIsOneEventAtTheRightPlaceWithinFiveFrames) {
     EXPECT_EQ(s.found, s.truths) << name << ": the change was told";
     EXPECT_EQ(s.events, s.truths) << name << ": one fact, one event, and nothing else";
     EXPECT_LE(s.worst_delay, 5) << name;
+  }
+}
+
+TEST(Stream, ACameraThatJoinsAfterTheChangeTellsItAsTheFirstWould) {
+  // The frames after the change come from a camera that has not seen the scene before. It sees the
+  // cup in front of a table only the first camera saw; that table is hidden, not displaced (two
+  // cameras' versions of a surface lie within their tolerances of each other), so the cup is an
+  // addition, not only an appearance change (as it was before the displacement was bounded). A
+  // moved object is told as an addition where it went: its old spot is a surface only the first
+  // camera saw, and a camera claims removals only of surfaces it saw itself (seen through by
+  // another camera, a surface is as often a reflection or a hole: 4 more false removals in the two
+  // kitchen cameras below when the new camera could claim them beyond the same bound).
+  for (const char* name : {"cup_added"}) {
+    const SequenceRun run = run_scenario(name, 12, 320, 240, LocalizationMode::kGiven, {0, 0}, true);
+    const Score s = score(run);
+    print(std::string(name) + ", a new camera after the change", s, run);
+    EXPECT_EQ(s.found, s.truths) << name;
+    EXPECT_EQ(s.events, s.truths) << name;
   }
 }
 
@@ -249,8 +271,12 @@ TEST(Stream, TwoCamerasOnOneRoomInterleaved) {
   const auto events = run_recording(test::data_dir() / "redkitchen_long", order, cameras);
   std::printf("redkitchen_long two cameras interleaved: %zu events in 200 frames\n", events.size());
   // 3 measured before the noise along the ray counted the incidence (change.incidence_aware), 1
-  // since (0.5 per 100 frames; the issue asks at most 1).
-  EXPECT_LE(events.size(), 1u);
+  // since; 2 (1 per 100 frames, the issue's bound) since a surface only the other camera saw stops
+  // a claim only as far behind as a displaced version of it could lie (so that a camera joining
+  // after a change can tell an addition): an OBJECT_ADDED of 36 points at 2.2 m, 14-20 cm in front
+  // of camera b's surface. Other interleavings, not tuned on: files 0-248 with 250-498 either way
+  // round, 2 events before and after; files 80-198 with 380-498, 0 before and after.
+  EXPECT_LE(events.size(), 2u);
 }
 
 }  // namespace

@@ -23,20 +23,18 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 // of its centre.
 constexpr double kHalfDiagonal = 0.8660254;
 
-// How far behind a point in free space its ray is followed for the surface the frame would have
-// seen there without it.
-constexpr double kBehindM = 1.0;
-
 // Whether a point in free space may claim a new surface for its camera. Not when the camera itself
 // has seen a surface in that voxel before (another camera's rays freed it: its own surface, not a
 // new one), nor when the first surface behind it along its ray is one only other cameras have seen
-// (its own version of that surface, displaced, is what this camera sees).
+// and lies within `displaced_m`: near enough to be their version of the surface this camera sees,
+// displaced. Farther behind, the others' surface is hidden by something new: a camera that joins
+// after a cup was put down sees the cup in front of a table only the first camera saw.
 bool claims_new_surface(const background::DenseGrid& grid, const Eigen::Vector3d& origin, const Eigen::Vector3d& p,
-                        const SurfaceWitness& witness, std::uint32_t camera) {
+                        const SurfaceWitness& witness, std::uint32_t camera, double displaced_m) {
   if (witness.seen(p, camera) == SurfaceWitness::Seen::kBySelf) return false;
   const Eigen::Vector3d dir = (p - origin).normalized();
   const double step = 0.5 * grid.resolution;
-  for (double s = step; s <= kBehindM; s += step) {
+  for (double s = step; s <= displaced_m; s += step) {
     const long idx = grid.index_of(p + s * dir);
     if (idx < 0) return true;  // left the grid: nothing behind to ask about
     if (grid.at(idx) != background::Occupancy::kOccupied) continue;
@@ -247,7 +245,11 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
         if (reach > (kMaxRing + 0.5) * res || surface_within(grid, idx, w, reach, kMaxRing)) continue;
       }
     }
-    if (witness != nullptr && !claims_new_surface(grid, T.translation(), w, *witness, camera)) continue;
+    // Two cameras' versions of one surface lie within both their tolerances of each other, plus
+    // what this frame's measured disagreement with the map (its robust RMS residual) explains.
+    if (witness != nullptr &&
+        !claims_new_surface(grid, T.translation(), w, *witness, camera, 2 * gap + config.sigma_factor * measured_pose.rms_residual_m))
+      continue;
     out.added.push_back(static_cast<int>(i));
     out.added_gap_m.push_back(static_cast<float>(gap));
   }
