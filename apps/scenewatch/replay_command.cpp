@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -20,6 +21,7 @@
 #include "scenewatch/io/rgbd.h"
 #include "scenewatch/ontology/class_catalog.h"
 #include "scenewatch/pipeline/working_memory.h"
+#include "subcommand.h"
 
 namespace scenewatch::cli {
 namespace {
@@ -260,6 +262,71 @@ int run_replay(const ReplayOptions& options) {
   }
   print_summary(tally, memory.stats(), wall_s, options.json);
   return kExitOk;
+}
+
+void add_replay_command(CLI::App& app, Action& action) {
+  auto options = std::make_shared<ReplayOptions>();
+  auto* replay = app.add_subcommand(
+      "replay",
+      "offline: run recordings through the working memory exactly as the daemon would (no daemon), print\n"
+      "each event as it arises, then count them (events per 100 frames, by kind) and time the frames\n"
+      "(median and p90, per stage). The way to see what a planner would be told about a recording.");
+  replay->footer(
+      "Inputs: SEQDIR (every frame, with its poses), SEQDIR:N, SEQDIR:A-B (frames A to B, 0-based), cloud files.\n"
+      "Examples:\n"
+      "  scenewatch replay ../shared/data/redkitchen\n"
+      "  scenewatch replay ../shared/data/hrt1/pick_toy_1:0-14 --config config/scenewatchd.yaml --json\n"
+      "  scenewatch replay ../shared/data/pcl/table_scene_mug_stereo_textured.pcd --objects --classes\n"
+      "  scenewatch replay rgbd_dataset_freiburg1_xyz          (a TUM RGB-D folder: rgb.txt, depth.txt, groundtruth.txt)\n"
+      "  scenewatch replay ../shared/data/ycb --depth-scale 0.0001   (depth in units of 0.1 mm)\n"
+      "  scenewatch replay kitchen.bag:0-99 --depth-topic /camera/aligned_depth_to_color/image_raw   (a ROS bag)\n"
+      "Scenario scripts: `scenewatch replay SCRIPT.yaml [--check] [--port P] [--token-file F]` streams what the\n"
+      "script names (a simulator scenario or a sequence folder) through a RUNNING daemon over TCP, prints the\n"
+      "events and the foreground objects, and compares them with the script's expectations (docs/testing.md,\n"
+      "'Scenario scripts'); with --check it exits 1 when one is not met.\n"
+      "  scenewatch replay tests/scenarios/hand_tilts_cup.yaml --check --port 7501");
+  replay->add_option("inputs", options->inputs, "sequence folders, ROS bags, frame ranges or cloud files")->required();
+  replay->add_option("--config", options->config, "YAML config, as the daemon's (its pipeline sections are used)");
+  replay->add_option("--stride", options->stride, "process every N-th frame of each input")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  replay->add_option("--heatmaps", options->heatmap_dir,
+                     "write each frame's image surprise over its colour image as DIR/surprise-NNNNNN.png");
+  replay->add_flag("--json", options->json, "one JSON object per event (with its frame), then a summary object");
+  add_depth_scale_option(replay, options->depth_scale_m);
+  add_bag_options(replay, options->bag);
+  replay->add_option("--localization", options->localization,
+                     "where frames were taken: given (trust their poses), refine (align the given pose to the memory; "
+                     "the default), track (no poses needed); overrides localization.mode")
+      ->check(CLI::IsMember({"given", "refine", "track"}));
+  replay->add_option("--trajectory", options->trajectory,
+                     "write the poses the memory used (aligned frames) as a TUM trajectory: t tx ty tz qx qy qz qw");
+  auto* objects_flag = replay->add_flag("--objects", options->objects,
+                                        "after each frame, the object list a planner would get (GetObjects): id, size, "
+                                        "points, sightings");
+  auto* classes_flag =
+      replay->add_flag("--classes", options->classes,
+                       "with --objects: each object's class and score, as GetObjects with describe gives them (the "
+                       "ontology; an object is described again when seen again and its description is older than 2 s)")
+          ->needs(objects_flag);
+  replay->add_option("--classes-file", options->classes_file,
+                     "the object classes for --classes (default: the shipped ontology.yaml, in /etc/scenewatch when installed)")
+      ->needs(classes_flag);
+  // A scenario script goes to a running daemon, with flags of its own.
+  struct Scenario {
+    bool check = false;
+    RemoteOptions remote;
+  };
+  auto scenario = std::make_shared<Scenario>();
+  replay->add_flag("--check", scenario->check, "scenario scripts: exit 1 when an expectation is not met");
+  replay->add_option("--host", scenario->remote.host, "scenario scripts: the daemon's host")->capture_default_str();
+  replay->add_option("--port", scenario->remote.port, "scenario scripts: the daemon's TCP port")->check(CLI::Range(1, 65535))->capture_default_str();
+  replay->add_option("--token-file", scenario->remote.token_file, "scenario scripts: the daemon's access token")->capture_default_str();
+  on_parsed(replay, action, [options, scenario] {
+    const bool script = options->inputs.size() == 1 && std::filesystem::path(options->inputs[0]).extension() == ".yaml";
+    if (script) return run_scenario(scenario->remote, options->inputs[0], scenario->check);
+    return run_replay(*options);
+  });
 }
 
 }  // namespace scenewatch::cli
