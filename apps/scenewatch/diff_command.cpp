@@ -1,6 +1,7 @@
 // Offline: geometric change detection between two observations (no daemon).
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <iostream>
 
@@ -11,6 +12,7 @@
 #include "frame_spec.h"
 #include "scenewatch/change/diff.h"
 #include "scenewatch/core/event_json.h"
+#include "subcommand.h"
 
 namespace scenewatch::cli {
 namespace fs = std::filesystem;
@@ -71,6 +73,27 @@ int run_diff(const DiffOptions& options) {
               << " in AFTER]\n";
   }
   return kExitOk;
+}
+
+void add_diff_command(CLI::App& app, Action& action) {
+  auto options = std::make_shared<DiffOptions>();
+  auto* diff = app.add_subcommand(
+      "diff",
+      "offline: objects added, removed or moved from BEFORE to AFTER (no daemon).\n"
+      "BEFORE and AFTER are cloud files (.pcd/.ply) or frames of RGB-D sequences (DIR/frame-NNNNNN, with\n"
+      "their poses). Organized clouds of one unmoved camera are compared pixel by pixel; otherwise BEFORE\n"
+      "goes into an occupancy map and AFTER is checked against it at its pose. Added: AFTER points in space\n"
+      "BEFORE saw free. Removed: BEFORE surfaces AFTER's rays pass through. Occluded or unseen space\n"
+      "claims nothing. --json lists each event with the indices of its points in BEFORE and AFTER.");
+  diff->add_option("before", options->before, "the earlier observation")->required();
+  diff->add_option("after", options->after, "the later observation")->required();
+  diff->add_flag("--json", options->json, "print JSON: events with point indices, world boxes, evidence");
+  diff->add_option("--config", options->config, "YAML config (its change and background sections are used)");
+  diff->add_flag("--force-map", options->force_map, "compare through the occupancy map even for same-camera pairs");
+  diff->add_option("--resolution", options->resolution_m, "map voxel edge in metres for the map path")
+      ->check(CLI::Range(0.002, 0.2));
+  add_depth_scale_option(diff, options->depth_scale_m);
+  on_parsed(diff, action, [options] { return run_diff(*options); });
 }
 
 }  // namespace scenewatch::cli

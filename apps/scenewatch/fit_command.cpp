@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -15,6 +16,7 @@
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/ontology/describe.h"
 #include "scenewatch/segmentation/tabletop.h"
+#include "subcommand.h"
 
 namespace scenewatch::cli {
 namespace {
@@ -254,6 +256,28 @@ int run_fit(const FitOptions& options) {
             << (scene.objects.size() == 1 ? " object" : " objects") << " (segmentation " << fixed(segment_ms, 0) << " ms)\n"
             << lines << std::flush;
   return kExitOk;
+}
+
+void add_fit_command(CLI::App& app, Action& action) {
+  auto options = std::make_shared<FitOptions>();
+  auto* fit = app.add_subcommand(
+      "fit", "offline: segment one frame, fit primitives to each object and classify it (no daemon)");
+  fit->footer(
+      "FILE: a .pcd/.ply cloud, or one frame of an RGB-D sequence folder (DIR:N, DIR/frame-NNNNNN).\n"
+      "Shapes by CGAL's Efficient RANSAC on the object's normals; the largest cylinder is refined by\n"
+      "least squares, held upright along the support's normal when it stands within 25 degrees of it.\n"
+      "Each class's primitive is then fitted and checked against the class's bounds: the object gets the\n"
+      "best accepted class (score, grasp points, completed model) or 'unknown' with its best primitive.\n"
+      "Example: scenewatch fit ../shared/data/ycb/frame-000003 --depth-scale 0.0001");
+  fit->add_option("file", options->file, "cloud file, sequence frame or bag frame (BAG:N)")->required();
+  fit->add_flag("--json", options->json, "print JSON (each object's shapes, refined cylinder, class, candidates, grasps and timings)");
+  fit->add_option("--config", options->config, "YAML config (its segmentation section is used)");
+  fit->add_option("--classes", options->classes, "object classes file (default: the shipped ontology.yaml, in /etc/scenewatch when installed)");
+  fit->add_option("--out", options->out_dir,
+                  "write each object's completed model (its class's primitive, whole surface) to DIR as object-N-CLASS.pcd and .ply");
+  add_depth_scale_option(fit, options->depth_scale_m);
+  add_bag_options(fit, options->bag);
+  on_parsed(fit, action, [options] { return run_fit(*options); });
 }
 
 }  // namespace scenewatch::cli

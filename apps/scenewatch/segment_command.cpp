@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 
 #include <nlohmann/json.hpp>
 
@@ -9,6 +10,7 @@
 #include "config_file.h"
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/segmentation/tabletop.h"
+#include "subcommand.h"
 
 namespace scenewatch::cli {
 namespace fs = std::filesystem;
@@ -139,6 +141,19 @@ int run_segment(const SegmentOptions& options) {
   if (!written.empty()) std::cout << "wrote " << written.size() << " files to " << options.out_dir << "\n";
   std::cout << std::flush;
   return kExitOk;
+}
+
+void add_segment_command(CLI::App& app, Action& action) {
+  auto options = std::make_shared<SegmentOptions>();
+  auto* segment = app.add_subcommand(
+      "segment", "offline: find supporting planes and the objects on them in a cloud file (no daemon)");
+  segment->add_option("file", options->file, "cloud file (.pcd or .ply)")->required();
+  segment->add_flag("--json", options->json, "print JSON (objects with the indices of their points)");
+  segment->add_option("--out", options->out_dir,
+                      "write object_000.pcd, ... and plane_000.pcd, ... into this folder");
+  segment->add_option("--config", options->config, "YAML config (its segmentation section is used)");
+  segment->add_flag("--plane-indices", options->plane_indices, "with --json: also list plane inlier indices");
+  on_parsed(segment, action, [options] { return run_segment(*options); });
 }
 
 }  // namespace scenewatch::cli

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <memory>
 #include <optional>
 
 #include "commands.h"
@@ -18,6 +19,7 @@
 #include "scenewatch/io/rgbd.h"
 #include "scenewatch/service/client.h"
 #include "scenewatch/surprise/surprise_map.h"
+#include "subcommand.h"
 
 namespace scenewatch::cli {
 namespace {
@@ -213,6 +215,42 @@ int run_surprise(const SurpriseOptions& o, const RemoteOptions& r) {
   if (!o.mesh_ply.empty()) written.push_back(o.mesh_ply);
   if (auto st = write_outputs(o, *out, written); !st) return fail(st.error().message);
   return print(o, *out, written);
+}
+
+void add_surprise_command(CLI::App& app, RemoteOptions& remote, Action& action) {
+  auto options = std::make_shared<SurpriseOptions>();
+  auto* surprise = app.add_subcommand(
+      "surprise",
+      "image-based Bayesian surprise of an observed RGB-D frame: offline against --reference frames, or "
+      "from the daemon's appearance memory when no reference is given");
+  surprise->footer(
+      "Frames: FILE.pcd|FILE.ply (an organized cloud, same camera as its references; intrinsics are recovered "
+      "from its points unless --intrinsics), SEQDIR (every frame of a sequence, with its poses), SEQDIR:N (frame "
+      "N, 0-based), SEQDIR:A-B.\n"
+      "Examples:\n"
+      "  scenewatch surprise after/:40 --reference before/ --out heat.png --raw kl.tiff\n"
+      "  scenewatch surprise learn13.pcd --reference learn12.pcd --json\n"
+      "  scenewatch surprise --out heat.png          (the daemon's last posed frame)");
+  surprise->add_option("observed", options->observed, "the observed frame (optional with the daemon)");
+  surprise->add_option("--reference,-r", options->references,
+                       "reference frames (repeatable); without any, the daemon is asked");
+  surprise->add_option("--out,-o", options->out_png, "write the surprise as a heatmap over the observed image (PNG)");
+  surprise->add_option("--raw", options->raw_tiff, "write the total surprise per pixel, KL in nats, as 32-bit float TIFF (NaN: unknown)");
+  surprise->add_option("--expected", options->expected_png, "offline: write the expected (virtual) image (PNG)");
+  surprise->add_option("--panel", options->panel_png,
+                       "offline: write the observed image, the expected image and the surprise heatmap side by side (PNG)");
+  surprise->add_option("--mesh", options->mesh_ply, "offline: write the references' textured mesh (PLY)");
+  surprise->add_option("--intrinsics", options->intrinsics, "3x3 camera matrix file for cloud files");
+  surprise->add_option("--config", options->config, "YAML config (its appearance and surprise sections are used)");
+  surprise->add_option("--saturation", options->saturation, "heatmap scale: nats shown as the hottest colour")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  add_depth_scale_option(surprise, options->depth_scale_m);
+  add_remote_options(surprise, remote);  // --json among them: regions as APPEARANCE_CHANGE events
+  on_parsed(surprise, action, [&remote, options] {
+    options->json = remote.json;
+    return run_surprise(*options, remote);
+  });
 }
 
 }  // namespace scenewatch::cli

@@ -1,0 +1,34 @@
+#pragma once
+// What the commands that talk to the daemon share: connecting with the token, one call with its
+// error printed, and the small pieces of their output.
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+
+namespace scenewatch::cli {
+
+/// The daemon's message, with why no token was sent when it asked for one.
+std::string refusal(const proto::Status& status);
+
+/// Sends one request; prints the problem and returns nothing on a transport error or an error
+/// status.
+std::optional<proto::Response> call(service::Client& client, proto::Request request, const RemoteOptions& options);
+
+/// Connects, makes one call and prints its result with `print`.
+int simple_call(const RemoteOptions& options, proto::Request request,
+                const std::function<void(const proto::Response&)>& print);
+
+void print_json(const nlohmann::json& j);
+
+/// MINX MINY MINZ MAXX MAXY MAXZ into `out`.
+void set_box(proto::Box* out, const std::vector<double>& box);
+
+/// "1 frame", "2 frames".
+std::string plural(std::size_t n, const std::string& word);
+
+}  // namespace scenewatch::cli
