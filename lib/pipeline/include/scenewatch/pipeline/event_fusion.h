@@ -76,6 +76,15 @@ class EventFusion {
     ZoneKind kind;
     int age = 0;
   };
+  // The steps of update(), in order.
+  void age();
+  std::vector<Event> drop_told_pieces(std::vector<Event> geometric) const;
+  std::vector<const Event*> claim_appearance(const std::vector<Event>& appearance,
+                                             const std::vector<change::ChangeCluster>& pending,
+                                             const std::vector<Aabb>& geometric_boxes);
+  void tell(Event& e, const std::vector<Aabb>& geometric_boxes);
+  void follow_appearance(const std::vector<const Event*>& free_regions, std::uint32_t camera, std::vector<Event>& out);
+
   FusionConfig config_;
   std::vector<Candidate> candidates_;
   std::vector<Claimed> claimed_;
