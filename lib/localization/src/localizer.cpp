@@ -187,6 +187,20 @@ std::vector<std::uint32_t> Localizer::cameras() const {
   return out;
 }
 
+/// One call of localize(): the camera's track and what the frame's placement is built from.
+struct Localizer::Attempt {
+  Attempt(const Frame& f, Track& t, std::chrono::steady_clock::time_point start) : frame(f), track(t), t0(start) {}
+  const Frame& frame;
+  Track& track;
+  std::chrono::steady_clock::time_point t0;
+  bool use_given = false;
+  Pose prior = Pose::Identity();
+  // In `refine` mode: where the running correction puts this frame (the given pose's own noise
+  // left out), and how uncertain the frame's placement is; the prior's until an alignment says more.
+  std::optional<Pose> odom_pose;
+  double placed_var_m2 = 0, placed_var_rad2 = 0;
+};
+
 Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const KeyframeSource& keyframes, const AllKeyframes& all) {
   const auto t0 = std::chrono::steady_clock::now();
   auto& slot = tracks_[camera];
@@ -195,80 +209,63 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
   Localization out;
   out.mode = frame.localization.value_or(config_.mode);
   out.given = frame.T_world_camera;
-  const bool use_given = out.mode != LocalizationMode::kTrack && frame.T_world_camera.has_value();
+  Attempt at(frame, track, t0);
+  at.use_given = out.mode != LocalizationMode::kTrack && frame.T_world_camera.has_value();
   // The prior: the given pose in the memory's frame, else the last pose moved on by the last step.
-  const Pose prior = use_given ? track.T_world_odom * *frame.T_world_camera
-                               : (track.started ? Pose(track.last * track.motion) : Pose::Identity());
-  out.T_world_camera = prior;
+  at.prior = at.use_given ? track.T_world_odom * *frame.T_world_camera
+                          : (track.started ? Pose(track.last * track.motion) : Pose::Identity());
+  out.T_world_camera = at.prior;
   out.T_world_odom = track.T_world_odom;
-  // In `refine` mode: where the running correction puts this frame (the given pose's own noise
-  // left out), and how uncertain the frame's placement is; the prior's until an alignment says more.
-  std::optional<Pose> odom_pose;
   const double noise_rad = config_.noise_deg * M_PI / 180.0;
-  double placed_var_m2 = track.var_m2 + config_.noise_m * config_.noise_m;
-  double placed_var_rad2 = track.var_rad2 + noise_rad * noise_rad;
-  auto finish = [&](Localization r) {
-    r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    if (r.placed()) {
-      if (track.started && !r.relocalized) track.motion = track.last.inverse() * r.T_world_camera;
-      if (r.relocalized) track.motion = Pose::Identity();
-      track.last = r.T_world_camera;
-      track.started = true;
-      track.homed = true;
-      track.lost_in_row = 0;
-      if (use_given) {
-        const Pose before = track.T_world_odom;
-        track.T_world_odom = odom_pose.value_or(r.T_world_camera) * frame.T_world_camera->inverse();
-        if (r.mode == LocalizationMode::kRefine) remember_placement(r.T_world_camera, placed_var_m2, placed_var_rad2);
-        const auto moved = background::view_distance(before, track.T_world_odom);
-        r.odom_change_m = moved.translation_m;
-        r.odom_change_deg = moved.rotation_deg;
-      }
-      r.T_world_odom = track.T_world_odom;
-    } else {
-      ++track.lost_in_row;
-    }
-    r.homed = track.homed;
-    track.result = r;
-    return r;
-  };
+  at.placed_var_m2 = track.var_m2 + config_.noise_m * config_.noise_m;
+  at.placed_var_rad2 = track.var_rad2 + noise_rad * noise_rad;
   if (out.mode == LocalizationMode::kGiven) {
     out.state = State::kGiven;
     out.T_world_camera = frame.pose_or_identity();
-    return finish(out);
+    return finish(at, out);
   }
   if (!organized_with_intrinsics(frame)) {
     out.state = State::kGiven;
     out.reason = "not an organized frame with intrinsics: its pose is used as given";
     out.T_world_camera = frame.pose_or_identity();
-    return finish(out);
+    return finish(at, out);
   }
   // The keyframe list is asked for only when the camera must relocalize: most frames do not.
   if (all && must_relocalize(track, out.mode)) {
     const auto every = all();
-    if (!every.empty()) {
-      Localization r = relocalize(frame, every);
-      r.mode = out.mode;
-      if (!r.placed()) {
-        r.T_world_camera = prior;  // placed nowhere new
-        if (!track.homed) r.reason = "homing: " + r.reason;
-        return finish(r);
-      }
-      if (use_given) {
-        // The relocalized pose starts the camera's correction anew: its error is the alignment's.
-        track.var_m2 = r.residual_m * r.residual_m;
-        track.var_rad2 = track.var_m2;
-        placed_var_m2 = track.var_m2;
-        placed_var_rad2 = track.var_rad2;
-        const auto from_given = background::view_distance(r.T_world_camera, *frame.T_world_camera);
-        r.correction_m = from_given.translation_m;
-        r.correction_deg = from_given.rotation_deg;
-      }
-      return finish(r);
-    }
+    if (!every.empty()) return finish(at, relocalize_track(at, out.mode, every));
   }
+  return finish(at, align_with_keyframes(at, out, keyframes));
+}
+
+Localization Localizer::relocalize_track(Attempt& at, LocalizationMode mode,
+                                         const std::vector<std::shared_ptr<const background::Keyframe>>& every) {
+  Localization r = relocalize(at.frame, every);
+  r.mode = mode;
+  if (!r.placed()) {
+    r.T_world_camera = at.prior;  // placed nowhere new
+    if (!at.track.homed) r.reason = "homing: " + r.reason;
+    return r;
+  }
+  if (at.use_given) {
+    // The relocalized pose starts the camera's correction anew: its error is the alignment's.
+    at.track.var_m2 = r.residual_m * r.residual_m;
+    at.track.var_rad2 = at.track.var_m2;
+    at.placed_var_m2 = at.track.var_m2;
+    at.placed_var_rad2 = at.track.var_rad2;
+    const auto from_given = background::view_distance(r.T_world_camera, *at.frame.T_world_camera);
+    r.correction_m = from_given.translation_m;
+    r.correction_deg = from_given.rotation_deg;
+  }
+  return r;
+}
+
+Localization Localizer::align_with_keyframes(Attempt& at, const Localization& out, const KeyframeSource& keyframes) {
+  const Frame& frame = at.frame;
+  const Track& track = at.track;
+  const Pose& prior = at.prior;
   auto candidates = keyframes ? keyframes(prior, config_.reference_keyframes) : decltype(keyframes(prior, 1)){};
-  if (use_given) {
+  if (at.use_given) {
     // Of the keyframes near the prior, the one placed most surely is tried first: an older one,
     // placed before the chain of refined keyframes grew, anchors the frame better than the newest.
     std::stable_sort(candidates.begin(), candidates.end(), [&](const auto& a, const auto& b) {
@@ -276,16 +273,17 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
     });
   }
   if (candidates.empty()) {
-    out.state = State::kStarting;
-    out.reason = "no keyframe near the prior to align with";
+    Localization r = out;
+    r.state = State::kStarting;
+    r.reason = "no keyframe near the prior to align with";
     // With a given pose, a view the memory has no keyframe of is new ground: the prior places
     // it, so that the memory grows there. Without one, a camera that had been placed and now
     // finds no keyframe near its prior has left the memory's views: that is lost.
-    if (!use_given && track.started && track.result.state == State::kTracking) {
-      out.state = State::kLost;
-      out.reason = "no keyframe of the memory sees towards the prior";
+    if (!at.use_given && track.started && track.result.state == State::kTracking) {
+      r.state = State::kLost;
+      r.reason = "no keyframe of the memory sees towards the prior";
     }
-    return finish(out);
+    return r;
   }
   const RgbdPyramid current = build_pyramid(*frame.cloud, *frame.intrinsics, sensor_, config_.pyramid, false);
   Localization best = out;
@@ -295,7 +293,7 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
   for (const auto& keyframe : candidates) {
     const auto ref = reference(*keyframe);
     Alignment a = align(*ref, current, keyframe->T_world_camera.inverse() * prior, sensor_, config_.alignment);
-    if (!use_given && track.started) {
+    if (!at.use_given && track.started) {
       // Without a given pose the prior assumes the camera kept its last motion; when it stopped
       // or turned back, that prior lies twice as far off as the last pose. Both are tried; the
       // one more of the frame agrees with wins.
@@ -314,28 +312,58 @@ Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const
   if (!aligned) {
     best.state = State::kLost;
     best.T_world_camera = prior;  // a lost frame is placed nowhere new
-    return finish(best);
+    return best;
   }
-  if (use_given) {
-    const Fused f = fuse_with_prior(track, prior, best.T_world_camera, *aligned, *aligned_to);
-    best.T_world_camera = f.pose;
-    best.alignment_rejected = f.rejected;
-    odom_pose = f.odom_pose;
-    placed_var_m2 = f.var_m2;
-    placed_var_rad2 = f.var_rad2;
-    const auto from_given = background::view_distance(best.T_world_camera, *frame.T_world_camera);
-    best.correction_m = from_given.translation_m;
-    best.correction_deg = from_given.rotation_deg;
-    const auto moved = background::view_distance(best.T_world_camera, prior);
-    if (moved.translation_m > config_.max_correction_m || moved.rotation_deg > config_.max_correction_deg) {
-      best.state = State::kLost;
-      best.reason = "the alignment moved the given pose too far (" + std::to_string(moved.translation_m) + " m, " +
-                    std::to_string(moved.rotation_deg) + " deg)";
-      best.T_world_camera = prior;
-      odom_pose.reset();
+  if (at.use_given) weigh_against_given(at, best, *aligned, *aligned_to);
+  return best;
+}
+
+void Localizer::weigh_against_given(Attempt& at, Localization& best, const Alignment& aligned,
+                                    const background::Keyframe& aligned_to) {
+  const Fused f = fuse_with_prior(at.track, at.prior, best.T_world_camera, aligned, aligned_to);
+  best.T_world_camera = f.pose;
+  best.alignment_rejected = f.rejected;
+  at.odom_pose = f.odom_pose;
+  at.placed_var_m2 = f.var_m2;
+  at.placed_var_rad2 = f.var_rad2;
+  const auto from_given = background::view_distance(best.T_world_camera, *at.frame.T_world_camera);
+  best.correction_m = from_given.translation_m;
+  best.correction_deg = from_given.rotation_deg;
+  const auto moved = background::view_distance(best.T_world_camera, at.prior);
+  if (moved.translation_m > config_.max_correction_m || moved.rotation_deg > config_.max_correction_deg) {
+    best.state = State::kLost;
+    best.reason = "the alignment moved the given pose too far (" + std::to_string(moved.translation_m) + " m, " +
+                  std::to_string(moved.rotation_deg) + " deg)";
+    best.T_world_camera = at.prior;
+    at.odom_pose.reset();
+  }
+}
+
+Localization Localizer::finish(Attempt& at, Localization r) {
+  Track& track = at.track;
+  r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - at.t0).count();
+  if (r.placed()) {
+    if (track.started && !r.relocalized) track.motion = track.last.inverse() * r.T_world_camera;
+    if (r.relocalized) track.motion = Pose::Identity();
+    track.last = r.T_world_camera;
+    track.started = true;
+    track.homed = true;
+    track.lost_in_row = 0;
+    if (at.use_given) {
+      const Pose before = track.T_world_odom;
+      track.T_world_odom = at.odom_pose.value_or(r.T_world_camera) * at.frame.T_world_camera->inverse();
+      if (r.mode == LocalizationMode::kRefine) remember_placement(r.T_world_camera, at.placed_var_m2, at.placed_var_rad2);
+      const auto moved = background::view_distance(before, track.T_world_odom);
+      r.odom_change_m = moved.translation_m;
+      r.odom_change_deg = moved.rotation_deg;
     }
+    r.T_world_odom = track.T_world_odom;
+  } else {
+    ++track.lost_in_row;
   }
-  return finish(best);
+  r.homed = track.homed;
+  track.result = r;
+  return r;
 }
 
 // Refine mode. The given pose G is the true one moved by the pose source's drift D (a random walk:

@@ -8,6 +8,8 @@
 #include <set>
 #include <sstream>
 
+#include "scenewatch/core/yaml_value.h"
+
 namespace scenewatch::ontology {
 namespace {
 
@@ -17,7 +19,7 @@ class Fields {
   Fields(const YAML::Node& node, std::string path) : node_(node), path_(std::move(path)) {}
 
   Status is_map() const {
-    if (!node_.IsMap()) return invalid_argument(path_ + ": expected a map");
+    if (!node_.IsMap()) return yaml::key_error(path_, "expected a map");
     return {};
   }
   std::string path(const std::string& key) const { return path_ + "." + key; }
@@ -28,41 +30,40 @@ class Fields {
   Status number(const std::string& key, double& out) {
     const YAML::Node v = get(key);
     if (!v) return {};
-    try {
-      out = v.as<double>();
-    } catch (const YAML::Exception&) {
-      return invalid_argument(path(key) + ": expected a number");
-    }
+    // Any number yaml-cpp reads, .inf and .nan too (validate() bounds the fields that need it).
+    const auto number = yaml::read_number(v, path(key), yaml::Finite::kAny);
+    if (!number) return number.error();
+    out = *number;
     return {};
   }
   Status text(const std::string& key, std::string& out, bool required = false) {
     const YAML::Node v = get(key);
-    if (!v) return required ? Status(invalid_argument(path(key) + ": required")) : Status();
-    if (!v.IsScalar()) return invalid_argument(path(key) + ": expected a string");
-    out = v.as<std::string>();
+    if (!v) return required ? Status(yaml::key_error(path(key), "required")) : Status();
+    const auto s = yaml::read_string(v, path(key));
+    if (!s) return s.error();
+    out = *s;
     return {};
   }
   Status range(const std::string& key, Range& out, bool required) {
     const YAML::Node v = get(key);
-    if (!v) return required ? Status(invalid_argument(path(key) + ": required ([min, max])")) : Status();
+    if (!v) return required ? Status(yaml::key_error(path(key), "required ([min, max])")) : Status();
     return parse_range(v, path(key), out);
   }
   Status finish() const {
     for (const auto& kv : node_) {
       if (!kv.first.IsScalar()) return invalid_argument(path_ + ": a key is not a plain name");
       const std::string key = kv.first.as<std::string>();
-      if (!read_.count(key)) return invalid_argument(path(key) + ": unknown key");
+      if (!read_.count(key)) return yaml::key_error(path(key), "unknown key");
     }
     return {};
   }
 
   static Status parse_range(const YAML::Node& v, const std::string& where, Range& out) {
-    if (!v.IsSequence() || v.size() != 2) return invalid_argument(where + ": expected [min, max]");
-    try {
-      out.min = v[0].as<double>();
-      out.max = v[1].as<double>();
-    } catch (const YAML::Exception&) {
-      return invalid_argument(where + ": expected two numbers [min, max]");
+    if (!v.IsSequence() || v.size() != 2) return yaml::key_error(where, "expected [min, max]");
+    for (std::size_t i = 0; i < 2; ++i) {
+      const auto bound = yaml::read_number(v[i], where, yaml::Finite::kAny);
+      if (!bound) return yaml::key_error(where, "expected two numbers [min, max]");
+      (i == 0 ? out.min : out.max) = *bound;
     }
     return {};
   }
@@ -140,8 +141,9 @@ Status parse_class(const YAML::Node& node, const std::string& where, ObjectClass
   if (const YAML::Node v = named.get("allowed_dofs")) {
     if (!v.IsSequence()) return invalid_argument(named.path("allowed_dofs") + ": expected a list of x, y, z, roll, pitch, yaw");
     for (std::size_t i = 0; i < v.size(); ++i) {
-      if (!v[i].IsScalar()) return invalid_argument(named.path("allowed_dofs") + "[" + std::to_string(i) + "]: expected a string");
-      c.allowed_dofs.push_back(v[i].as<std::string>());
+      auto dof = yaml::read_string(v[i], named.path("allowed_dofs") + "[" + std::to_string(i) + "]");
+      if (!dof) return dof.error();
+      c.allowed_dofs.push_back(*dof);
     }
   }
   if (Status s = named.finish(); !s) return s;

@@ -11,76 +11,107 @@
 #include "voxel_index.h"
 
 namespace scenewatch::segmentation {
+namespace {
 
-std::vector<std::vector<int>> cut_at_boundaries(const Cloud& cloud, const std::vector<int>& part, const Eigen::Vector3d& sensor_origin,
-                                                const BoundaryTest& is_boundary, const EdgePixelTest& is_edge_pixel,
-                                                const BoundaryCutParams& params) {
-  const int width = static_cast<int>(cloud.width);
-  if (cloud.height <= 1 || part.size() < 2 * static_cast<std::size_t>(params.min_points)) return {part};
-  // The part's pixels in its bounding box.
-  int u0 = width, v0 = static_cast<int>(cloud.height), u1 = -1, v1 = -1;
-  for (int i : part) {
-    u0 = std::min(u0, i % width), u1 = std::max(u1, i % width);
-    v0 = std::min(v0, i / width), v1 = std::max(v1, i / width);
+/// The part's pixels in its bounding box: each pixel's local index (into `part`), -1 outside.
+struct PartImage {
+  int width = 0;  ///< the organized cloud's
+  int u0 = 0, v0 = 0, u1 = -1, v1 = -1;
+  int bw = 0, bh = 0;
+  std::vector<int> local;
+
+  PartImage(const Cloud& cloud, const std::vector<int>& part) : width(static_cast<int>(cloud.width)) {
+    u0 = width, v0 = static_cast<int>(cloud.height);
+    for (int i : part) {
+      u0 = std::min(u0, i % width), u1 = std::max(u1, i % width);
+      v0 = std::min(v0, i / width), v1 = std::max(v1, i / width);
+    }
+    bw = u1 - u0 + 1, bh = v1 - v0 + 1;
+    local.assign(static_cast<std::size_t>(bw) * bh, -1);
+    for (std::size_t k = 0; k < part.size(); ++k) at(part[k] % width, part[k] / width) = static_cast<int>(k);
   }
-  const int bw = u1 - u0 + 1, bh = v1 - v0 + 1;
-  std::vector<int> local(static_cast<std::size_t>(bw) * bh, -1);
-  auto at = [&](int u, int v) -> int& { return local[static_cast<std::size_t>(v - v0) * bw + (u - u0)]; };
-  for (std::size_t k = 0; k < part.size(); ++k) at(part[k] % width, part[k] / width) = static_cast<int>(k);
+  int& at(int u, int v) { return local[static_cast<std::size_t>(v - v0) * bw + (u - u0)]; }
+};
 
-  // The angle one pixel spans (1 / focal length): the spacing of two neighbouring points across
-  // their ray, over their range; the median of a sample.
+/// The spacing of the points at cloud indices i and j across the ray from `sensor_origin` to i.
+double spacing_across_ray(const Cloud& cloud, int i, int j, const Eigen::Vector3d& sensor_origin) {
+  const Eigen::Vector3d p = cloud[i].getVector3fMap().cast<double>(), q = cloud[j].getVector3fMap().cast<double>();
+  const Eigen::Vector3d ray = (p - sensor_origin).normalized(), d = q - p;
+  return (d - ray * ray.dot(d)).norm();
+}
+
+/// The angle one pixel spans (1 / focal length): the spacing of two neighbouring points across
+/// their ray, over their range; the median of a sample.
+double pixel_angle(const Cloud& cloud, const std::vector<int>& part, PartImage& image, const Eigen::Vector3d& sensor_origin) {
+  const int width = image.width;
   std::vector<double> angles;
   for (std::size_t k = 0; k + 1 < part.size() && angles.size() < 64; k += 16) {
     const int i = part[k];
-    if (i % width + 1 > u1 || at(i % width + 1, i / width) < 0) continue;
-    const Eigen::Vector3d p = cloud[i].getVector3fMap().cast<double>(), q = cloud[i + 1].getVector3fMap().cast<double>();
-    const Eigen::Vector3d ray = (p - sensor_origin).normalized(), d = q - p;
-    angles.push_back((d - ray * ray.dot(d)).norm() / std::max(1e-6, (p - sensor_origin).norm()));
+    if (i % width + 1 > image.u1 || image.at(i % width + 1, i / width) < 0) continue;
+    const Eigen::Vector3d p = cloud[i].getVector3fMap().cast<double>();
+    angles.push_back(spacing_across_ray(cloud, i, i + 1, sensor_origin) / std::max(1e-6, (p - sensor_origin).norm()));
   }
   std::nth_element(angles.begin(), angles.begin() + angles.size() / 2, angles.end());
-  const double pixel_angle = angles.empty() ? 1.0 / 525.0 : angles[angles.size() / 2];
+  return angles.empty() ? 1.0 / 525.0 : angles[angles.size() / 2];
+}
 
-  // 1. Regions: neighbouring pixels without a boundary between them.
-  const int n = static_cast<int>(part.size());
-  UnionFind pixels(n);
-  struct Crossing {
-    int a, b;         ///< local pixel indices
-    double length_m;  ///< the boundary's length between the two pixels: their spacing across the ray
-    bool step;        ///< a depth step (else a colour edge)
-  };
-  std::vector<char> on_outline(n, 0);  ///< a pixel with a 4-neighbour outside the part
+struct Crossing {
+  int a, b;         ///< local pixel indices
+  double length_m;  ///< the boundary's length between the two pixels: their spacing across the ray
+  bool step;        ///< a depth step (else a colour edge)
+};
+
+/// Step 1a: neighbouring pixels without a boundary between them joined; the boundaries crossed.
+struct PixelLinks {
+  UnionFind pixels;
+  std::vector<char> on_outline;  ///< a pixel with a 4-neighbour outside the part
   std::vector<Crossing> crossings;
+};
+
+PixelLinks link_pixels(const Cloud& cloud, const std::vector<int>& part, PartImage& image,
+                       const Eigen::Vector3d& sensor_origin, const BoundaryTest& is_boundary,
+                       const EdgePixelTest& is_edge_pixel) {
+  const int n = static_cast<int>(part.size()), width = image.width;
+  const int u0 = image.u0, v0 = image.v0, u1 = image.u1, v1 = image.v1;
+  PixelLinks links{UnionFind(n), std::vector<char>(n, 0), {}};
   for (int k = 0; k < n; ++k) {
     const int i = part[k], u = i % width, v = i / width;
-    on_outline[k] = u == u0 || u == u1 || v == v0 || v == v1 || at(u - 1, v) < 0 || at(u + 1, v) < 0 ||
-                    at(u, v - 1) < 0 || at(u, v + 1) < 0;
+    links.on_outline[k] = u == u0 || u == u1 || v == v0 || v == v1 || image.at(u - 1, v) < 0 ||
+                          image.at(u + 1, v) < 0 || image.at(u, v - 1) < 0 || image.at(u, v + 1) < 0;
     if (is_edge_pixel && is_edge_pixel(i)) continue;
     for (const auto& [du, dv, offset] : {std::array<int, 3>{1, 0, 1}, std::array<int, 3>{0, 1, width}}) {
       if (u + du > u1 || v + dv > v1) continue;
-      const int other = at(u + du, v + dv);
+      const int other = image.at(u + du, v + dv);
       if (other < 0 || (is_edge_pixel && is_edge_pixel(part[other]))) continue;
       const Boundary b = is_boundary(i, offset);
       if (b != Boundary::kNone) {
-        const Eigen::Vector3d p = cloud[i].getVector3fMap().cast<double>(), q = cloud[i + offset].getVector3fMap().cast<double>();
-        const Eigen::Vector3d ray = (p - sensor_origin).normalized(), d = q - p;
-        crossings.push_back({k, other, (d - ray * ray.dot(d)).norm(), b == Boundary::kDepthStep});
+        links.crossings.push_back({k, other, spacing_across_ray(cloud, i, i + offset, sensor_origin), b == Boundary::kDepthStep});
       } else {
-        pixels.unite(k, other);
+        links.pixels.unite(k, other);
       }
     }
   }
-  // Edge pixels (a colour edge's line) belong to no region yet. Each lies between the regions
-  // around it (within two pixels: a line may be two pixels wide, and colour may be off depth by
-  // as much); the line's length counts as colour boundary between each two of them, and the
-  // pixel joins the one most around it.
-  std::vector<int> edge_pixels;
-  if (is_edge_pixel)
-    for (int k = 0; k < n; ++k)
-      if (is_edge_pixel(part[k])) edge_pixels.push_back(k);
-  if (crossings.empty() && edge_pixels.empty()) return {part};
-  std::vector<int> region(n, -1);
-  int regions = 0;
+  return links;
+}
+
+/// Step 1b: each pixel's region, and the length of colour-edge line between each two regions.
+struct Regions {
+  std::vector<int> region;  ///< per local pixel
+  int count = 0;
+  std::map<std::pair<int, int>, double> colour_m;
+};
+
+// Edge pixels (a colour edge's line) belong to no region yet. Each lies between the regions
+// around it (within two pixels: a line may be two pixels wide, and colour may be off depth by
+// as much); the line's length counts as colour boundary between each two of them, and the
+// pixel joins the one most around it.
+Regions label_regions(const Cloud& cloud, const std::vector<int>& part, PartImage& image, UnionFind& pixels,
+                      const std::vector<int>& edge_pixels, double pixel_angle, const Eigen::Vector3d& sensor_origin) {
+  const int n = static_cast<int>(part.size()), width = image.width;
+  Regions out;
+  std::vector<int>& region = out.region;
+  int& regions = out.count;
+  region.assign(n, -1);
   std::vector<char> is_line(n, 0);
   for (int k : edge_pixels) is_line[k] = 1;
   for (int k = 0; k < n; ++k) {
@@ -89,14 +120,13 @@ std::vector<std::vector<int>> cut_at_boundaries(const Cloud& cloud, const std::v
     if (region[root] < 0) region[root] = regions++;
     region[k] = region[root];
   }
-  std::map<std::pair<int, int>, double> colour_m;
   for (int k : edge_pixels) {
     const int i = part[k], u = i % width, v = i / width;
     std::map<int, int> around;
     for (int dv = -2; dv <= 2; ++dv)
       for (int du = -2; du <= 2; ++du) {
-        if (u + du < u0 || u + du > u1 || v + dv < v0 || v + dv > v1) continue;
-        const int other = at(u + du, v + dv);
+        if (u + du < image.u0 || u + du > image.u1 || v + dv < image.v0 || v + dv > image.v1) continue;
+        const int other = image.at(u + du, v + dv);
         if (other >= 0 && !is_line[other]) ++around[region[other]];
       }
     if (around.empty()) {
@@ -111,62 +141,65 @@ std::vector<std::vector<int>> cut_at_boundaries(const Cloud& cloud, const std::v
     // One pixel of line between two regions: its spacing at its range, shared among the pairs.
     const double length = (cloud[i].getVector3fMap().cast<double>() - sensor_origin).norm() * pixel_angle;
     for (auto a = around.begin(); a != around.end(); ++a)
-      for (auto b = std::next(a); b != around.end(); ++b) colour_m[{a->first, b->first}] += length;
+      for (auto b = std::next(a); b != around.end(); ++b) out.colour_m[{a->first, b->first}] += length;
   }
-  if (regions < 2) return {part};
+  return out;
+}
 
-  // 2. Object-sized regions.
-  std::vector<PartShape> shapes(regions);
-  for (int k = 0; k < n; ++k) shapes[region[k]].add(cloud[part[k]].getVector3fMap().cast<double>());
-  std::vector<char> object_sized(regions, 0), reaches_outline(regions, 0);
-  for (int k = 0; k < n; ++k) reaches_outline[region[k]] |= on_outline[k];
-  int object_sized_count = 0;
-  for (int r = 0; r < regions; ++r) {
-    object_sized[r] = shapes[r].count >= params.min_points && shapes[r].width() >= params.min_part_size_m;
-    object_sized_count += object_sized[r];
-  }
-  if (object_sized_count < 2) return {part};
-
-  // 3. How regions meet: across a boundary (its length), and in space (neighbouring cells at the
-  // clustering tolerance, the way the cluster itself was connected; this bridges holes).
-  std::map<std::pair<int, int>, std::pair<double, double>> boundary_m;  // (depth steps, colour edges)
+/// Step 3a: the boundary between each two regions: (depth steps, colour edges), metres.
+std::map<std::pair<int, int>, std::pair<double, double>> boundary_lengths(const std::vector<Crossing>& crossings,
+                                                                          const Regions& regions) {
+  std::map<std::pair<int, int>, std::pair<double, double>> boundary_m;
   for (const Crossing& c : crossings) {
-    const int ra = region[c.a], rb = region[c.b];
+    const int ra = regions.region[c.a], rb = regions.region[c.b];
     if (ra == rb) continue;
     auto& length = boundary_m[{std::min(ra, rb), std::max(ra, rb)}];
     (c.step ? length.first : length.second) += c.length_m;
   }
-  for (const auto& [pair, length] : colour_m) boundary_m[pair].second += length;
+  for (const auto& [pair, length] : regions.colour_m) boundary_m[pair].second += length;
+  return boundary_m;
+}
+
+/// Step 3b: how often two regions meet in space: neighbouring cells at the clustering tolerance,
+/// the way the cluster itself was connected (this bridges holes).
+std::map<std::pair<int, int>, int> touching_regions(const Cloud& cloud, const std::vector<int>& part,
+                                                    const std::vector<int>& region, double cluster_tolerance_m) {
   std::map<std::pair<int, int>, int> touching;
-  {
-    const VoxelIndex cells(cloud, part, params.cluster_tolerance_m);
-    // Local index of each member: members are cloud indices, part is sorted.
-    auto local_of = [&](int i) { return static_cast<int>(std::lower_bound(part.begin(), part.end(), i) - part.begin()); };
-    std::vector<std::vector<int>> cell_regions(cells.centroids.size());
-    for (std::size_t c = 0; c < cells.centroids.size(); ++c) {
-      auto& rs = cell_regions[c];
-      for (const int* m = cells.members_begin(static_cast<int>(c)); m != cells.members_end(static_cast<int>(c)); ++m)
-        rs.push_back(region[local_of(*m)]);
-      std::sort(rs.begin(), rs.end());
-      rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
-    }
-    auto meet = [&](const std::vector<int>& x, const std::vector<int>& y) {
-      for (int a : x)
-        for (int b : y)
-          if (a != b) ++touching[{std::min(a, b), std::max(a, b)}];
-    };
-    for (std::size_t c = 0; c < cells.centroids.size(); ++c) {
-      meet(cell_regions[c], cell_regions[c]);
-      const auto& xyz = cells.coords[c];
-      for (const auto& o : forward_offsets()) {
-        const int w = cells.find(xyz[0] + o[0], xyz[1] + o[1], xyz[2] + o[2]);
-        if (w >= 0) meet(cell_regions[c], cell_regions[w]);
-      }
+  const VoxelIndex cells(cloud, part, cluster_tolerance_m);
+  // Local index of each member: members are cloud indices, part is sorted.
+  auto local_of = [&](int i) { return static_cast<int>(std::lower_bound(part.begin(), part.end(), i) - part.begin()); };
+  std::vector<std::vector<int>> cell_regions(cells.centroids.size());
+  for (std::size_t c = 0; c < cells.centroids.size(); ++c) {
+    auto& rs = cell_regions[c];
+    for (const int* m = cells.members_begin(static_cast<int>(c)); m != cells.members_end(static_cast<int>(c)); ++m)
+      rs.push_back(region[local_of(*m)]);
+    std::sort(rs.begin(), rs.end());
+    rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
+  }
+  auto meet = [&](const std::vector<int>& x, const std::vector<int>& y) {
+    for (int a : x)
+      for (int b : y)
+        if (a != b) ++touching[{std::min(a, b), std::max(a, b)}];
+  };
+  for (std::size_t c = 0; c < cells.centroids.size(); ++c) {
+    meet(cell_regions[c], cell_regions[c]);
+    const auto& xyz = cells.coords[c];
+    for (const auto& o : forward_offsets()) {
+      const int w = cells.find(xyz[0] + o[0], xyz[1] + o[1], xyz[2] + o[2]);
+      if (w >= 0) meet(cell_regions[c], cell_regions[w]);
     }
   }
+  return touching;
+}
 
-  // 4. Join regions, most contact first; two object-sized regions with a boundary of object
-  // length between them never join, not even through a third region.
+/// Step 4: the regions joined, most contact first; two object-sized regions with a boundary of
+/// object length between them never join, not even through a third region. Part indices by root.
+std::map<int, std::vector<int>> join_regions(const std::vector<int>& part, const std::vector<int>& region, int regions,
+                                             const std::vector<char>& object_sized,
+                                             const std::vector<char>& reaches_outline,
+                                             const std::map<std::pair<int, int>, std::pair<double, double>>& boundary_m,
+                                             const std::map<std::pair<int, int>, int>& touching,
+                                             const BoundaryCutParams& params) {
   ApartSets apart;
   for (const auto& [pair, length] : boundary_m) {
     if (!object_sized[pair.first] || !object_sized[pair.second]) continue;
@@ -182,13 +215,17 @@ std::vector<std::vector<int>> cut_at_boundaries(const Cloud& cloud, const std::v
   UnionFind joined(regions);
   for (const auto& [count, pair] : ranked) unite_unless_apart(joined, apart, pair.first, pair.second);
   std::map<int, std::vector<int>> by_root;
-  for (int k = 0; k < n; ++k) by_root[joined.find(region[k])].push_back(part[k]);
-  if (by_root.size() < 2) return {part};
-  // A set that is no object (a fragment touching nothing in space) goes to the largest one.
+  for (std::size_t k = 0; k < part.size(); ++k) by_root[joined.find(region[k])].push_back(part[k]);
+  return by_root;
+}
+
+/// The joined sets with at least min_points points, each sorted; a set that is no object (a
+/// fragment touching nothing in space) goes to the largest one. Fewer than two: `{part}`.
+std::vector<std::vector<int>> pieces(std::map<int, std::vector<int>>& by_root, const std::vector<int>& part, int min_points) {
   std::vector<std::vector<int>> out;
   std::vector<int> leftover;
   for (auto& [root, indices] : by_root) {
-    if (static_cast<int>(indices.size()) >= params.min_points) out.push_back(std::move(indices));
+    if (static_cast<int>(indices.size()) >= min_points) out.push_back(std::move(indices));
     else leftover.insert(leftover.end(), indices.begin(), indices.end());
   }
   if (out.size() < 2) return {part};
@@ -198,6 +235,48 @@ std::vector<std::vector<int>> cut_at_boundaries(const Cloud& cloud, const std::v
   }
   for (auto& indices : out) std::sort(indices.begin(), indices.end());
   return out;
+}
+
+}  // namespace
+
+std::vector<std::vector<int>> cut_at_boundaries(const Cloud& cloud, const std::vector<int>& part, const Eigen::Vector3d& sensor_origin,
+                                                const BoundaryTest& is_boundary, const EdgePixelTest& is_edge_pixel,
+                                                const BoundaryCutParams& params) {
+  if (cloud.height <= 1 || part.size() < 2 * static_cast<std::size_t>(params.min_points)) return {part};
+  PartImage image(cloud, part);
+  const double angle = pixel_angle(cloud, part, image, sensor_origin);
+
+  // 1. Regions: neighbouring pixels without a boundary between them.
+  const int n = static_cast<int>(part.size());
+  PixelLinks links = link_pixels(cloud, part, image, sensor_origin, is_boundary, is_edge_pixel);
+  std::vector<int> edge_pixels;
+  if (is_edge_pixel)
+    for (int k = 0; k < n; ++k)
+      if (is_edge_pixel(part[k])) edge_pixels.push_back(k);
+  if (links.crossings.empty() && edge_pixels.empty()) return {part};
+  const Regions regions = label_regions(cloud, part, image, links.pixels, edge_pixels, angle, sensor_origin);
+  if (regions.count < 2) return {part};
+
+  // 2. Object-sized regions.
+  std::vector<PartShape> shapes(regions.count);
+  for (int k = 0; k < n; ++k) shapes[regions.region[k]].add(cloud[part[k]].getVector3fMap().cast<double>());
+  std::vector<char> object_sized(regions.count, 0), reaches_outline(regions.count, 0);
+  for (int k = 0; k < n; ++k) reaches_outline[regions.region[k]] |= links.on_outline[k];
+  int object_sized_count = 0;
+  for (int r = 0; r < regions.count; ++r) {
+    object_sized[r] = shapes[r].count >= params.min_points && shapes[r].width() >= params.min_part_size_m;
+    object_sized_count += object_sized[r];
+  }
+  if (object_sized_count < 2) return {part};
+
+  // 3. How regions meet: across a boundary (its length), and in space.
+  const auto boundary_m = boundary_lengths(links.crossings, regions);
+  const auto touching = touching_regions(cloud, part, regions.region, params.cluster_tolerance_m);
+
+  // 4. Join regions.
+  auto by_root = join_regions(part, regions.region, regions.count, object_sized, reaches_outline, boundary_m, touching, params);
+  if (by_root.size() < 2) return {part};
+  return pieces(by_root, part, params.min_points);
 }
 
 }  // namespace scenewatch::segmentation

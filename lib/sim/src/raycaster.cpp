@@ -163,47 +163,10 @@ inline bool room_exit(const RoomView& r, const Vector3d& d, double* t, int* axis
 }
 
 
-}  // namespace
-
-Raycaster::Raycaster(RaycasterConfig config) : config_(config) {}
-
-void Raycaster::render(const RenderScene& scene, const Pose& T_world_camera, const Intrinsics& K, IdealView* out) {
-  assert(K.valid());
-  const int W = K.width, H = K.height;
-  const std::size_t n = static_cast<std::size_t>(W) * H;
-  out->width = W;
-  out->height = H;
-  // Every pixel is written below: resize, no fill.
-  out->depth_m.resize(n);
-  out->opaque_depth_m.resize(n);
-  out->cos_incidence.resize(n);
-  out->opaque_cos_incidence.resize(n);
-  out->transparent.resize(n);
-  out->rgb.resize(3 * n);
-  out->labels.resize(n);
-
-  // Per-pixel ray tables, rebuilt only when the intrinsics change.
-  if (rays_for_.fx != K.fx || rays_for_.fy != K.fy || rays_for_.cx != K.cx || rays_for_.cy != K.cy ||
-      rays_for_.width != W || rays_for_.height != H) {
-    rays_for_ = K;
-    x_normalized_.resize(static_cast<std::size_t>(W));
-    y_normalized_.resize(static_cast<std::size_t>(H));
-    inv_ray_length_.resize(n);
-    for (int u = 0; u < W; ++u) x_normalized_[static_cast<std::size_t>(u)] = (u - K.cx) / K.fx;
-    for (int v = 0; v < H; ++v) y_normalized_[static_cast<std::size_t>(v)] = (v - K.cy) / K.fy;
-    for (int v = 0; v < H; ++v) {
-      for (int u = 0; u < W; ++u) {
-        const double x = x_normalized_[static_cast<std::size_t>(u)], y = y_normalized_[static_cast<std::size_t>(v)];
-        inv_ray_length_[static_cast<std::size_t>(v) * W + u] = static_cast<float>(1.0 / std::sqrt(x * x + y * y + 1.0));
-      }
-    }
-  }
-
+/// Per-frame preparation of every item.
+std::vector<Prepared> prepare_items(const RenderScene& scene, const Pose& T_world_camera) {
   const Matrix3d R_wc = T_world_camera.linear();
   const Vector3d o_w = T_world_camera.translation();
-  const Pose T_camera_world = T_world_camera.inverse();
-
-  // Per-frame preparation of every item.
   std::vector<Prepared> prepared(scene.items.size());
   for (std::size_t i = 0; i < scene.items.size(); ++i) {
     const RenderItem& item = scene.items[i];
@@ -221,20 +184,25 @@ void Raycaster::render(const RenderScene& scene, const Pose& T_world_camera, con
     bounding_sphere(item.shape, &p.sphere_center_local, &r);
     p.sphere_radius2 = r * r;
   }
+  return prepared;
+}
 
-  // Screen tiles with the items whose bounding spheres project onto them.
-  const int tile = std::max(1, config_.tile_px);
-  const int tiles_x = (W + tile - 1) / tile, tiles_y = (H + tile - 1) / tile;
-  tiles_.resize(static_cast<std::size_t>(tiles_x) * tiles_y);
-  for (auto& list : tiles_) list.clear();
+/// Screen tiles (`tile` pixels square, tiles_x a row) with the items whose bounding boxes project
+/// onto them, nearest first; with `cull`, each item's z_min_m is set.
+void bin_into_tiles(std::vector<Prepared>& prepared, const Pose& T_world_camera, const Intrinsics& K, bool cull,
+                    double near_m, int tile, int tiles_x, int tiles_y, std::vector<std::vector<std::uint16_t>>* tiles) {
+  const int W = K.width, H = K.height;
+  const Pose T_camera_world = T_world_camera.inverse();
+  tiles->resize(static_cast<std::size_t>(tiles_x) * tiles_y);
+  for (auto& list : *tiles) list.clear();
   std::vector<std::array<int, 4>> boxes(prepared.size(), {0, W - 1, 0, H - 1});
   std::vector<bool> visible(prepared.size(), true);
-  if (config_.cull) {
+  if (cull) {
     for (std::size_t i = 0; i < prepared.size(); ++i) {
       Vector3d lo, hi;
       bounding_box(prepared[i].item->shape, &lo, &hi);
       auto& b = boxes[i];
-      visible[i] = project_box(T_camera_world * prepared[i].item->T_world_item, lo, hi, K, config_.near_m, &b[0], &b[1],
+      visible[i] = project_box(T_camera_world * prepared[i].item->T_world_item, lo, hi, K, near_m, &b[0], &b[1],
                                &b[2], &b[3], &prepared[i].z_min_m);
     }
   }
@@ -249,10 +217,105 @@ void Raycaster::render(const RenderScene& scene, const Pose& T_world_camera, con
     const int u0 = boxes[i][0], u1 = boxes[i][1], v0 = boxes[i][2], v1 = boxes[i][3];
     for (int ty = v0 / tile; ty <= v1 / tile; ++ty) {
       for (int tx = u0 / tile; tx <= u1 / tile; ++tx) {
-        tiles_[static_cast<std::size_t>(ty) * tiles_x + tx].push_back(static_cast<std::uint16_t>(i));
+        (*tiles)[static_cast<std::size_t>(ty) * tiles_x + tx].push_back(static_cast<std::uint16_t>(i));
       }
     }
   }
+}
+
+/// Where the ray d_w from o_w leaves the room (farther than near_m): its depth, normal and lit
+/// colour; false when it leaves nowhere, the outputs untouched then.
+inline bool room_surface(const Room& room, const RoomView& room_from_camera, const Vector3d& o_w, const Vector3d& d_w,
+                         double near_m, const Lighting& light, double* t_best, Vector3d* normal_w, Vector3d* color) {
+  double t_room = 0;
+  int axis = 2, side = -1;
+  const bool have_opaque = room_exit(room_from_camera, d_w, &t_room, &axis, &side) && t_room > near_m;
+  if (have_opaque) {
+    *t_best = t_room;
+    *normal_w = Vector3d::Zero();
+    (*normal_w)[axis] = -side;
+    const Material& m = axis == 2 ? (side < 0 ? room.floor : room.ceiling) : room.walls;
+    *color = detail::albedo_inline(m, o_w + t_room * d_w) * light_factor(*normal_w, d_w, light);
+  }
+  return have_opaque;
+}
+
+/// The nearest opaque surface along d_c (camera frame, z = 1) among a tile's items, sorted near
+/// to far and skipped when they cannot be nearer; null when none is nearer than t_best.
+inline const Prepared* nearest_opaque(const Prepared* items, const std::uint16_t* list, std::size_t list_size,
+                                      const Vector3d& d_c, double near_m, double* t_best, ShapeHit* best_hit,
+                                      Vector3d* best_dir_local) {
+  const Prepared* best = nullptr;
+  ShapeHit hit;
+  for (std::size_t k = 0; k < list_size; ++k) {
+    const Prepared& p = items[list[k]];
+    if (p.transparent || p.z_min_m >= *t_best) continue;
+    const Vector3d d_l = p.R_local_camera * d_c;
+    if (p.sphere_test) {
+      // Bounding sphere first (no division): a miss when the origin is outside it and
+      // the ray's closest approach is farther than the radius.
+      const Vector3d oc = p.sphere_center_local - p.origin_local;
+      const double b = oc.dot(d_l), c = oc.squaredNorm() - p.sphere_radius2;
+      if (c > 0.0 && (b <= 0.0 || b * b < c * d_l.squaredNorm())) continue;
+    }
+    if (detail::intersect_inline(p.item->shape, p.origin_local, d_l, near_m, *t_best, &hit)) {
+      *t_best = hit.t;
+      best = &p;
+      *best_hit = hit;
+      *best_dir_local = d_l;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+Raycaster::Raycaster(RaycasterConfig config) : config_(config) {}
+
+void Raycaster::update_ray_tables(const Intrinsics& K) {
+  const int W = K.width, H = K.height;
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  if (rays_for_.fx != K.fx || rays_for_.fy != K.fy || rays_for_.cx != K.cx || rays_for_.cy != K.cy ||
+      rays_for_.width != W || rays_for_.height != H) {
+    rays_for_ = K;
+    x_normalized_.resize(static_cast<std::size_t>(W));
+    y_normalized_.resize(static_cast<std::size_t>(H));
+    inv_ray_length_.resize(n);
+    for (int u = 0; u < W; ++u) x_normalized_[static_cast<std::size_t>(u)] = (u - K.cx) / K.fx;
+    for (int v = 0; v < H; ++v) y_normalized_[static_cast<std::size_t>(v)] = (v - K.cy) / K.fy;
+    for (int v = 0; v < H; ++v) {
+      for (int u = 0; u < W; ++u) {
+        const double x = x_normalized_[static_cast<std::size_t>(u)], y = y_normalized_[static_cast<std::size_t>(v)];
+        inv_ray_length_[static_cast<std::size_t>(v) * W + u] = static_cast<float>(1.0 / std::sqrt(x * x + y * y + 1.0));
+      }
+    }
+  }
+}
+
+void Raycaster::render(const RenderScene& scene, const Pose& T_world_camera, const Intrinsics& K, IdealView* out) {
+  assert(K.valid());
+  const int W = K.width, H = K.height;
+  const std::size_t n = static_cast<std::size_t>(W) * H;
+  out->width = W;
+  out->height = H;
+  // Every pixel is written below: resize, no fill.
+  out->depth_m.resize(n);
+  out->opaque_depth_m.resize(n);
+  out->cos_incidence.resize(n);
+  out->opaque_cos_incidence.resize(n);
+  out->transparent.resize(n);
+  out->rgb.resize(3 * n);
+  out->labels.resize(n);
+
+  // Per-pixel ray tables, rebuilt only when the intrinsics change.
+  update_ray_tables(K);
+
+  const Matrix3d R_wc = T_world_camera.linear();
+  const Vector3d o_w = T_world_camera.translation();
+  std::vector<Prepared> prepared = prepare_items(scene, T_world_camera);
+  const int tile = std::max(1, config_.tile_px);
+  const int tiles_x = (W + tile - 1) / tile, tiles_y = (H + tile - 1) / tile;
+  bin_into_tiles(prepared, T_world_camera, K, config_.cull, config_.near_m, tile, tiles_x, tiles_y, &tiles_);
 
   // Locals and raw pointers: the byte stores below may alias anything, so nothing the loop reads
   // should live behind a pointer the compiler has to reload.
@@ -292,29 +355,10 @@ void Raycaster::render(const RenderScene& scene, const Pose& T_world_camera, con
           const std::size_t pix = static_cast<std::size_t>(v) * W + u;
           const double inv_len = inv_lengths[pix];
 
-          // Nearest opaque surface: items sorted near to far, skipped when they cannot be nearer.
           double t_best = std::numeric_limits<double>::infinity();
-          const Prepared* best = nullptr;
-          ShapeHit hit, best_hit;
+          ShapeHit best_hit;
           Vector3d best_dir_local;
-          for (std::size_t k = 0; k < list_size; ++k) {
-            const Prepared& p = items[list[k]];
-            if (p.transparent || p.z_min_m >= t_best) continue;
-            const Vector3d d_l = p.R_local_camera * d_c;
-            if (p.sphere_test) {
-              // Bounding sphere first (no division): a miss when the origin is outside it and
-              // the ray's closest approach is farther than the radius.
-              const Vector3d oc = p.sphere_center_local - p.origin_local;
-              const double b = oc.dot(d_l), c = oc.squaredNorm() - p.sphere_radius2;
-              if (c > 0.0 && (b <= 0.0 || b * b < c * d_l.squaredNorm())) continue;
-            }
-            if (detail::intersect_inline(p.item->shape, p.origin_local, d_l, near_m, t_best, &hit)) {
-              t_best = hit.t;
-              best = &p;
-              best_hit = hit;
-              best_dir_local = d_l;
-            }
-          }
+          const Prepared* best = nearest_opaque(items, list, list_size, d_c, near_m, &t_best, &best_hit, &best_dir_local);
 
           Vector3d color = Vector3d::Zero();
           Vector3d normal_w;
@@ -326,16 +370,7 @@ void Raycaster::render(const RenderScene& scene, const Pose& T_world_camera, con
             color = detail::albedo_inline(best->item->material, pt_local) * light_factor(normal_w, d_w, light);
             label = best->item->label;
           } else {
-            double t_room = 0;
-            int axis = 2, side = -1;
-            have_opaque = room_exit(room_from_camera, d_w, &t_room, &axis, &side) && t_room > near_m;
-            if (have_opaque) {
-              t_best = t_room;
-              normal_w = Vector3d::Zero();
-              normal_w[axis] = -side;
-              const Material& m = axis == 2 ? (side < 0 ? room.floor : room.ceiling) : room.walls;
-              color = detail::albedo_inline(m, o_w + t_room * d_w) * light_factor(normal_w, d_w, light);
-            }
+            have_opaque = room_surface(room, room_from_camera, o_w, d_w, near_m, light, &t_best, &normal_w, &color);
           }
           float cos_inc = have_opaque ? static_cast<float>(std::abs(normal_w.dot(d_w)) * inv_len) : 0.0f;
           float depth = have_opaque ? static_cast<float>(t_best) : kInf;

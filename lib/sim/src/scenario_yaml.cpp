@@ -9,12 +9,24 @@
 #include <set>
 #include <sstream>
 
+#include "scenewatch/core/yaml_value.h"
+
 namespace scenewatch::sim {
 namespace {
 
 struct ParseError {
   std::string message;
 };
+
+/// The value, or the error thrown as a ParseError (the reader below unwinds on the first error).
+template <typename T>
+T or_throw(Result<T> r) {
+  if (!r) throw ParseError{r.error().message};
+  return std::move(*r);
+}
+void or_throw(const Status& s) {
+  if (!s) throw ParseError{s.error().message};
+}
 
 /// A YAML map with its path, read strictly: every key must be one of the allowed ones.
 class Map {
@@ -52,32 +64,23 @@ class Map {
   }
   double positive(const std::string& key, double fallback) const {
     const double v = number(key, fallback);
-    if (!(v > 0)) fail(key_path(key), "must be positive");
+    or_throw(yaml::check_positive(v, key_path(key)));
     return v;
   }
   double non_negative(const std::string& key, double fallback) const {
     const double v = number(key, fallback);
-    if (!(v >= 0)) fail(key_path(key), "must not be negative");
+    or_throw(yaml::check_non_negative(v, key_path(key)));
     return v;
   }
   int integer(const std::string& key, int fallback) const { return has(key) ? integer(key) : fallback; }
-  int integer(const std::string& key) const {
-    const double v = number(key);
-    if (v != std::floor(v) || std::abs(v) > 1e9) fail(key_path(key), "expected an integer");
-    return static_cast<int>(v);
-  }
+  int integer(const std::string& key) const { return or_throw(yaml::read_integer(required(key), key_path(key))); }
   bool boolean(const std::string& key, bool fallback) const {
     if (!has(key)) return fallback;
-    const YAML::Node n = node_[key];
-    bool v = false;
-    if (!n.IsScalar() || !YAML::convert<bool>::decode(n, v)) fail(key_path(key), "expected true or false");
-    return v;
+    return or_throw(yaml::read_bool(node_[key], key_path(key)));
   }
   std::string string(const std::string& key, const std::string& fallback) const {
     if (!has(key)) return fallback;
-    const YAML::Node n = node_[key];
-    if (!n.IsScalar()) fail(key_path(key), "expected a string");
-    return n.as<std::string>();
+    return or_throw(yaml::read_string(node_[key], key_path(key)));
   }
   /// A list of exactly `n` numbers (or, when min_n < n, between min_n and n).
   std::vector<double> numbers(const std::string& key, std::size_t n, std::size_t min_n = 0) const {
@@ -113,13 +116,11 @@ class Map {
     return out;
   }
 
-  [[noreturn]] static void fail(const std::string& where, const std::string& what) { throw ParseError{where + ": " + what}; }
-
-  static double to_number(const YAML::Node& n, const std::string& where) {
-    double v = 0;
-    if (!n.IsScalar() || !YAML::convert<double>::decode(n, v) || !std::isfinite(v)) fail(where, "expected a number");
-    return v;
+  [[noreturn]] static void fail(const std::string& where, const std::string& what) {
+    throw ParseError{yaml::key_error(where, what).message};
   }
+
+  static double to_number(const YAML::Node& n, const std::string& where) { return or_throw(yaml::read_number(n, where)); }
 
  private:
   YAML::Node required(const std::string& key) const {
@@ -165,7 +166,7 @@ void read_appearance(const Map& m, Material* mat, bool allow_glass) {
   if (allow_glass) {
     mat->transparent = m.boolean("transparent", mat->transparent);
     mat->opacity = m.number("opacity", mat->opacity);
-    if (mat->opacity < 0 || mat->opacity > 1) Map::fail(m.key_path("opacity"), "must be in 0..1");
+    or_throw(yaml::check_in(mat->opacity, 0, 1, m.key_path("opacity")));
   }
 }
 
@@ -393,8 +394,8 @@ Scenario parse(const YAML::Node& root) {
     Intrinsics& K = sc.intrinsics;
     K.width = k.integer("width", K.width);
     K.height = k.integer("height", K.height);
-    if (K.width < 1 || K.width > 8192) Map::fail("intrinsics.width", "must be in 1..8192");
-    if (K.height < 1 || K.height > 8192) Map::fail("intrinsics.height", "must be in 1..8192");
+    or_throw(yaml::check_in(K.width, 1, 8192, "intrinsics.width"));
+    or_throw(yaml::check_in(K.height, 1, 8192, "intrinsics.height"));
     K.fx = k.positive("fx", 525.0 * K.width / 640.0);
     K.fy = k.positive("fy", K.fx);
     K.cx = k.number("cx", 0.5 * (K.width - 1));

@@ -158,6 +158,17 @@ class Localizer {
   bool must_relocalize(const Track& track, LocalizationMode mode) const;
   /// Fills r's quality from an alignment with a keyframe; true when it passes the checks.
   bool accept(Localization& r, const Alignment& a, const background::Keyframe& keyframe) const;
+  // The steps of localize() (localizer.cpp), on one frame's Attempt.
+  struct Attempt;
+  /// A camera that must relocalize, against every keyframe.
+  Localization relocalize_track(Attempt& at, LocalizationMode mode,
+                                const std::vector<std::shared_ptr<const background::Keyframe>>& every);
+  /// Alignment with the keyframes near the prior; `out` is the result so far.
+  Localization align_with_keyframes(Attempt& at, const Localization& out, const KeyframeSource& keyframes);
+  /// In `refine` or given-pose mode: the alignment fused with the given pose, or refused.
+  void weigh_against_given(Attempt& at, Localization& best, const Alignment& aligned, const background::Keyframe& aligned_to);
+  /// Times the result and moves the camera's track on by it.
+  Localization finish(Attempt& at, Localization r);
 
   Config config_;
   SensorModel sensor_;

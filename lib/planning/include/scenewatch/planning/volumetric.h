@@ -58,7 +58,16 @@ class ViewScorer {
   double coverage() const { return target_voxels_ ? static_cast<double>(target_known_) / target_voxels_ : 0.0; }
 
  private:
+  /// score()'s running sums over the rays of one view.
+  struct RaySums {
+    double unknown_entropy = 0.0, rear_entropy = 0.0, occlusion_aware = 0.0, known_entropy = 0.0;
+  };
   double occupied_probability(long index) const;
+  /// The part of a ray (from g0 along dg, grid units) worth walking, in metres; false: none.
+  bool clip_ray(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_max, double& t_enter, double& t_exit) const;
+  /// Walks one clipped ray voxel by voxel, counting into `out` and `sums`.
+  void walk_ray(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_enter, double t_exit, std::uint32_t stamp,
+                ViewGain& out, RaySums& sums);
   const background::DenseGrid& grid_;
   VolumetricConfig config_;
   long lo_[3] = {0, 0, 0}, hi_[3] = {-1, -1, -1};  ///< the target's voxel index range, inclusive

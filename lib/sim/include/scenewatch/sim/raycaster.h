@@ -70,6 +70,9 @@ class Raycaster {
   void render(const RenderScene& scene, const Pose& T_world_camera, const Intrinsics& K, IdealView* out);
 
  private:
+  /// Rebuilds the per-pixel ray tables below when K is not the intrinsics they are for.
+  void update_ray_tables(const Intrinsics& K);
+
   RaycasterConfig config_;
   std::vector<std::vector<std::uint16_t>> tiles_;  ///< candidate items per screen tile
   Intrinsics rays_for_;                            ///< intrinsics the ray tables below are for
