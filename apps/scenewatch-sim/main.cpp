@@ -241,7 +241,7 @@ int main(int argc, char** argv) {
     if (!pcd_path.empty()) {
       // Rendering is deterministic: frame 0 again gives the images just written.
       const sim::SimFrame frame = simulator->render(0, 0);
-      auto cloud = io::rgbd_to_cloud(frame.color, frame.depth, simulator->scenario().intrinsics,
+      auto cloud = io::rgbd_to_cloud(frame.color, frame.depth, simulator->scenario().intrinsics, io::kDepthMillimetres,
                                      simulator->scenario().sensor.max_depth_m);
       if (!cloud) return fail(cloud.error());
       if (auto st = io::write_pcd(pcd_path, **cloud); !st) return fail(st.error());

@@ -109,194 +109,221 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
   return s.finish();
 }
 
+// The `background:` section.
+Status read_background(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "background");
+  auto& b = c.background;
+  if (auto st = s.check_is_map(); !st) return st;
+  if (auto st = read_all([&] { return s.read("resolution_m", b.resolution_m); }, [&] { return s.read("max_range_m", b.max_range_m); },
+                         [&] { return s.read("prob_hit", b.prob_hit); }, [&] { return s.read("prob_miss", b.prob_miss); },
+                         [&] { return s.read("clamp_min", b.clamp_min); }, [&] { return s.read("clamp_max", b.clamp_max); },
+                         [&] { return s.read("fast_insertion", b.fast_insertion); },
+                         [&] { return s.read("ray_stop_after", b.ray_stop_after); },
+                         [&] { return s.read("insert_stride_px", b.insert_stride_px); });
+      !st)
+    return st;
+  return s.finish();
+}
+
+// The `segmentation:` section.
+Status read_segmentation(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "segmentation");
+  auto& g = c.segmentation;
+  if (auto st = s.check_is_map(); !st) return st;
+  std::vector<double> up;
+  if (auto st = read_all([&] { return s.read("voxel_size_m", g.voxel_size_m); }, [&] { return s.read("max_planes", g.max_planes); },
+                         [&] { return s.read("plane_distance_m", g.plane_distance_m); },
+                         [&] { return s.read("ransac_iterations", g.ransac_iterations); }, [&] { return s.read("seed", g.seed); },
+                         [&] { return s.read("min_plane_area_m2", g.min_plane_area_m2); },
+                         [&] { return s.read("plane_connectivity_m", g.plane_connectivity_m); },
+                         [&] { return s.read("up_vector", up); },
+                         [&] { return s.read("max_normal_angle_deg", g.max_normal_angle_deg); },
+                         [&] { return s.read("min_object_height_m", g.min_object_height_m); },
+                         [&] { return s.read("max_object_height_m", g.max_object_height_m); },
+                         [&] { return s.read("height_noise_sigmas", g.height_noise_sigmas); },
+                         [&] { return s.read("cluster_tolerance_m", g.cluster_tolerance_m); },
+                         [&] { return s.read("min_cluster_points", g.min_cluster_points); },
+                         [&] { return s.read("max_cluster_points", g.max_cluster_points); },
+                         [&] { return s.read("split_concave", g.split_concave); },
+                         [&] { return s.read("patch_size_m", g.patch_size_m); },
+                         [&] { return s.read("concavity_tolerance_deg", g.concavity_tolerance_deg); },
+                         [&] { return s.read("crease_angle_deg", g.crease_angle_deg); },
+                         [&] { return s.read("join_occluded", g.join_occluded); },
+                         [&] { return s.read("recover_image_grid", g.recover_image_grid); },
+                         [&] { return s.read("bridge_hidden_support", g.bridge_hidden_support); },
+                         [&] { return s.read("split_depth_steps", g.split_depth_steps); },
+                         [&] { return s.read("split_colour_edges", g.split_colour_edges); });
+      !st)
+    return st;
+  if (!up.empty()) {
+    if (up.size() != 3) return invalid_argument("segmentation.up_vector: must be [x, y, z] or null");
+    g.up = Eigen::Vector3d(up[0], up[1], up[2]);
+  }
+  return s.finish();
+}
+
+// The `tracking:` section.
+Status read_tracking(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "tracking");
+  if (auto st = s.check_is_map(); !st) return st;
+  if (auto st = read_all([&] { return s.read("match_distance_m", c.tracking.match_distance_m); },
+                         [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); },
+                         [&] { return s.read("confirm_frames", c.tracking.confirm_frames); },
+                         [&] { return s.read("min_extent_cells", c.tracking.min_extent_cells); },
+                         [&] { return s.read("gone_frames", c.tracking.gone_frames); },
+                         [&] { return s.read("max_range_m", c.tracking.max_range_m); },
+                         [&] { return s.read("segmentation_stride_px", c.tracking.segmentation_stride_px); });
+      !st)
+    return st;
+  return s.finish();
+}
+
+// The `change:` section.
+Status read_change(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "change");
+  auto& g = c.change;
+  if (auto st = s.check_is_map(); !st) return st;
+  if (auto st = read_all([&] { return s.read("enabled", c.change_enabled); },
+                         [&] { return s.read("persistence_frames", g.persistence_frames); },
+                         [&] { return s.read("persistence_match_m", g.persistence_match_m); },
+                         [&] { return s.read("sigma_factor", g.sigma_factor); },
+                         [&] { return s.read("max_range_m", g.max_range_m); },
+                         [&] { return s.read("min_surface_probability", g.min_surface_probability); },
+                         [&] { return s.read("min_tolerance_m", g.min_tolerance_m); },
+                         [&] { return s.read("cluster_voxel_m", g.cluster_voxel_m); },
+                         [&] { return s.read("min_object_size_m", g.min_object_size_m); },
+                         [&] { return s.read("min_object_area_m2", g.min_object_area_m2); },
+                         [&] { return s.read("min_cluster_points", g.min_cluster_points); },
+                         [&] { return s.read("move_max_size_ratio", g.move_max_size_ratio); },
+                         [&] { return s.read("move_max_color_distance", g.move_max_color_distance); },
+                         [&] { return s.read("move_min_distance_m", g.move_min_distance_m); },
+                         [&] { return s.read("complete_objects", g.complete_objects); },
+                         [&] { return s.read("completion_evidence_share", g.completion_evidence_share); },
+                         [&] { return s.read("completion_object_share", g.completion_object_share); },
+                         [&] { return s.read("completion_stride_px", g.completion_stride_px); },
+                         [&] { return s.read("trusted_pixels_only", g.trusted_pixels_only); },
+                         [&] { return s.read("measure_pose", g.measure_pose); },
+                         [&] { return s.read("witness_per_camera", g.witness_per_camera); },
+                         [&] { return s.read("incidence_aware", g.incidence_aware); });
+      !st)
+    return st;
+  return s.finish();
+}
+
+// The `appearance:` section.
+Status read_appearance(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "appearance");
+  if (auto st = s.check_is_map(); !st) return st;
+  background::AppearanceConfig& a = c.appearance;
+  if (auto st = read_all([&] { return s.read("enabled", a.enabled); },
+                         [&] { return s.read("keyframe_min_translation_m", a.keyframe_min_translation_m); },
+                         [&] { return s.read("keyframe_min_rotation_deg", a.keyframe_min_rotation_deg); },
+                         [&] { return s.read("max_keyframes", a.max_keyframes); },
+                         [&] { return s.read("memory_budget_mb", a.memory_budget_mb); },
+                         [&] { return s.read("mesh_stride_px", a.mesh_stride_px); },
+                         [&] { return s.read("mesh_max_depth_jump", a.mesh_max_depth_jump); },
+                         [&] { return s.read("depth_views", a.depth_views); });
+      !st)
+    return st;
+  return s.finish();
+}
+
+// The `surprise:` section.
+Status read_surprise(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "surprise");
+  if (auto st = s.check_is_map(); !st) return st;
+  surprise::SurpriseConfig& u = c.surprise;
+  if (auto st = read_all([&] { return s.read("enabled", u.enabled); }, [&] { return s.read("a0", u.prior.a0); },
+                         [&] { return s.read("b0", u.prior.b0); }, [&] { return s.read("min_samples", u.min_samples); },
+                         [&] { return s.read("max_samples", u.view.max_samples); },
+                         [&] { return s.read("depth_tolerance_m", u.view.depth_tolerance_m); },
+                         [&] { return s.read("depth_tolerance_rel", u.view.depth_tolerance_rel); },
+                         [&] { return s.read("fill_holes_px", u.view.fill_holes_px); },
+                         [&] { return s.read("sample_step_px", u.view.sample_step_px); },
+                         [&] { return s.read("fill_holes_max_jump", u.view.fill_holes_max_jump); },
+                         [&] { return s.read("threshold_high", u.regions.threshold_high); },
+                         [&] { return s.read("threshold_low", u.regions.threshold_low); },
+                         [&] { return s.read("open_radius_px", u.regions.open_radius_px); },
+                         [&] { return s.read("min_area_px", u.regions.min_area_px); },
+                         [&] { return s.read("min_extent_px", u.regions.min_extent_px); },
+                         [&] { return s.read("adopt_after_frames", u.adopt_after_frames); },
+                         [&] { return s.read("photometric", u.robust.photometric); },
+                         [&] { return s.read("align_radius_px", u.robust.align_radius_px); },
+                         [&] { return s.read("align_min_kl", u.robust.align_min_kl); },
+                         [&] { return s.read("familiar_after_frames", u.familiar_after_frames); });
+      !st)
+    return st;
+  return s.finish();
+}
+
+// The `foreground:` section.
+Status read_foreground(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "foreground");
+  if (auto st = s.check_is_map(); !st) return st;
+  foreground::ForegroundConfig& f = c.foreground;
+  if (auto st = read_all([&] { return s.read("enabled", f.enabled); },
+                         [&] { return s.read("contact_m", f.contact_m); },
+                         [&] { return s.read("promote_translation_m", f.promote_translation_m); },
+                         [&] { return s.read("promote_rotation_deg", f.promote_rotation_deg); },
+                         [&] { return s.read("vacated_fraction", f.vacated_fraction); },
+                         [&] { return s.read("promote_lift_m", f.promote_lift_m); },
+                         [&] { return s.read("touch_timeout_frames", f.touch_timeout_frames); },
+                         [&] { return s.read("release_frames", f.release_frames); },
+                         [&] { return s.read("dof_translation_m", f.dof.translation_m); },
+                         [&] { return s.read("dof_rotation_deg", f.dof.rotation_deg); },
+                         [&] { return s.read("search_radius_m", f.search_radius_m); },
+                         [&] { return s.read("mask_m", f.mask_m); },
+                         [&] { return s.read("max_model_points", f.max_model_points); },
+                         [&] { return s.read("grow_model", f.grow_model); },
+                         [&] { return s.read("grow_max_rmse_m", f.grow_max_rmse_m); },
+                         [&] { return s.read("grow_min_inlier_fraction", f.grow_min_inlier_fraction); },
+                         [&] { return s.read("reacquire_radius_m", f.reacquire_radius_m); },
+                         [&] { return s.read("hands", f.hands.enabled); },
+                         [&] { return s.read("hand_min_area_m2", f.hands.min_hand_area_m2); },
+                         [&] { return s.read("hand_max_area_m2", f.hands.max_hand_area_m2); });
+      !st)
+    return st;
+  return s.finish();
+}
+
+// The `events:` section.
+Status read_events(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "events");
+  if (auto st = s.check_is_map(); !st) return st;
+  if (auto st = read_all([&] { return s.read("max_log", c.max_event_log); },
+                         [&] { return s.read("appearance_persistence_frames", c.fusion.persistence_frames); },
+                         [&] { return s.read("appearance_match_m", c.fusion.match_m); },
+                         [&] { return s.read("merge_margin_m", c.fusion.margin_m); },
+                         [&] { return s.read("silence_frames", c.fusion.zone_frames); });
+      !st)
+    return st;
+  return s.finish();
+}
+
+// The `workspace:` section.
+Status read_workspace(const YAML::Node& node, Config& c) {
+  YamlSection s(node, "workspace");
+  if (auto st = s.check_is_map(); !st) return st;
+  if (auto st = s.read("radius_m", c.workspace_radius_m); !st) return st;
+  return s.finish();
+}
+
 }  // namespace
 
 Status read_pipeline_config(const YAML::Node& root, Config& c) {
   if (auto st = read_sensor(root["sensor"], c.sensor); !st) return st;
   c.change.sensor = c.sensor;  // what reads config.change alone (scenewatch diff) sees the same sensor
   c.segmentation.sensor = c.sensor;
-  {
-    YamlSection s(root["background"], "background");
-    auto& b = c.background;
-    if (auto st = s.check_is_map(); !st) return st;
-    if (auto st = read_all([&] { return s.read("resolution_m", b.resolution_m); }, [&] { return s.read("max_range_m", b.max_range_m); },
-                           [&] { return s.read("prob_hit", b.prob_hit); }, [&] { return s.read("prob_miss", b.prob_miss); },
-                           [&] { return s.read("clamp_min", b.clamp_min); }, [&] { return s.read("clamp_max", b.clamp_max); },
-                           [&] { return s.read("fast_insertion", b.fast_insertion); },
-                           [&] { return s.read("ray_stop_after", b.ray_stop_after); },
-                           [&] { return s.read("insert_stride_px", b.insert_stride_px); });
-        !st)
-      return st;
-    if (auto st = s.finish(); !st) return st;
-  }
-  {
-    YamlSection s(root["segmentation"], "segmentation");
-    auto& g = c.segmentation;
-    if (auto st = s.check_is_map(); !st) return st;
-    std::vector<double> up;
-    if (auto st = read_all([&] { return s.read("voxel_size_m", g.voxel_size_m); }, [&] { return s.read("max_planes", g.max_planes); },
-                           [&] { return s.read("plane_distance_m", g.plane_distance_m); },
-                           [&] { return s.read("ransac_iterations", g.ransac_iterations); }, [&] { return s.read("seed", g.seed); },
-                           [&] { return s.read("min_plane_area_m2", g.min_plane_area_m2); },
-                           [&] { return s.read("plane_connectivity_m", g.plane_connectivity_m); },
-                           [&] { return s.read("up_vector", up); },
-                           [&] { return s.read("max_normal_angle_deg", g.max_normal_angle_deg); },
-                           [&] { return s.read("min_object_height_m", g.min_object_height_m); },
-                           [&] { return s.read("max_object_height_m", g.max_object_height_m); },
-                           [&] { return s.read("height_noise_sigmas", g.height_noise_sigmas); },
-                           [&] { return s.read("cluster_tolerance_m", g.cluster_tolerance_m); },
-                           [&] { return s.read("min_cluster_points", g.min_cluster_points); },
-                           [&] { return s.read("max_cluster_points", g.max_cluster_points); },
-                           [&] { return s.read("split_concave", g.split_concave); },
-                           [&] { return s.read("patch_size_m", g.patch_size_m); },
-                           [&] { return s.read("concavity_tolerance_deg", g.concavity_tolerance_deg); },
-                           [&] { return s.read("crease_angle_deg", g.crease_angle_deg); },
-                           [&] { return s.read("join_occluded", g.join_occluded); },
-                           [&] { return s.read("recover_image_grid", g.recover_image_grid); },
-                           [&] { return s.read("bridge_hidden_support", g.bridge_hidden_support); },
-                           [&] { return s.read("split_depth_steps", g.split_depth_steps); },
-                           [&] { return s.read("split_colour_edges", g.split_colour_edges); });
-        !st)
-      return st;
-    if (!up.empty()) {
-      if (up.size() != 3) return invalid_argument("segmentation.up_vector: must be [x, y, z] or null");
-      g.up = Eigen::Vector3d(up[0], up[1], up[2]);
-    }
-    if (auto st = s.finish(); !st) return st;
-  }
-  {
-    YamlSection s(root["tracking"], "tracking");
-    if (auto st = s.check_is_map(); !st) return st;
-    if (auto st = read_all([&] { return s.read("match_distance_m", c.tracking.match_distance_m); },
-                           [&] { return s.read("gone_free_fraction", c.tracking.gone_free_fraction); },
-                           [&] { return s.read("confirm_frames", c.tracking.confirm_frames); },
-                           [&] { return s.read("min_extent_cells", c.tracking.min_extent_cells); },
-                           [&] { return s.read("gone_frames", c.tracking.gone_frames); },
-                           [&] { return s.read("max_range_m", c.tracking.max_range_m); },
-                           [&] { return s.read("segmentation_stride_px", c.tracking.segmentation_stride_px); });
-        !st)
-      return st;
-    if (auto st = s.finish(); !st) return st;
-  }
-  {
-    YamlSection s(root["change"], "change");
-    auto& g = c.change;
-    if (auto st = s.check_is_map(); !st) return st;
-    if (auto st = read_all([&] { return s.read("enabled", c.change_enabled); },
-                           [&] { return s.read("persistence_frames", g.persistence_frames); },
-                           [&] { return s.read("persistence_match_m", g.persistence_match_m); },
-                           [&] { return s.read("sigma_factor", g.sigma_factor); },
-                           [&] { return s.read("max_range_m", g.max_range_m); },
-                           [&] { return s.read("min_surface_probability", g.min_surface_probability); },
-                           [&] { return s.read("min_tolerance_m", g.min_tolerance_m); },
-                           [&] { return s.read("cluster_voxel_m", g.cluster_voxel_m); },
-                           [&] { return s.read("min_object_size_m", g.min_object_size_m); },
-                           [&] { return s.read("min_object_area_m2", g.min_object_area_m2); },
-                           [&] { return s.read("min_cluster_points", g.min_cluster_points); },
-                           [&] { return s.read("move_max_size_ratio", g.move_max_size_ratio); },
-                           [&] { return s.read("move_max_color_distance", g.move_max_color_distance); },
-                           [&] { return s.read("move_min_distance_m", g.move_min_distance_m); },
-                           [&] { return s.read("complete_objects", g.complete_objects); },
-                           [&] { return s.read("completion_evidence_share", g.completion_evidence_share); },
-                           [&] { return s.read("completion_object_share", g.completion_object_share); },
-                           [&] { return s.read("completion_stride_px", g.completion_stride_px); },
-                           [&] { return s.read("trusted_pixels_only", g.trusted_pixels_only); },
-                           [&] { return s.read("measure_pose", g.measure_pose); },
-                           [&] { return s.read("witness_per_camera", g.witness_per_camera); },
-                           [&] { return s.read("incidence_aware", g.incidence_aware); });
-        !st)
-      return st;
-    if (auto st = s.finish(); !st) return st;
-  }
-  {
-    YamlSection s(root["appearance"], "appearance");
-    if (auto st = s.check_is_map(); !st) return st;
-    background::AppearanceConfig& a = c.appearance;
-    if (auto st = read_all([&] { return s.read("enabled", a.enabled); },
-                           [&] { return s.read("keyframe_min_translation_m", a.keyframe_min_translation_m); },
-                           [&] { return s.read("keyframe_min_rotation_deg", a.keyframe_min_rotation_deg); },
-                           [&] { return s.read("max_keyframes", a.max_keyframes); },
-                           [&] { return s.read("memory_budget_mb", a.memory_budget_mb); },
-                           [&] { return s.read("mesh_stride_px", a.mesh_stride_px); },
-                           [&] { return s.read("mesh_max_depth_jump", a.mesh_max_depth_jump); },
-                           [&] { return s.read("depth_views", a.depth_views); });
-        !st)
-      return st;
-    if (auto st = s.finish(); !st) return st;
-  }
-  {
-    YamlSection s(root["surprise"], "surprise");
-    if (auto st = s.check_is_map(); !st) return st;
-    surprise::SurpriseConfig& u = c.surprise;
-    if (auto st = read_all([&] { return s.read("enabled", u.enabled); }, [&] { return s.read("a0", u.prior.a0); },
-                           [&] { return s.read("b0", u.prior.b0); }, [&] { return s.read("min_samples", u.min_samples); },
-                           [&] { return s.read("max_samples", u.view.max_samples); },
-                           [&] { return s.read("depth_tolerance_m", u.view.depth_tolerance_m); },
-                           [&] { return s.read("depth_tolerance_rel", u.view.depth_tolerance_rel); },
-                           [&] { return s.read("fill_holes_px", u.view.fill_holes_px); },
-                           [&] { return s.read("sample_step_px", u.view.sample_step_px); },
-                           [&] { return s.read("fill_holes_max_jump", u.view.fill_holes_max_jump); },
-                           [&] { return s.read("threshold_high", u.regions.threshold_high); },
-                           [&] { return s.read("threshold_low", u.regions.threshold_low); },
-                           [&] { return s.read("open_radius_px", u.regions.open_radius_px); },
-                           [&] { return s.read("min_area_px", u.regions.min_area_px); },
-                           [&] { return s.read("min_extent_px", u.regions.min_extent_px); },
-                           [&] { return s.read("adopt_after_frames", u.adopt_after_frames); },
-                           [&] { return s.read("photometric", u.robust.photometric); },
-                           [&] { return s.read("align_radius_px", u.robust.align_radius_px); },
-                           [&] { return s.read("align_min_kl", u.robust.align_min_kl); },
-                           [&] { return s.read("familiar_after_frames", u.familiar_after_frames); });
-        !st)
-      return st;
-    if (auto st = s.finish(); !st) return st;
-  }
-  {
-    YamlSection s(root["foreground"], "foreground");
-    if (auto st = s.check_is_map(); !st) return st;
-    foreground::ForegroundConfig& f = c.foreground;
-    if (auto st = read_all([&] { return s.read("enabled", f.enabled); },
-                           [&] { return s.read("contact_m", f.contact_m); },
-                           [&] { return s.read("promote_translation_m", f.promote_translation_m); },
-                           [&] { return s.read("promote_rotation_deg", f.promote_rotation_deg); },
-                           [&] { return s.read("vacated_fraction", f.vacated_fraction); },
-                           [&] { return s.read("promote_lift_m", f.promote_lift_m); },
-                           [&] { return s.read("touch_timeout_frames", f.touch_timeout_frames); },
-                           [&] { return s.read("release_frames", f.release_frames); },
-                           [&] { return s.read("dof_translation_m", f.dof.translation_m); },
-                           [&] { return s.read("dof_rotation_deg", f.dof.rotation_deg); },
-                           [&] { return s.read("search_radius_m", f.search_radius_m); },
-                           [&] { return s.read("mask_m", f.mask_m); },
-                           [&] { return s.read("max_model_points", f.max_model_points); },
-                           [&] { return s.read("grow_model", f.grow_model); },
-                           [&] { return s.read("grow_max_rmse_m", f.grow_max_rmse_m); },
-                           [&] { return s.read("grow_min_inlier_fraction", f.grow_min_inlier_fraction); },
-                           [&] { return s.read("reacquire_radius_m", f.reacquire_radius_m); },
-                           [&] { return s.read("hands", f.hands.enabled); },
-                           [&] { return s.read("hand_min_area_m2", f.hands.min_hand_area_m2); },
-                           [&] { return s.read("hand_max_area_m2", f.hands.max_hand_area_m2); });
-        !st)
-      return st;
-    if (auto st = s.finish(); !st) return st;
-  }
-  {
-    YamlSection s(root["events"], "events");
-    if (auto st = s.check_is_map(); !st) return st;
-    if (auto st = read_all([&] { return s.read("max_log", c.max_event_log); },
-                           [&] { return s.read("appearance_persistence_frames", c.fusion.persistence_frames); },
-                           [&] { return s.read("appearance_match_m", c.fusion.match_m); },
-                           [&] { return s.read("merge_margin_m", c.fusion.margin_m); },
-                           [&] { return s.read("silence_frames", c.fusion.zone_frames); });
-        !st)
-      return st;
-    if (auto st = s.finish(); !st) return st;
-  }
+  if (auto st = read_background(root["background"], c); !st) return st;
+  if (auto st = read_segmentation(root["segmentation"], c); !st) return st;
+  if (auto st = read_tracking(root["tracking"], c); !st) return st;
+  if (auto st = read_change(root["change"], c); !st) return st;
+  if (auto st = read_appearance(root["appearance"], c); !st) return st;
+  if (auto st = read_surprise(root["surprise"], c); !st) return st;
+  if (auto st = read_foreground(root["foreground"], c); !st) return st;
+  if (auto st = read_events(root["events"], c); !st) return st;
   if (auto st = read_localization(root["localization"], c.localization); !st) return st;
-  {
-    YamlSection s(root["workspace"], "workspace");
-    if (auto st = s.check_is_map(); !st) return st;
-    if (auto st = s.read("radius_m", c.workspace_radius_m); !st) return st;
-    if (auto st = s.finish(); !st) return st;
-  }
+  if (auto st = read_workspace(root["workspace"], c); !st) return st;
   return validate(c);
 }
 
