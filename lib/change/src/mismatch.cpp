@@ -161,6 +161,63 @@ DepthView depth_view(const Cloud& cloud, const Intrinsics& K) {
   return view;
 }
 
+namespace {
+// Removed: occupied voxels whose whole projected footprint shows depth behind them by more than the
+// tolerance. A footprint pixel at or in front of the voxel (the surface is still there, or
+// something occludes it) vetoes; so does one without depth (a hole at a grazing edge may be the
+// surface itself) or one the sensor model does not trust. The footprint is the voxel's, grown by
+// the pose's uncertainty at that range: wherever the voxel may really project, the frame must see
+// behind it.
+template <typename TrustedAt>
+std::vector<MissingVoxel> missing_surfaces(const background::DenseGrid& grid, const Pose& T, const Intrinsics& K,
+                                           const Config& config, const DepthView& depth, const TrustedAt& trusted_at,
+                                           const PoseAgreement& measured_pose, const SurfaceWitness* witness,
+                                           std::uint32_t camera, double res) {
+  std::vector<MissingVoxel> missing;
+  const Eigen::Isometry3d T_camera_world = T.inverse();
+  const auto min_probability = static_cast<std::uint8_t>(std::floor(255.0 * config.min_surface_probability));
+  for (const background::DenseGrid::Surface& surface : grid.occupied) {
+    if (surface.probability < min_probability) continue;
+    const Eigen::Vector3d c = grid.center(static_cast<long>(surface.index));
+    if (witness != nullptr && witness->seen(c, camera) == SurfaceWitness::Seen::kByOthersOnly) continue;
+    const Eigen::Vector3d q = T_camera_world * c;
+    if (q.z() <= res || q.z() > config.max_range_m) continue;
+    const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
+    const double shift = measured_pose.shift_at(c);
+    const double half_px = K.fx * (kHalfDiagonal * res + config.sigma_factor * config.sensor.pose_sigma_at(q.z()) + shift) / q.z();
+    if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) continue;
+    const double limit = q.z() + kHalfDiagonal * res + map_tolerance_m(config, q.z(), shift);
+    constexpr int kSteps = 3;  // (2 kSteps + 1)^2 samples over the footprint
+    int with_depth = 0, total = 0;
+    float nearest = std::numeric_limits<float>::infinity();
+    bool veto = false;
+    for (int a = -kSteps; a <= kSteps && !veto; ++a)
+      for (int b = -kSteps; b <= kSteps; ++b) {
+        const int u = static_cast<int>(std::lround(uc + half_px * a / kSteps));
+        const int v = static_cast<int>(std::lround(vc + half_px * b / kSteps));
+        ++total;
+        const float z = depth.at(u, v);
+        if (!(z > 0) || !trusted_at(u, v)) continue;
+        ++with_depth;
+        if (z <= limit) {
+          veto = true;
+          break;
+        }
+        nearest = std::min(nearest, z);
+      }
+    if (veto || with_depth < total) continue;
+    MissingVoxel m;
+    m.center_world = c;
+    m.rgb = surface.rgb;
+    m.u = static_cast<int>(std::lround(uc));
+    m.v = static_cast<int>(std::lround(vc));
+    m.depth_gap_m = static_cast<float>(nearest - q.z());
+    missing.push_back(m);
+  }
+  return missing;
+}
+}  // namespace
+
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& cloud, const Pose& T,
                                       const Intrinsics& K, const Config& config, background::DenseGrid* grid_scratch,
                                       const SurfaceWitness* witness, std::uint32_t camera) {
@@ -255,53 +312,9 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   }
   out.added_ms = ms_since(t1);
 
-  // 3. Removed: occupied voxels whose whole projected footprint shows depth behind them by more
-  //    than the tolerance. A footprint pixel at or in front of the voxel (the surface is still
-  //    there, or something occludes it) vetoes; so does one without depth (a hole at a grazing
-  //    edge may be the surface itself) or one the sensor model does not trust. The footprint is
-  //    the voxel's, grown by the pose's uncertainty at that range: wherever the voxel may really
-  //    project, the frame must see behind it.
+  // 3. Removed (missing_surfaces).
   const auto t2 = Clock::now();
-  const Eigen::Isometry3d T_camera_world = T.inverse();
-  const auto min_probability = static_cast<std::uint8_t>(std::floor(255.0 * config.min_surface_probability));
-  for (const background::DenseGrid::Surface& surface : grid.occupied) {
-    if (surface.probability < min_probability) continue;
-    const Eigen::Vector3d c = grid.center(static_cast<long>(surface.index));
-    if (witness != nullptr && witness->seen(c, camera) == SurfaceWitness::Seen::kByOthersOnly) continue;
-    const Eigen::Vector3d q = T_camera_world * c;
-    if (q.z() <= res || q.z() > config.max_range_m) continue;
-    const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
-    const double shift = measured_pose.shift_at(c);
-    const double half_px = K.fx * (kHalfDiagonal * res + config.sigma_factor * config.sensor.pose_sigma_at(q.z()) + shift) / q.z();
-    if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) continue;
-    const double limit = q.z() + kHalfDiagonal * res + map_tolerance_m(config, q.z(), shift);
-    constexpr int kSteps = 3;  // (2 kSteps + 1)^2 samples over the footprint
-    int with_depth = 0, total = 0;
-    float nearest = std::numeric_limits<float>::infinity();
-    bool veto = false;
-    for (int a = -kSteps; a <= kSteps && !veto; ++a)
-      for (int b = -kSteps; b <= kSteps; ++b) {
-        const int u = static_cast<int>(std::lround(uc + half_px * a / kSteps));
-        const int v = static_cast<int>(std::lround(vc + half_px * b / kSteps));
-        ++total;
-        const float z = depth.at(u, v);
-        if (!(z > 0) || !trusted_at(u, v)) continue;
-        ++with_depth;
-        if (z <= limit) {
-          veto = true;
-          break;
-        }
-        nearest = std::min(nearest, z);
-      }
-    if (veto || with_depth < total) continue;
-    MissingVoxel m;
-    m.center_world = c;
-    m.rgb = surface.rgb;
-    m.u = static_cast<int>(std::lround(uc));
-    m.v = static_cast<int>(std::lround(vc));
-    m.depth_gap_m = static_cast<float>(nearest - q.z());
-    out.missing.push_back(m);
-  }
+  out.missing = missing_surfaces(grid, T, K, config, depth, trusted_at, measured_pose, witness, camera, res);
   out.missing_ms = ms_since(t2);
   return out;
 }
