@@ -5,7 +5,6 @@
 #include <chrono>
 #include <deque>
 #include <filesystem>
-#include <functional>
 #include <iostream>
 #include <memory>
 #include <optional>
@@ -226,17 +225,19 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
     }
     return true;
   };
-  // The frames to send, as (name, loader). With `preload` every frame is decoded before the clock
-  // starts, so they leave at `fps` as from a sensor, not at the pace of the disk and the decoder.
+  // The frames to send. With `preload` every frame is decoded and encoded before the clock starts,
+  // so they leave at `fps` as from a sensor, not at the pace of the disk and the decoder.
   struct Pending {
     std::string name;
-    std::function<Result<proto::IngestFrame>()> load;
+    std::shared_ptr<const cli::SequenceSpan> seq;
+    std::size_t index = 0;
+    std::optional<Result<proto::Request>> preloaded;
   };
-  auto encode = [&](Result<Frame> frame) -> Result<proto::IngestFrame> {
+  auto encode = [&](const Pending& p) -> Result<proto::Request> {
+    auto frame = p.seq->load(p.index);
     if (!frame) return frame.error();
-    frame->camera = camera;
-    frame->localization = options.localization;
-    return service::make_ingest_frame(*frame);
+    const std::string source = frame->source;  // the file it came from, as before
+    return ingest_request(*frame, source, camera, options);
   };
   std::vector<Pending> pending;
   for (const std::string& path : paths) {
@@ -245,29 +246,25 @@ int run_live_ingest(const RemoteOptions& options, const std::vector<std::string>
     auto span = cli::sequence_span(path, inputs);
     if (!span) return fail(naming(path, span.error().message + " (--live takes RGB-D sequence folders and bags)"));
     if (!*span) return fail(naming(path, "not a sequence folder nor a bag (--live takes RGB-D sequence folders and bags)"));
-    auto seq = std::make_shared<cli::SequenceSpan>(std::move(**span));
-    for (std::size_t i = seq->first; i <= seq->last; ++i)
-      pending.push_back({seq->frame_name(i), [seq, i, &encode] { return encode(seq->load(i)); }});
+    auto seq = std::make_shared<const cli::SequenceSpan>(std::move(**span));
+    for (std::size_t i = seq->first; i <= seq->last; ++i) pending.push_back({seq->frame_name(i), seq, i, std::nullopt});
   }
   if (preload) {
     std::cerr << "decoding " << pending.size() << " frames before the first is sent (--preload)" << std::endl;
-    for (Pending& p : pending) {
-      auto frame = std::make_shared<Result<proto::IngestFrame>>(p.load());
-      p.load = [frame] { return std::move(*frame); };
-    }
+    for (Pending& p : pending) p.preloaded = encode(p);
   }
   const auto start = std::chrono::steady_clock::now();
   auto last_sent = start;
   for (Pending& p : pending) {
-    auto frame = p.load();
-    if (!frame) {
-      fail(naming(p.name, frame.error().message));
+    auto encoded = p.preloaded ? std::move(*p.preloaded) : encode(p);
+    p.preloaded.reset();
+    if (!encoded) {
+      fail(naming(p.name, encoded.error().message));
       ++failures;
       continue;
     }
     std::this_thread::sleep_until(start + std::chrono::duration<double>(sent / fps));
-    proto::Request request;
-    *request.mutable_ingest_frame() = std::move(*frame);
+    proto::Request request = std::move(*encoded);
     request.mutable_ingest_frame()->set_live(true);
     request.set_token(client->token());
     request.set_id(++sent);
