@@ -81,8 +81,11 @@ std::string camera_name(const std::string& given, const std::vector<std::string>
     fs::path p = fs::path(paths.front()).lexically_normal();
     if (p.filename().empty()) p = p.parent_path();  // "dir/"
     if (!fs::is_directory(p)) p = p.parent_path();
-    const fs::path absolute = fs::absolute(p).lexically_normal();
-    if (!absolute.filename().empty()) folder = absolute.filename().string();
+    if (p.empty()) p = ".";  // a file name alone (or one that does not exist): the current folder
+    std::error_code ec;
+    fs::path absolute = fs::absolute(p, ec).lexically_normal();
+    if (absolute.filename().empty()) absolute = absolute.parent_path();  // "/here/." is "/here/"
+    if (!ec && !absolute.filename().empty()) folder = absolute.filename().string();
   }
   return folder + "#" + std::to_string(::getpid());
 }

@@ -243,6 +243,7 @@ int main(int argc, char** argv) {
   if (live_view_on) {
     scenewatch::service::LiveViewConfig view_config;
     view_config.three_js = config.server.http_three_js;
+    view_config.classes = config.server.classes;
     live_view = std::make_unique<scenewatch::service::LiveView>(memory, view_config);
     if (auto s = live_view->check_three_js(); !s) log(LogLevel::kWarning, "live view: " + s.error().message);
     server.set_frame_observer([view = live_view.get()](const scenewatch::Frame& frame,

@@ -518,6 +518,12 @@ TEST_F(CliTest, IngestTakesOneFrameOrARangeOfASequence) {
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.err.find("the sequence has 3 frames"), std::string::npos) << result.err;
   EXPECT_EQ(frames_processed(), 4);
+  // A bare file name that is not there (no folder to name the camera after) is an error naming
+  // it, not an abort.
+  result = remote({"ingest", "no-such-cloud.pcd"});
+  EXPECT_EQ(result.exit_code, 1) << result.err;
+  EXPECT_NE(result.err.find("no-such-cloud.pcd"), std::string::npos) << result.err;
+  EXPECT_EQ(frames_processed(), 4);
 
   // --trajectory: the poses the memory used, one TUM line per frame (given mode: the frame's own).
   result = remote({"ingest", seq.string() + ":0-2", "--camera", "arm", "--trajectory", (tmp_ / "used.txt").string()});

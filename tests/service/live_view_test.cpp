@@ -1,7 +1,7 @@
 // The live view in the browser: the HTTP request parser on byte splits and bad input, the real
 // scenewatchd's HTTP port against raw sockets (bad requests neither stop it nor its TCP API), and
 // headless Chromium on the page after a simulated cup was put on the table: the event and the
-// object are in the page's DOM, and the object's box is drawn in the 3D view of the screenshot.
+// object with its class are in the page's DOM, and the object's box is drawn in the 3D view of the screenshot.
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
@@ -422,6 +422,10 @@ TEST_F(LiveViewTest, ChromiumShowsTheObjectAndTheEventAfterACupIsPutOnTheTable) 
   ASSERT_NE(events.find("OBJECT_ADDED"), std::string::npos) << events;
   const std::string state = body_of(get(http_port_, "/api/state"));
   ASSERT_NE(state.find("\"objects\":[{"), std::string::npos) << state;
+  // The daemon's classes describe the objects in the whole state (as GetObjects does); the
+  // cheap poll leaves them out.
+  EXPECT_NE(state.find("\"class\":\"cup\""), std::string::npos) << state;
+  EXPECT_EQ(body_of(get(http_port_, "/api/state?voxels=0")).find("\"class\":"), std::string::npos);
   const std::string frame = get(http_port_, "/api/frame.png");
   ASSERT_EQ(status_of(frame), 200);
   EXPECT_EQ(body_of(frame).substr(1, 3), "PNG");
@@ -435,6 +439,7 @@ TEST_F(LiveViewTest, ChromiumShowsTheObjectAndTheEventAfterACupIsPutOnTheTable) 
   ASSERT_EQ(dom.exit_code, 0) << dom.err;
   EXPECT_NE(dom.out.find("class=\"event OBJECT_ADDED\""), std::string::npos) << dom.out;
   EXPECT_NE(dom.out.find("class=\"object\">object "), std::string::npos) << dom.out;
+  EXPECT_NE(dom.out.find(" (cup, score "), std::string::npos) << "the object's class is listed:\n" << dom.out;
   EXPECT_NE(dom.out.find("id=\"three-error\" hidden"), std::string::npos) << "three.js or WebGL missing:\n" << dom.out;
 
   const fs::path shot = tmp_ / "live-view.png";

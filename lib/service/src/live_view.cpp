@@ -9,6 +9,7 @@
 #include <sstream>
 #include <vector>
 
+#include "class_records.h"
 #include "live_view_page.h"
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/core/event_json.h"
@@ -102,6 +103,16 @@ struct LiveView::Impl {
     for (const auto& p : snapshot->planes) planes.push_back(to_json(p));
     json objects = json::array();
     for (const auto& o : snapshot->objects) objects.push_back(to_json(o));
+    // The classes only in the whole state, which the page asks for when a frame was processed:
+    // describing is cached per object, but the cheap poll should not start it.
+    if (with_voxels && config.classes) {
+      const auto described = describe_and_record(memory, *snapshot, *config.classes);
+      for (std::size_t k = 0; k < described.size(); ++k) {
+        if (!described[k]) continue;  // an object without points
+        objects[k]["class"] = described[k]->class_name;
+        objects[k]["class_score"] = described[k]->score;
+      }
+    }
     json state = {{"frames_processed", snapshot->frames_processed},
                   {"last_stamp_s", snapshot->last_stamp_s},
                   {"stats",

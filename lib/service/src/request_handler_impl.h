@@ -65,8 +65,6 @@ struct RequestHandler::Impl {
   Status get_planes(proto::Response& response);
   Status get_map(proto::Response& response);
   Status get_objects(const proto::GetObjects& msg, proto::Response& response);
-  /// Keeps one new description in the class catalog.
-  void record(const TrackedObject& object, const pipeline::ObjectClassInfo& described);
   Status get_hands(proto::Response& response);
   Status query_occupancy(const proto::QueryOccupancy& msg, proto::Response& response);
   static proto::OccupancyState to_proto(background::Occupancy state);

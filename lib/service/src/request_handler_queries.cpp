@@ -3,8 +3,7 @@
 #include <algorithm>
 #include <optional>
 
-#include <google/protobuf/util/json_util.h>
-
+#include "class_records.h"
 #include "ontology_convert.h"
 #include "proto_convert.h"
 #include "request_handler_impl.h"
@@ -98,10 +97,7 @@ Status RequestHandler::Impl::get_objects(const proto::GetObjects& msg, proto::Re
   const bool describe = msg.describe() && config.classes;
   std::vector<std::shared_ptr<const pipeline::ObjectClassInfo>> described;
   if (describe) {
-    described = memory.describe_objects(*snapshot, *config.classes,
-                                        [this](const TrackedObject& object, const pipeline::ObjectClassInfo& info) {
-                                          record(object, info);
-                                        });
+    described = describe_and_record(memory, *snapshot, *config.classes);
   }
   auto* out = response.mutable_objects();
   out->set_frames_processed(snapshot->frames_processed);
@@ -113,26 +109,6 @@ Status RequestHandler::Impl::get_objects(const proto::GetObjects& msg, proto::Re
     if (described[k]) convert::to_proto(*described[k], ontology);
   }
   return {};
-}
-
-// Each new description is an instance seen (class, the fitted primitive as JSON, when the object
-// was last seen); a handled object's learnt free DoFs also teach its class's motions. The catalog
-// queues the writes for its own thread: nothing here waits for the disk.
-void RequestHandler::Impl::record(const TrackedObject& object, const pipeline::ObjectClassInfo& described) {
-  proto::ObjectClassInfo info;
-  convert::to_proto(described, &info);
-  ontology::InstanceRecord instance;
-  instance.class_name = info.class_name();
-  instance.time_s = object.last_seen_s;
-  google::protobuf::util::JsonPrintOptions options;
-  options.preserve_proto_field_names = true;
-  if (info.has_primitive() && !google::protobuf::util::MessageToJsonString(info.primitive(), &instance.parameters_json, options).ok()) {
-    instance.parameters_json.clear();
-  }
-  if (instance.parameters_json.empty()) instance.parameters_json = "{}";
-  std::optional<DofFlags> handled_free;
-  if (object.foreground && !object.foreground->handlings.empty()) handled_free = object.foreground->free;
-  config.classes->record(instance, handled_free);
 }
 
 Status RequestHandler::Impl::get_hands(proto::Response& response) {

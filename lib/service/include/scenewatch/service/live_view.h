@@ -4,8 +4,9 @@
 ///
 ///   GET /                  the page (embedded in the binary)
 ///   GET /three.min.js      three.js, read from Debian's libjs-three (LiveViewConfig::three_js)
-///   GET /api/state         frames, stats, planes (hulls), objects (boxes), occupied voxels (JSON);
-///                          (?voxels=0: without the voxels)
+///   GET /api/state         frames, stats, planes (hulls), objects (boxes, and their class when
+///                          LiveViewConfig::classes is set), occupied voxels (JSON);
+///                          (?voxels=0: without the voxels and the classes: the page's cheap poll)
 ///   GET /api/frame.png     the last colour frame with the surprise heatmap laid over it
 ///   GET /api/events        the events as they are emitted (Server-Sent Events)
 ///   GET /api/events?since=N  the logged events with id > N (JSON)
@@ -16,6 +17,10 @@
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/service/http_server.h"
+
+namespace scenewatch::ontology {
+class ClassCatalog;
+}  // namespace scenewatch::ontology
 
 namespace scenewatch::pipeline {
 class WorkingMemory;
@@ -31,6 +36,9 @@ struct LiveViewConfig {
   std::filesystem::path three_js = kDefaultThreeJs;  ///< served as /three.min.js
   std::size_t max_voxels = 200000;     ///< more occupied voxels are thinned to every k-th
   std::size_t max_backlog_events = 1000;  ///< events per /api/events?since=N answer
+  /// The classes the objects are described by in /api/state (each new description is recorded
+  /// in the catalog, as GetObjects records it); null: the objects carry no class.
+  std::shared_ptr<ontology::ClassCatalog> classes;
 };
 
 /// Thread safe. `memory` must outlive it; it subscribes to the memory's events and unsubscribes
