@@ -1,6 +1,6 @@
 // The live view in the browser: the HTTP request parser on byte splits and bad input, the real
 // scenewatchd's HTTP port against raw sockets (bad requests neither stop it nor its TCP API), and
-// headless Chromium on the page after a simulated cup was put on the table: the event and the
+// both servers refusing a bad address or a taken port, and headless Chromium on the page after a simulated cup was put on the table: the event and the
 // object with its class are in the page's DOM, and the object's box is drawn in the 3D view of the screenshot.
 #include <gtest/gtest.h>
 
@@ -23,7 +23,9 @@
 #include "daemon_harness.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/service/http_request.h"
+#include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/service/http_server.h"
+#include "scenewatch/service/server.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"
 
@@ -338,6 +340,53 @@ TEST(HttpServerStreams, AStreamWhoseClientReadsNothingIsClosedAfterTheTimeout) {
     EXPECT_GE(streamed.size(), kBytes) << "the reading client got it all";
     EXPECT_NE(streamed.find(": heartbeat\n\n"), std::string::npos) << "and its stream stayed open";
   }
+}
+
+// ---- listening: both servers open their port the same way (tcp_endpoint.h)
+
+// An address that is not one names its config key; a port already taken names the endpoint; in
+// both cases the server stays closed (port 0) and nothing else is disturbed.
+TEST(Listening, ABadAddressNamesItsKeyAndATakenPortNamesTheEndpoint) {
+  service::HttpServerConfig http_config;
+  http_config.address = "localhost:80";
+  service::HttpServer bad_http(http_config, [](const service::HttpRequest&) { return service::HttpResponse{}; });
+  auto status = bad_http.listen();
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.error().message, "server.http_bind: 'localhost:80' is not an IP address");
+
+  http_config.address = "127.0.0.1";
+  http_config.port = 0;
+  service::HttpServer first(http_config, [](const service::HttpRequest&) { return service::HttpResponse{}; });
+  ASSERT_TRUE(first.listen().ok());
+  const std::uint16_t taken = first.port();
+  ASSERT_NE(taken, 0);
+
+  // reuse_address lets a port in TIME_WAIT be bound again, not one that is listening.
+  http_config.port = taken;
+  service::HttpServer second(http_config, [](const service::HttpRequest&) { return service::HttpResponse{}; });
+  status = second.listen();
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.error().message.rfind("cannot listen for HTTP on 127.0.0.1:" + std::to_string(taken) + ": ", 0), 0u)
+      << status.error().message;
+  EXPECT_EQ(second.port(), 0) << "the acceptor is closed again";
+
+  pipeline::WorkingMemory memory{pipeline::Config{}};
+  service::ServerConfig api_config;
+  api_config.access_token = "a token";  // the server refuses to listen without one
+  api_config.address = "::1::";
+  service::Server bad_api(api_config, memory, {}, false);
+  status = bad_api.listen();
+  ASSERT_FALSE(status.ok());
+  EXPECT_NE(status.error().message.find("server.address: '::1::' is not an IP address"), std::string::npos)
+      << status.error().message;
+  api_config.address = "127.0.0.1";
+  api_config.port = taken;
+  service::Server busy_api(api_config, memory, {}, false);
+  status = busy_api.listen();
+  ASSERT_FALSE(status.ok());
+  EXPECT_EQ(status.error().message.rfind("cannot listen on 127.0.0.1:" + std::to_string(taken) + ": ", 0), 0u)
+      << status.error().message;
+  EXPECT_EQ(first.port(), taken) << "the first server still listens";
 }
 
 // ---- the page in headless Chromium

@@ -21,7 +21,7 @@
 #include <thread>
 #include <vector>
 
-#include "session.h"  // format_endpoint
+#include "tcp_endpoint.h"
 
 namespace scenewatch::service {
 namespace asio = boost::asio;
@@ -405,18 +405,10 @@ HttpServer::~HttpServer() { stop(); }
 
 Status HttpServer::listen() {
   Impl& s = *impl_;
-  boost::system::error_code ec;
-  const auto address = asio::ip::make_address(s.shared.config.address, ec);
-  if (ec) return invalid_argument("server.http_bind: '" + s.shared.config.address + "' is not an IP address");
-  const tcp::endpoint endpoint(address, s.shared.config.port);
-  s.acceptor.open(endpoint.protocol(), ec);
-  if (!ec) s.acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
-  if (!ec) s.acceptor.bind(endpoint, ec);
-  if (!ec) s.acceptor.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) {
-    boost::system::error_code ignored;
-    s.acceptor.close(ignored);
-    return io_error("cannot listen for HTTP on " + format_endpoint(endpoint) + ": " + ec.message());
+  if (auto listening = listen_on(s.acceptor, s.shared.config.address, s.shared.config.port, "server.http_bind",
+                                 "for HTTP ");
+      !listening) {
+    return listening;
   }
   return {};
 }

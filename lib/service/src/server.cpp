@@ -139,20 +139,10 @@ Status Server::listen() {
     return invalid_argument("no access token: calls that change the model would be open to every local user "
                             "(read server.token_file into ServerConfig::access_token)");
   }
-  boost::system::error_code ec;
-  const auto address = asio::ip::make_address(s.config.address, ec);
-  if (ec) return invalid_argument("server.address: '" + s.config.address + "' is not an IP address");
-  const tcp::endpoint endpoint(address, s.config.port);
-  const std::string where = format_endpoint(endpoint);
-  s.acceptor.open(endpoint.protocol(), ec);
-  if (!ec) s.acceptor.set_option(tcp::acceptor::reuse_address(true), ec);
-  if (!ec) s.acceptor.bind(endpoint, ec);
-  if (!ec) s.acceptor.listen(asio::socket_base::max_listen_connections, ec);
-  if (ec) {
-    boost::system::error_code ignored;
-    s.acceptor.close(ignored);
-    return io_error("cannot listen on " + where + ": " + ec.message());
+  if (auto listening = listen_on(s.acceptor, s.config.address, s.config.port, "server.address", ""); !listening) {
+    return listening;
   }
+  boost::system::error_code ec;
   if (s.handle_signals) {
     // Caught from here on (delivered once run() runs), so a signal right after the daemon says
     // it is listening still shuts it down cleanly.

@@ -41,23 +41,6 @@ std::string seconds(double s) {
 }
 }  // namespace
 
-std::string format_endpoint(const tcp::endpoint& endpoint) {
-  const std::string address = endpoint.address().to_string();
-  return (endpoint.address().is_v6() ? "[" + address + "]" : address) + ":" + std::to_string(endpoint.port());
-}
-
-std::uint16_t bound_port(const tcp::acceptor& acceptor) {
-  boost::system::error_code ec;
-  const auto endpoint = acceptor.local_endpoint(ec);
-  return ec ? 0 : endpoint.port();
-}
-
-std::string bound_endpoint(const tcp::acceptor& acceptor) {
-  boost::system::error_code ec;
-  const auto endpoint = acceptor.local_endpoint(ec);
-  return ec ? std::string() : format_endpoint(endpoint);
-}
-
 Session::Session(tcp::socket socket, const SessionOptions& options, RequestHandler& handler,
                  ConnectionRegistry& registry, const LogSink& log, std::uint64_t number)
     : executor_(socket.get_executor()),

@@ -18,14 +18,9 @@
 #include "scenewatch/service/frame_parser.h"
 #include "scenewatch/service/log.h"
 #include "scenewatch/service/request_handler.h"
+#include "tcp_endpoint.h"
 
 namespace scenewatch::service {
-
-/// "1.2.3.4:5678", or "[::1]:5678" for IPv6.
-std::string format_endpoint(const boost::asio::ip::tcp::endpoint& endpoint);
-/// The port an acceptor is bound to (0 when it is not), and its endpoint formatted ("" when not).
-std::uint16_t bound_port(const boost::asio::ip::tcp::acceptor& acceptor);
-std::string bound_endpoint(const boost::asio::ip::tcp::acceptor& acceptor);
 
 struct SessionOptions {
   std::size_t max_message_bytes = 0;
