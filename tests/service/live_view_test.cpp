@@ -1,7 +1,8 @@
 // The live view in the browser: the HTTP request parser on byte splits and bad input, the real
-// scenewatchd's HTTP port against raw sockets (bad requests neither stop it nor its TCP API), and
-// both servers refusing a bad address or a taken port, and headless Chromium on the page after a simulated cup was put on the table: the event and the
-// object with its class are in the page's DOM, and the object's box is drawn in the 3D view of the screenshot.
+// scenewatchd's HTTP port against raw sockets (bad requests neither stop it nor its TCP API), both
+// servers refusing a bad address or a taken port, and headless Chromium on the page after a
+// simulated cup was put on the table: the event and the object with its class are in the page's
+// DOM, and the object's box is drawn in the 3D view of the screenshot.
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
