@@ -10,7 +10,7 @@
 
 #include "bench.h"
 #include "scenewatch/change/diff.h"
-#include "scenewatch/change/evaluation.h"
+#include "scenewatch/change/event_scoring.h"
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/io/rgbd.h"
 

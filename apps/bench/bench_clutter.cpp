@@ -7,7 +7,7 @@
 // test56 and test58 are unorganized as shipped: their "as recorded" figure is already unorganized.
 #include "bench.h"
 #include "scenewatch/io/cloud_io.h"
-#include "scenewatch/segmentation/evaluation.h"
+#include "scenewatch/segmentation/label_scoring.h"
 #include "scenewatch/segmentation/tabletop.h"
 
 namespace scenewatch::bench {

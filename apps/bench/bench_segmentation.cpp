@@ -15,7 +15,7 @@
 #include "bench.h"
 #include "bench_lccp.h"
 #include "scenewatch/io/cloud_io.h"
-#include "scenewatch/segmentation/evaluation.h"
+#include "scenewatch/segmentation/label_scoring.h"
 #include "scenewatch/segmentation/tabletop.h"
 
 namespace scenewatch::bench {

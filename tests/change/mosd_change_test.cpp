@@ -12,7 +12,7 @@
 #include <string>
 
 #include "scenewatch/change/diff.h"
-#include "scenewatch/change/evaluation.h"
+#include "scenewatch/change/event_scoring.h"
 #include "scenewatch/io/cloud_io.h"
 #include "test_data.h"
 

@@ -7,7 +7,7 @@
 #include <cstdio>
 
 #include "scenewatch/change/diff.h"
-#include "scenewatch/change/evaluation.h"
+#include "scenewatch/change/event_scoring.h"
 #include "scenewatch/io/rgbd.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"

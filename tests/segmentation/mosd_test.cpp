@@ -5,7 +5,7 @@
 #include <cstdio>
 
 #include "scenewatch/io/cloud_io.h"
-#include "scenewatch/segmentation/evaluation.h"
+#include "scenewatch/segmentation/label_scoring.h"
 #include "scenewatch/segmentation/tabletop.h"
 #include "test_data.h"
 

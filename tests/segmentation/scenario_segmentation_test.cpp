@@ -8,7 +8,7 @@
 
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/io/rgbd.h"
-#include "scenewatch/segmentation/evaluation.h"
+#include "scenewatch/segmentation/label_scoring.h"
 #include "scenewatch/segmentation/tabletop.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"

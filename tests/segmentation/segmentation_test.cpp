@@ -5,7 +5,7 @@
 #include <limits>
 #include <random>
 
-#include "scenewatch/segmentation/evaluation.h"
+#include "scenewatch/segmentation/label_scoring.h"
 #include "scenewatch/segmentation/tabletop.h"
 
 namespace scenewatch::segmentation {

@@ -19,7 +19,7 @@
 #include <cstdlib>
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"
-#include "scenewatch/surprise/evaluation.h"
+#include "scenewatch/surprise/pixel_scoring.h"
 #include "scenewatch/surprise/surprise_map.h"
 #include "test_data.h"
 

@@ -1,7 +1,7 @@
 // Two single observations: same-camera per-pixel reasoning, or BEFORE as a map and AFTER against it.
 #include "scenewatch/change/diff.h"
 
-#include "scenewatch/change/completion.h"
+#include "scenewatch/change/whole_objects.h"
 
 #include <algorithm>
 #include <chrono>

@@ -1,5 +1,5 @@
 #pragma once
-/// The segmented objects of one frame by point, for whole-object completion (completion.h).
+/// The segmented objects of one frame by point, for whole-object completion (whole_objects.h).
 #include <vector>
 
 #include "scenewatch/change/mismatch.h"

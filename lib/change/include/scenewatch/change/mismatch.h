@@ -69,7 +69,7 @@ struct Config {
   double move_max_size_ratio = 2.0;
   double move_max_color_distance = 80.0;
   double move_min_distance_m = 0.03;
-  /// Whole-object completion of diffs (completion.h): each side of a change is replaced by the
+  /// Whole-object completion of diffs (whole_objects.h): each side of a change is replaced by the
   /// segmented objects of its frame that its evidence substantially belongs to. An object joins
   /// when it carries at least `completion_evidence_share` of the evidence (the evidence is mostly
   /// its surface: the fringe a short move uncovers, whatever the share of the object) or when the

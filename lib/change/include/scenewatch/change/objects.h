@@ -25,7 +25,7 @@ struct ChangeCluster {
   double mean_gap_m = 0.0;       ///< mean depth or surface distance of the evidence
   std::size_t evidence_count = 0;  ///< pieces of mismatch evidence (points or voxels) it grew from
   /// True when `indices` and `points_world` are whole segmented objects of the frame
-  /// (completion.h), not the evidence itself.
+  /// (whole_objects.h), not the evidence itself.
   bool completed = false;
   /// Sorted box sides, largest first.
   Eigen::Vector3d sorted_extent() const;

@@ -1,5 +1,5 @@
 // Object-level scoring of change events against true changes.
-#include "scenewatch/change/evaluation.h"
+#include "scenewatch/change/event_scoring.h"
 
 #include <algorithm>
 #include <cmath>

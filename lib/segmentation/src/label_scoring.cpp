@@ -1,4 +1,4 @@
-#include "scenewatch/segmentation/evaluation.h"
+#include "scenewatch/segmentation/label_scoring.h"
 
 #include <algorithm>
 #include <map>

@@ -9,9 +9,9 @@
 #include <limits>
 #include <numeric>
 
-#include "scenewatch/change/completion.h"
+#include "scenewatch/change/whole_objects.h"
 #include "scenewatch/change/diff.h"
-#include "scenewatch/change/evaluation.h"
+#include "scenewatch/change/event_scoring.h"
 #include "scenewatch/io/cloud_io.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"

@@ -1,5 +1,5 @@
 // Whole-object completion of change clusters from the segmentation of each frame.
-#include "scenewatch/change/completion.h"
+#include "scenewatch/change/whole_objects.h"
 
 #include <algorithm>
 #include <climits>

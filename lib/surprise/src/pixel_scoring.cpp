@@ -1,4 +1,4 @@
-#include "scenewatch/surprise/evaluation.h"
+#include "scenewatch/surprise/pixel_scoring.h"
 
 #include <algorithm>
 #include <cmath>
