@@ -25,7 +25,7 @@ struct BridgeConfig {
   double sync_tolerance_s = 0.02;  ///< colour and depth stamps this close make one frame
   double tf_wait_s = 0.5;          ///< how long a frame waits for its TF to arrive
   WithoutTf without_tf = WithoutTf::kDrop;
-  std::string output_namespace = "/scenewatch";  ///< events, objects, octomap_binary under it
+  std::string output_namespace = "/scenewatch";  ///< events, objects, octomap_binary, markers under it
   std::string camera_name;         ///< IngestFrame.camera (empty: the daemon's default camera)
 
   // Daemon side.
@@ -38,6 +38,8 @@ struct BridgeConfig {
   // Between the two.
   std::size_t queue_frames = 2;    ///< frames waiting for the daemon; the oldest is dropped beyond
   double map_period_s = 1.0;       ///< the octomap is published at most this often (and once idle)
+  bool markers = true;             ///< publish the MarkerArray after each frame (one GetHands more per frame)
+  std::size_t marker_events = 10;  ///< the newest events drawn as markers
   double stats_period_s = 0.0;     ///< a stats line on stdout this often (0: only at exit)
 };
 

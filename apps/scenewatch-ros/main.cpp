@@ -31,6 +31,8 @@ constexpr const char* kDescription =
     "  events          scenewatch_msgs/msg/EventArray      reliable, keep last 10\n"
     "  objects         vision_msgs/msg/Detection3DArray    reliable, keep last 10 (after every frame)\n"
     "  octomap_binary  octomap_msgs/msg/Octomap            reliable, transient local (binary, id OcTree)\n"
+    "  markers         visualization_msgs/msg/MarkerArray  reliable, keep last 10 (after every frame; for RViz:\n"
+    "                  a DELETEALL, then planes, objects, labels, hands, events; --no-markers)\n"
     "Images and camera info are read best effort, keep last 5; /tf reliable; /tf_static transient local.\n"
     "Prints 'ready' on stdout once its DDS entities exist, and a stats line on exit (SIGINT, SIGTERM).\n"
     "Exit codes: 0 stopped by a signal, 1 error (message on stderr), 2 usage.";
@@ -86,6 +88,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   seconds_option("--map-period", config.map_period_s,
                  "seconds between two octomap messages at most (the last frame's map is sent once the stream pauses)");
+  app.add_flag("--no-markers", [&](std::int64_t) { config.markers = false; },
+               "publish no MarkerArray (saves a GetHands call per frame)");
+  app.add_option("--marker-events", config.marker_events, "the newest events drawn as markers (yellow boxes)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   seconds_option("--stats-period", config.stats_period_s,
                  "seconds between two stats lines on stdout (0: only at exit)");
   CLI11_PARSE(app, argc, argv);
@@ -122,6 +129,7 @@ int main(int argc, char** argv) {
   outputs.events = [&](const std::vector<scenewatch::proto::Event>& events) { dds.write_events(events); };
   outputs.objects = [&](const scenewatch::proto::ObjectsReply& objects, double stamp_s) { dds.write_objects(objects, stamp_s); };
   outputs.map = [&](const scenewatch::proto::MapReply& map, double stamp_s) { dds.write_map(map, stamp_s); };
+  if (config.markers) outputs.markers = [&](const MarkerScene& scene, double stamp_s) { dds.write_markers(scene, stamp_s); };
   outputs.log = log;
   DaemonLink link(config, stats, outputs);
   FrameAssembler assembler(config, stats, [&](FrameJob job) { link.push(std::move(job)); }, log);
