@@ -67,6 +67,34 @@ sensor_msgs_msg_dds__Image_ image(double stamp_s, int width, int height, const c
   return m;
 }
 
+/// One visualization_msgs/Marker as received, copied out of its sample.
+struct ReceivedMarker {
+  std::string frame_id, ns, text;
+  double stamp_s = 0;
+  std::int32_t id = 0, type = 0, action = 0;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero(), scale = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  std::vector<Eigen::Vector3d> points;
+};
+
+ReceivedMarker received_marker(const visualization_msgs_msg_dds__Marker_& m) {
+  ReceivedMarker r;
+  r.frame_id = m.header.frame_id;
+  r.stamp_s = ros::seconds(m.header.stamp);
+  r.ns = m.ns;
+  r.text = m.text;
+  r.id = m.id;
+  r.type = m.type;
+  r.action = m.action;
+  r.position = Eigen::Vector3d(m.pose.position.x, m.pose.position.y, m.pose.position.z);
+  r.orientation = Eigen::Quaterniond(m.pose.orientation.w, m.pose.orientation.x, m.pose.orientation.y, m.pose.orientation.z);
+  r.scale = Eigen::Vector3d(m.scale.x, m.scale.y, m.scale.z);
+  for (std::uint32_t i = 0; i < m.points._length; ++i) {
+    r.points.emplace_back(m.points._buffer[i].x, m.points._buffer[i].y, m.points._buffer[i].z);
+  }
+  return r;
+}
+
 /// The test's ROS 2 side: a camera driver (depth 16UC1 + rgb8 + CameraInfo), TF (world -> rig on
 /// /tf_static, rig -> camera_optical on /tf per frame) and a subscriber of the bridge's topics.
 class CameraPeer {
@@ -80,6 +108,7 @@ class CameraPeer {
     events_r_ = peer_.entity("/scenewatch/events", &scenewatch_msgs_msg_dds__EventArray__desc, true, true, 100);
     objects_r_ = peer_.entity("/scenewatch/objects", &vision_msgs_msg_dds__Detection3DArray__desc, true, true, 100);
     map_r_ = peer_.entity("/scenewatch/octomap_binary", &octomap_msgs_msg_dds__Octomap__desc, true, true, 1, true);
+    markers_r_ = peer_.entity("/scenewatch/markers", &visualization_msgs_msg_dds__MarkerArray__desc, true, true, 100);
     // world -> rig: fixed and not the identity, so the bridge must chain a static and a timed link.
     T_world_rig_.translation() = Eigen::Vector3d(0.3, -0.2, 0.1);
     T_world_rig_.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -87,7 +116,7 @@ class CameraPeer {
 
   /// Waits for the bridge's participant (every writer and reader matched), then sends /tf_static.
   bool connect(double timeout_s) {
-    if (!DdsPeer::wait_matched({depth_w_, color_w_, info_w_, tf_w_, tf_static_w_}, {events_r_, objects_r_, map_r_}, timeout_s)) return false;
+    if (!DdsPeer::wait_matched({depth_w_, color_w_, info_w_, tf_w_, tf_static_w_}, {events_r_, objects_r_, map_r_, markers_r_}, timeout_s)) return false;
     auto t = transform(T_world_rig_, kStamp0, "world", "rig");
     tf2_msgs_msg_dds__TFMessage_ m{};
     m.transforms._length = m.transforms._maximum = 1;
@@ -145,14 +174,134 @@ class CameraPeer {
     return out;
   }
 
+  /// The MarkerArray of the frame stamped `stamp` (its first marker's stamp), waiting at most
+  /// timeout_s (nothing on timeout).
+  std::optional<std::vector<ReceivedMarker>> markers_of(double stamp, double timeout_s) {
+    std::optional<std::vector<ReceivedMarker>> out;
+    const auto start = Clock::now();
+    while (!out && ms_since(start) < timeout_s * 1000) {
+      DdsPeer::take<visualization_msgs_msg_dds__MarkerArray_>(markers_r_, [&](const visualization_msgs_msg_dds__MarkerArray_& m) {
+        if (m.markers._length == 0 || std::abs(ros::seconds(m.markers._buffer[0].header.stamp) - stamp) > 1e-6) return;
+        out.emplace();
+        for (std::uint32_t i = 0; i < m.markers._length; ++i) out->push_back(received_marker(m.markers._buffer[i]));
+      });
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    return out;
+  }
+
   dds_entity_t events_reader() const { return events_r_; }
   dds_entity_t map_reader() const { return map_r_; }
 
  private:
   DdsPeer peer_;
-  dds_entity_t depth_w_ = 0, color_w_ = 0, info_w_ = 0, tf_w_ = 0, tf_static_w_ = 0, events_r_ = 0, objects_r_ = 0, map_r_ = 0;
+  dds_entity_t depth_w_ = 0, color_w_ = 0, info_w_ = 0, tf_w_ = 0, tf_static_w_ = 0, events_r_ = 0, objects_r_ = 0, map_r_ = 0,
+               markers_r_ = 0;
   Pose T_world_rig_ = Pose::Identity();
 };
+
+/// An event as the EventArray gave it: what its marker must show.
+struct ReceivedEvent {
+  std::uint64_t id = 0;
+  double stamp_s = 0;
+  Eigen::Vector3d box_min, box_max;
+};
+
+/// The frame's markers of namespace `ns` (and `type`).
+std::vector<const ReceivedMarker*> markers_in(const std::vector<ReceivedMarker>& array, const std::string& ns, std::int32_t type) {
+  std::vector<const ReceivedMarker*> out;
+  for (const auto& m : array) {
+    if (m.ns == ns && m.type == type && m.action == visualization_msgs_msg_dds__Marker_Constants_ADD) out.push_back(&m);
+  }
+  return out;
+}
+
+/// The MarkerArrays of the cup test against the daemon's objects, the event and the simulator's
+/// truth (the cup's centre, the table's height).
+void expect_markers(const std::vector<std::pair<double, std::vector<ReceivedMarker>>>& arrays,
+                    const google::protobuf::RepeatedPtrField<proto::Object>& objects, const ReceivedEvent& event,
+                    const Eigen::Vector3d& cup_center, double table_height_m) {
+  ASSERT_FALSE(arrays.empty());
+  // Every array: a DELETEALL first, then markers in the world frame stamped with their frame's stamp.
+  for (const auto& [stamp, array] : arrays) {
+    ASSERT_FALSE(array.empty());
+    EXPECT_EQ(array.front().action, visualization_msgs_msg_dds__Marker_Constants_DELETEALL);
+    for (const auto& m : array) {
+      EXPECT_EQ(m.frame_id, "world");
+      EXPECT_NEAR(m.stamp_s, stamp, 1e-6);
+    }
+  }
+  const auto& last = arrays.back().second;
+
+  // Objects: one CUBE per object, its pose and scale the daemon's box; one near the cup's centre.
+  const auto cubes = markers_in(last, "objects", visualization_msgs_msg_dds__Marker_Constants_CUBE);
+  ASSERT_EQ(cubes.size(), static_cast<std::size_t>(objects.size()));
+  double cup_distance = 1e9;
+  const ReceivedMarker* cup_cube = nullptr;
+  for (int i = 0; i < objects.size(); ++i) {
+    const proto::OrientedBox& box = objects[i].box();
+    const ReceivedMarker& m = *cubes[static_cast<std::size_t>(i)];
+    EXPECT_EQ(m.id, static_cast<std::int32_t>(objects[i].id()));
+    EXPECT_LT((m.position - Eigen::Vector3d(box.center().x(), box.center().y(), box.center().z())).norm(), 1e-9);
+    EXPECT_LT((m.scale - Eigen::Vector3d(box.extents().x(), box.extents().y(), box.extents().z())).norm(), 1e-9);
+    EXPECT_NEAR(m.orientation.norm(), 1.0, 1e-6);
+    if ((m.position - cup_center).norm() < cup_distance) {
+      cup_distance = (m.position - cup_center).norm();
+      cup_cube = &m;
+    }
+  }
+  ASSERT_NE(cup_cube, nullptr);
+  // Measured 7 mm (the box of the points seen from one side); issue 32 allows 3 cm.
+  EXPECT_LT(cup_distance, 0.015) << "no object box within 1.5 cm of the cup's centre";
+  // Its label: above the box, "#<id>".
+  bool labelled = false;
+  for (const auto* label : markers_in(last, "labels", visualization_msgs_msg_dds__Marker_Constants_TEXT_VIEW_FACING)) {
+    if (label->id != cup_cube->id) continue;
+    labelled = true;
+    EXPECT_EQ(label->text.rfind("#" + std::to_string(cup_cube->id), 0), 0u) << label->text;
+    EXPECT_GT(label->position.z(), cup_cube->position.z());
+  }
+  EXPECT_TRUE(labelled) << "no label of the cup's box";
+
+  // Planes: a closed hull on the table top.
+  double worst_table_z = 1e9;
+  for (const auto* strip : markers_in(last, "planes", visualization_msgs_msg_dds__Marker_Constants_LINE_STRIP)) {
+    if (strip->points.size() < 4) continue;
+    double worst = 0;
+    for (const auto& p : strip->points) worst = std::max(worst, std::abs(p.z() - table_height_m));
+    worst_table_z = std::min(worst_table_z, worst);
+    EXPECT_LT((strip->points.front() - strip->points.back()).norm(), 1e-12) << "the hull is closed";
+  }
+  // Measured 0.1 mm: the hull lies on the fitted plane, so this is the fit's offset, well inside
+  // the depth noise at the table's 1 to 1.5 m (1.4 mm x z^2); issue 32 allows 1 cm.
+  EXPECT_LT(worst_table_z, 0.003) << "no plane hull within 3 mm of the table top (z = " << table_height_m << " m)";
+
+  // The event: a yellow wireframe of its box from the array of the frame that raised it on.
+  std::size_t first_with_event = arrays.size();
+  for (std::size_t i = 0; i < arrays.size(); ++i) {
+    const auto lists = markers_in(arrays[i].second, "events", visualization_msgs_msg_dds__Marker_Constants_LINE_LIST);
+    const auto it = std::find_if(lists.begin(), lists.end(), [&](const ReceivedMarker* m) { return m->id == static_cast<std::int32_t>(event.id); });
+    if (it == lists.end()) {
+      EXPECT_EQ(first_with_event, arrays.size()) << "the event's marker vanished from the frame of " << arrays[i].first - kStamp0 << " s";
+      continue;
+    }
+    if (first_with_event == arrays.size()) first_with_event = i;
+    ASSERT_EQ((*it)->points.size(), 24u) << "12 edges";
+    Eigen::Vector3d lo = (*it)->points[0], hi = (*it)->points[0];
+    for (const auto& p : (*it)->points) {
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+    EXPECT_LT((lo - event.box_min).norm() + (hi - event.box_max).norm(), 1e-9);
+  }
+  ASSERT_LT(first_with_event, arrays.size()) << "no events marker after the event";
+  EXPECT_NEAR(arrays[first_with_event].first, event.stamp_s, 1e-6) << "the event's marker comes with the frame that raised it";
+  std::printf("markers of the last frame: %zu (%zu plane hulls, %zu boxes); cup box %.1f mm from the cup's centre; plane hull within %.1f mm of the table top; "
+              "event %llu drawn from frame %zu of %zu on\n",
+              last.size(), markers_in(last, "planes", visualization_msgs_msg_dds__Marker_Constants_LINE_STRIP).size(), cubes.size(),
+              cup_distance * 1000, worst_table_z * 1000, static_cast<unsigned long long>(event.id), first_with_event + 1,
+              arrays.size());
+}
 
 class RosBridgeTest : public ::testing::Test {
  protected:
@@ -206,6 +355,9 @@ TEST_F(RosBridgeTest, CupAddedOverDdsGivesOneEventTheObjectsAndTheMap) {
   const auto truth = simulator->changes();
   ASSERT_EQ(truth.size(), 1u);
   const Eigen::Vector2d where = truth[0].added.at(0).T_world_object.translation().head<2>();
+  // The cup's centre: its frame's origin is the centre of its base, z up its axis.
+  const sim::PlacedObject& cup = truth[0].added.at(0);
+  const Eigen::Vector3d cup_center = cup.T_world_object * Eigen::Vector3d(0, 0, 0.5 * cup.object.shape.total_height_m());
 
   const fs::path model_dir = tmp_ / "model";
   ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "  model_dir: " + model_dir.string() + "\nsegmentation:\n  up_vector: [0, 0, 1]\n"));
@@ -218,6 +370,7 @@ TEST_F(RosBridgeTest, CupAddedOverDdsGivesOneEventTheObjectsAndTheMap) {
   // published the objects of this one (a best-effort image lost on the way is sent again).
   std::vector<double> round_trip_ms, stamps;
   std::vector<std::pair<std::string, Eigen::Vector3d>> last_objects;
+  std::vector<std::pair<double, std::vector<ReceivedMarker>>> marker_arrays;  // per frame, in order
   std::size_t retries = 0;
   for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
     for (int f = 0; f < simulator->frame_count(phase); ++f) {
@@ -234,17 +387,24 @@ TEST_F(RosBridgeTest, CupAddedOverDdsGivesOneEventTheObjectsAndTheMap) {
       }
       ASSERT_TRUE(objects) << "no Detection3DArray for the frame of " << stamp - kStamp0 << " s";
       last_objects = *objects;
+      // The markers follow the objects (after a GetHands), on the same reliable QoS.
+      auto markers = camera.markers_of(stamp, kFrameWaitS);
+      ASSERT_TRUE(markers) << "no MarkerArray for the frame of " << stamp - kStamp0 << " s";
+      marker_arrays.emplace_back(stamp, std::move(*markers));
     }
   }
 
   // The change, once: exactly one event, OBJECT_ADDED, where the truth put the cup.
   std::vector<std::tuple<std::uint8_t, std::string, Eigen::Vector2d>> events;
+  std::vector<ReceivedEvent> event_boxes;
   const auto waited = Clock::now();
   while (ms_since(waited) < (events.empty() ? kFrameWaitS * 1000 : 1500)) {
     DdsPeer::take<scenewatch_msgs_msg_dds__EventArray_>(camera.events_reader(), [&](const scenewatch_msgs_msg_dds__EventArray_& m) {
       for (std::uint32_t i = 0; i < m.events._length; ++i) {
         const auto& e = m.events._buffer[i];
         events.emplace_back(e.kind, e.kind_name, Eigen::Vector2d(e.centroid.x, e.centroid.y));
+        event_boxes.push_back({e.id, ros::seconds(e.header.stamp), Eigen::Vector3d(e.box_min.x, e.box_min.y, e.box_min.z),
+                               Eigen::Vector3d(e.box_max.x, e.box_max.y, e.box_max.z)});
       }
     });
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
@@ -265,6 +425,8 @@ TEST_F(RosBridgeTest, CupAddedOverDdsGivesOneEventTheObjectsAndTheMap) {
     EXPECT_EQ(id, std::to_string(o.id()));
     EXPECT_LT((center - Eigen::Vector3d(o.box().center().x(), o.box().center().y(), o.box().center().z())).norm(), 1e-9);
   }
+
+  expect_markers(marker_arrays, objects.objects().objects(), event_boxes.at(0), cup_center, scenario.table.height_m);
 
   // The map: the Octomap of the last frame, read by OctoMap's readBinaryData, is the tree the daemon
   // saves (same resolution, same nodes, same occupancy leaf for leaf).
