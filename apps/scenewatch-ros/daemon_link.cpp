@@ -143,6 +143,12 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
   }
   stats_.count("frames_sent");
   for (const auto& event : reply->ingest().events()) recent_events_.add(event);
+  // The frame's camera's T_world_odom, as the daemon holds it after this frame (identity in
+  // `given` mode: the given poses are world poses).
+  if (out_.odom && reply->ingest().has_localization()) {
+    out_.odom(reply->ingest().localization().t_world_odom(), frame.stamp_s);
+    stats_.count("odom_sent");
+  }
   proto::Request objects;
   objects.mutable_get_objects();
   auto answer = call(client, std::move(objects), "objects");

@@ -28,6 +28,7 @@ struct Outputs {
   std::function<void(const proto::ObjectsReply&, double stamp_s)> objects;
   std::function<void(const proto::MapReply&, double stamp_s)> map;
   std::function<void(const MarkerScene&, double stamp_s)> markers;  ///< unset: no markers
+  std::function<void(const proto::Pose& T_world_odom, double stamp_s)> odom;  ///< unset: no /tf
   std::function<void(const std::string&)> log;
 };
 

@@ -80,7 +80,9 @@ Result<std::unique_ptr<DdsNode>> DdsNode::create(const BridgeConfig& config, Bri
                   // As the objects (RViz's Marker display reads reliable, volatile): every frame's array reaches it.
                   !config.markers ? Status{}
                                   : entity(ns + "/markers", &visualization_msgs_msg_dds__MarkerArray__desc, Profile::kReliable, false,
-                                           &node->markers_writer_)}) {
+                                           &node->markers_writer_),
+                  // As a tf2_ros TransformBroadcaster (reliable, keep last 100, volatile).
+                  !config.publish_odom_tf ? Status{} : entity("/tf", &tf2_msgs_msg_dds__TFMessage__desc, Profile::kTf, false, &node->tf_writer_)}) {
     if (!st) return st.error();
   }
   return node;
@@ -159,6 +161,11 @@ void DdsNode::write_map(const proto::MapReply& map, double stamp_s) {
 void DdsNode::write_markers(const MarkerScene& scene, double stamp_s) {
   if (markers_writer_ <= 0) return;
   written(ros::write_markers(markers_writer_, scene, stamp_s, config_.world_frame), "markers");
+}
+
+void DdsNode::write_odom(const proto::Pose& T_world_odom, double stamp_s) {
+  if (tf_writer_ <= 0) return;
+  written(write_transform(tf_writer_, T_world_odom, stamp_s, config_.world_frame, config_.odom_frame), "tf");
 }
 
 }  // namespace scenewatch::ros

@@ -33,6 +33,8 @@ class DdsNode {
   void write_map(const proto::MapReply& map, double stamp_s);
   /// Only when config.markers (else there is no writer and nothing is written).
   void write_markers(const MarkerScene& scene, double stamp_s);
+  /// Only when config.publish_odom_tf: world -> odom on /tf.
+  void write_odom(const proto::Pose& T_world_odom, double stamp_s);
 
  private:
   DdsNode(const BridgeConfig& config, BridgeStats& stats) : config_(config), stats_(stats) {}
@@ -42,7 +44,7 @@ class DdsNode {
   BridgeStats& stats_;
   dds_entity_t participant_ = 0;
   dds_entity_t depth_reader_ = 0, color_reader_ = 0, info_reader_ = 0, tf_reader_ = 0, tf_static_reader_ = 0;
-  dds_entity_t events_writer_ = 0, objects_writer_ = 0, map_writer_ = 0, markers_writer_ = 0;
+  dds_entity_t events_writer_ = 0, objects_writer_ = 0, map_writer_ = 0, markers_writer_ = 0, tf_writer_ = 0;
 };
 
 }  // namespace scenewatch::ros
