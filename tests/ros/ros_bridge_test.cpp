@@ -99,7 +99,8 @@ ReceivedMarker received_marker(const visualization_msgs_msg_dds__Marker_& m) {
 /// /tf_static, rig -> camera_optical on /tf per frame) and a subscriber of the bridge's topics.
 class CameraPeer {
  public:
-  explicit CameraPeer(std::uint32_t domain) : peer_(domain) {
+  /// `root_frame`: the parent of the rig's /tf_static link (the world, or the robot's odometry).
+  explicit CameraPeer(std::uint32_t domain, std::string root_frame = "world") : peer_(domain), root_frame_(std::move(root_frame)) {
     depth_w_ = peer_.entity("/camera/depth/image_rect_raw", &sensor_msgs_msg_dds__Image__desc, false, false, 5);
     color_w_ = peer_.entity("/camera/color/image_raw", &sensor_msgs_msg_dds__Image__desc, false, false, 5);
     info_w_ = peer_.entity("/camera/depth/camera_info", &sensor_msgs_msg_dds__CameraInfo__desc, false, false, 5);
@@ -117,7 +118,7 @@ class CameraPeer {
   /// Waits for the bridge's participant (every writer and reader matched), then sends /tf_static.
   bool connect(double timeout_s) {
     if (!DdsPeer::wait_matched({depth_w_, color_w_, info_w_, tf_w_, tf_static_w_}, {events_r_, objects_r_, map_r_, markers_r_}, timeout_s)) return false;
-    auto t = transform(T_world_rig_, kStamp0, "world", "rig");
+    auto t = transform(T_world_rig_, kStamp0, root_frame_.c_str(), "rig");
     tf2_msgs_msg_dds__TFMessage_ m{};
     m.transforms._length = m.transforms._maximum = 1;
     m.transforms._buffer = &t;
@@ -195,6 +196,7 @@ class CameraPeer {
 
  private:
   DdsPeer peer_;
+  std::string root_frame_;
   dds_entity_t depth_w_ = 0, color_w_ = 0, info_w_ = 0, tf_w_ = 0, tf_static_w_ = 0, events_r_ = 0, objects_r_ = 0, map_r_ = 0,
                markers_r_ = 0;
   Pose T_world_rig_ = Pose::Identity();
@@ -473,6 +475,66 @@ TEST_F(RosBridgeTest, CupAddedOverDdsGivesOneEventTheObjectsAndTheMap) {
   EXPECT_EQ(stats.find("dropped."), std::string::npos) << "lock step: nothing to drop; " << stats;
   std::printf("scenewatch-ros on %zu frames of 320x240 (%zu sent again): %s\n", stamps.size(), retries, stats.c_str());
   std::printf("publish -> Detection3DArray back, through DDS, the bridge and the daemon: median %.1f ms\n", median(round_trip_ms));
+}
+
+// --publish-odom-tf: the camera's poses come from the robot's odometry (odom -> rig -> camera),
+// the daemon refines them against its memory, and the bridge publishes its correction, world ->
+// odom, on /tf after each frame: the T_world_odom that GetLocalization reports.
+TEST_F(RosBridgeTest, TheDaemonsOdometryCorrectionIsPublishedOnTf) {
+  const std::uint32_t domain = configure_loopback_dds();
+  ShippedScenario shipped = shipped_scenario("cup_added", 320, 240, 8);
+  ASSERT_TRUE(shipped.simulator);
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "segmentation:\n  up_vector: [0, 0, 1]\nlocalization:\n  mode: refine\n"));
+  ASSERT_NO_FATAL_FAILURE(start_bridge({"--publish-odom-tf", "--odom-frame", "odom"}));
+  CameraPeer camera(domain, "odom");
+  DdsPeer listener(domain);  // a tf2 listener of its own, as RViz's would be
+  const dds_entity_t tf_r = listener.entity("/tf", &tf2_msgs_msg_dds__TFMessage__desc, true, true, 100);
+  ASSERT_TRUE(camera.connect(30.0));
+  ASSERT_TRUE(DdsPeer::wait_matched({}, {tf_r}, 30.0)) << "no /tf writer of the bridge";
+
+  double stamp = kStamp0;
+  for (int f = 0; f < shipped.simulator->frame_count(0); ++f) {
+    const sim::SimFrame rendered = shipped.simulator->render(0, f);
+    stamp = kStamp0 + f / 30.0;
+    camera.publish(rendered, shipped.scenario.intrinsics, stamp);
+    ASSERT_TRUE(camera.objects_of(stamp, kFrameWaitS)) << "no objects for frame " << f;
+  }
+  // The last frame's world -> odom, as the listener received it (the camera's own /tf links are
+  // odom -> ... and are skipped).
+  std::optional<Pose> received;
+  const auto waited = Clock::now();
+  while (!received && ms_since(waited) < kFrameWaitS * 1000) {
+    DdsPeer::take<tf2_msgs_msg_dds__TFMessage_>(tf_r, [&](const tf2_msgs_msg_dds__TFMessage_& m) {
+      for (std::uint32_t i = 0; i < m.transforms._length; ++i) {
+        const auto& t = m.transforms._buffer[i];
+        if (std::string(t.header.frame_id) != "world" || std::string(t.child_frame_id) != "odom") continue;
+        if (std::abs(ros::seconds(t.header.stamp) - stamp) > 1e-6) continue;
+        const auto& q = t.transform.rotation;
+        EXPECT_NEAR(std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w), 1.0, 1e-9);
+        received = Pose::Identity();
+        received->linear() = Eigen::Quaterniond(q.w, q.x, q.y, q.z).toRotationMatrix();
+        received->translation() = Eigen::Vector3d(t.transform.translation.x, t.transform.translation.y, t.transform.translation.z);
+      }
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_TRUE(received) << "no world -> odom on /tf for the last frame";
+
+  service::Client client = daemon_.connect();
+  const auto where = call(client, request([](proto::Request& r) { r.mutable_get_localization(); }));
+  ASSERT_EQ(where.localization().cameras_size(), 1);
+  const auto& result = where.localization().cameras(0);
+  EXPECT_EQ(result.mode(), "refine");
+  ASSERT_EQ(result.t_world_odom().matrix_size(), 16);
+  Eigen::Matrix4d expected;
+  for (int i = 0; i < 16; ++i) expected(i / 4, i % 4) = result.t_world_odom().matrix(i);
+  EXPECT_LT((received->matrix() - expected).cwiseAbs().maxCoeff(), 1e-9) << "the daemon's T_world_odom:\n" << expected;
+  std::printf("world -> odom after %d frames (refine, state %s): %.2f mm, %.3f deg from the identity\n",
+              shipped.simulator->frame_count(0), result.state().c_str(), received->translation().norm() * 1000,
+              Eigen::AngleAxisd(received->linear()).angle() * 180 / M_PI);
+  const auto [code, stats] = stop_bridge();
+  EXPECT_EQ(code, std::optional<int>(0));
+  EXPECT_NE(stats.find("odom_sent="), std::string::npos) << stats;
 }
 
 // The daemon vanishes (killed) and comes back on the same port: the bridge keeps running,
