@@ -115,9 +115,12 @@ class CameraPeer {
     T_world_rig_.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   }
 
-  /// Waits for the bridge's participant (every writer and reader matched), then sends /tf_static.
-  bool connect(double timeout_s) {
-    if (!DdsPeer::wait_matched({depth_w_, color_w_, info_w_, tf_w_, tf_static_w_}, {events_r_, objects_r_, map_r_, markers_r_}, timeout_s)) return false;
+  /// Waits for the bridge's participant (every writer and reader matched; the markers reader only
+  /// when `markers`), then sends /tf_static.
+  bool connect(double timeout_s, bool markers = true) {
+    std::vector<dds_entity_t> readers{events_r_, objects_r_, map_r_};
+    if (markers) readers.push_back(markers_r_);
+    if (!DdsPeer::wait_matched({depth_w_, color_w_, info_w_, tf_w_, tf_static_w_}, readers, timeout_s)) return false;
     auto t = transform(T_world_rig_, kStamp0, root_frame_.c_str(), "rig");
     tf2_msgs_msg_dds__TFMessage_ m{};
     m.transforms._length = m.transforms._maximum = 1;
@@ -193,6 +196,7 @@ class CameraPeer {
   }
 
   dds_entity_t events_reader() const { return events_r_; }
+  dds_entity_t markers_reader() const { return markers_r_; }
   dds_entity_t map_reader() const { return map_r_; }
 
  private:
@@ -550,7 +554,7 @@ TEST_F(RosBridgeTest, TheDaemonsOdometryCorrectionIsPublishedOnTf) {
 
 // The daemon vanishes (killed) and comes back on the same port: the bridge keeps running,
 // reconnects with backoff and carries on. A frame whose TF never comes is dropped with its reason
-// counted, not sent.
+// counted, not sent. Run with --no-markers, which must leave no markers topic.
 TEST_F(RosBridgeTest, AVanishedDaemonIsReconnectedToAndAFrameWithoutTfIsDropped) {
   const std::uint32_t domain = configure_loopback_dds();
   ShippedScenario shipped = shipped_scenario("cup_added", 320, 240, 4);
@@ -585,13 +589,13 @@ TEST_F(RosBridgeTest, AVanishedDaemonIsReconnectedToAndAFrameWithoutTfIsDropped)
   std::vector<std::string> argv{bridge_binary().string(), "--port", std::to_string(port), "--token-file", (tmp_ / "token").string(),
                                 "--world-frame", "world", "--camera-frame", "camera_optical", "--depth-topic",
                                 "/camera/depth/image_rect_raw", "--color-topic", "/camera/color/image_raw", "--info-topic",
-                                "/camera/depth/camera_info", "--max-backoff", "0.5", "--tf-wait", "0.2"};
+                                "/camera/depth/camera_info", "--max-backoff", "0.5", "--tf-wait", "0.2", "--no-markers"};
   auto child = ChildProcess::start(argv, tmp_ / "scenewatch-ros.log");
   ASSERT_TRUE(child.has_value());
   bridge_ = std::make_unique<ChildProcess>(std::move(*child));
   ASSERT_EQ(bridge_->read_line(kStartTimeoutS).value_or(""), "ready") << bridge_->stderr_text();
   CameraPeer camera(domain);
-  ASSERT_TRUE(camera.connect(30.0));
+  ASSERT_TRUE(camera.connect(30.0, /*markers=*/false));
 
   double stamp = kStamp0;
   auto sent_and_answered = [&](double timeout_s) {
@@ -617,8 +621,13 @@ TEST_F(RosBridgeTest, AVanishedDaemonIsReconnectedToAndAFrameWithoutTfIsDropped)
   daemon = start_daemon(2);
   EXPECT_TRUE(sent_and_answered(kFrameWaitS)) << "no objects after the daemon came back";
 
+  // --no-markers: no MarkerArray writer at all, and no GetHands per frame.
+  dds_subscription_matched_status_t markers_matched{};
+  dds_get_subscription_matched_status(camera.markers_reader(), &markers_matched);
+  EXPECT_EQ(markers_matched.total_count, 0u);
   const auto [code, stats] = stop_bridge();
   EXPECT_EQ(code, std::optional<int>(0)) << bridge_->stderr_text();
+  EXPECT_EQ(stats.find("markers_sent"), std::string::npos) << stats;
   EXPECT_NE(stats.find("dropped.no_tf=1"), std::string::npos) << stats;
   EXPECT_NE(stats.find("reconnects.ingest="), std::string::npos) << stats;
   EXPECT_NE(bridge_->stderr_text().find("(no_tf, 1 so far)"), std::string::npos) << bridge_->stderr_text();
