@@ -20,12 +20,16 @@ struct BridgeConfig {
   std::string color_topic = "/camera/color/image_raw";  ///< empty: depth only (grey points)
   std::string info_topic = "/camera/aligned_depth_to_color/camera_info";
   std::string world_frame = "map";
+  /// With publish_odom_tf: the frame the camera poses are looked up in (the robot's odometry) and
+  /// the child of the world -> odom transform the bridge publishes on /tf.
+  std::string odom_frame = "odom";
+  bool publish_odom_tf = false;    ///< publish world -> odom from the daemon's localization (T_world_odom)
   std::string camera_frame;        ///< empty: the depth images' header.frame_id
   double tf_tolerance_s = 0.05;    ///< a /tf sample this far from the image stamp still counts
   double sync_tolerance_s = 0.02;  ///< colour and depth stamps this close make one frame
   double tf_wait_s = 0.5;          ///< how long a frame waits for its TF to arrive
   WithoutTf without_tf = WithoutTf::kDrop;
-  std::string output_namespace = "/scenewatch";  ///< events, objects, octomap_binary under it
+  std::string output_namespace = "/scenewatch";  ///< events, objects, octomap_binary, markers under it
   std::string camera_name;         ///< IngestFrame.camera (empty: the daemon's default camera)
 
   // Daemon side.
@@ -38,8 +42,16 @@ struct BridgeConfig {
   // Between the two.
   std::size_t queue_frames = 2;    ///< frames waiting for the daemon; the oldest is dropped beyond
   double map_period_s = 1.0;       ///< the octomap is published at most this often (and once idle)
+  bool markers = true;             ///< publish the MarkerArray after each frame (one GetHands more per frame)
+  std::size_t marker_events = 10;  ///< the newest events drawn as markers
   double stats_period_s = 0.0;     ///< a stats line on stdout this often (0: only at exit)
 };
+
+/// The TF frame camera poses are looked up in: the odometry frame when the bridge publishes world ->
+/// odom itself (else it would read back its own transform), else the world frame.
+inline const std::string& pose_frame(const BridgeConfig& config) {
+  return config.publish_odom_tf ? config.odom_frame : config.world_frame;
+}
 
 /// The ROS 2 DDS topic name of a ROS topic: "/tf" -> "rt/tf". Errors for an empty or relative name.
 Result<std::string> dds_topic_name(const std::string& ros_topic);

@@ -13,7 +13,7 @@ double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono
 }  // namespace
 
 DaemonLink::DaemonLink(const BridgeConfig& config, BridgeStats& stats, Outputs outputs)
-    : config_(config), stats_(stats), out_(std::move(outputs)), queue_(config.queue_frames) {}
+    : config_(config), stats_(stats), out_(std::move(outputs)), queue_(config.queue_frames), recent_events_(config.marker_events) {}
 
 DaemonLink::~DaemonLink() { stop(); }
 
@@ -142,6 +142,13 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
     return true;
   }
   stats_.count("frames_sent");
+  for (const auto& event : reply->ingest().events()) recent_events_.add(event);
+  // The frame's camera's T_world_odom, as the daemon holds it after this frame (identity in
+  // `given` mode: the given poses are world poses).
+  if (out_.odom && reply->ingest().has_localization()) {
+    out_.odom(reply->ingest().localization().t_world_odom(), frame.stamp_s);
+    stats_.count("odom_sent");
+  }
   proto::Request objects;
   objects.mutable_get_objects();
   auto answer = call(client, std::move(objects), "objects");
@@ -149,6 +156,7 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
   if (service::status_of(*answer)) {
     out_.objects(answer->objects(), frame.stamp_s);
     stats_.sample_ms("out.reply_to_objects_written", ms_between(replied, Clock::now()));
+    if (out_.markers && !publish_markers(client, reply->ingest(), answer->objects(), frame.stamp_s)) return false;
   }
   map_stamp_s_ = frame.stamp_s;
   map_dirty_ = true;
@@ -187,6 +195,23 @@ void DaemonLink::publish_map(service::Client& client, double stamp_s) {
   map_dirty_ = false;
 }
 
+bool DaemonLink::publish_markers(service::Client& client, const proto::IngestReply& ingest, const proto::ObjectsReply& objects,
+                                 double stamp_s) {
+  proto::Request request;
+  request.mutable_get_hands();
+  auto answer = call(client, std::move(request), "hands");
+  if (!answer) return false;
+  MarkerScene scene;
+  scene.planes = &ingest.planes();
+  scene.objects = &objects;
+  // An older daemon without GetHands still gets the other markers.
+  if (service::status_of(*answer)) scene.hands = &answer->hands();
+  scene.events = recent_events_.newest();
+  out_.markers(scene, stamp_s);
+  stats_.count("markers_sent");
+  return true;
+}
+
 void DaemonLink::subscribe_loop() {
   while (!stopping_) {
     auto client = connect("events");
@@ -209,6 +234,7 @@ void DaemonLink::subscribe_loop() {
       }
       if (!pushed->has_event()) continue;  // a localization notice
       const auto received = Clock::now();
+      recent_events_.add(pushed->event());
       out_.events({pushed->event()});
       stats_.count("events_sent");
       stats_.sample_ms("out.event_to_written", ms_between(received, Clock::now()));

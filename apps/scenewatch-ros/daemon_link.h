@@ -1,7 +1,7 @@
 #pragma once
 /// The daemon side of the bridge: one thread sends the queued frames (IngestFrame) and, after each
-/// reply, asks for the objects (GetObjects) and, at most every map_period_s and once the stream
-/// pauses, the map (GetMap); another holds a Subscribe connection and passes each pushed event on.
+/// reply, asks for the objects (GetObjects), the hands for the markers (GetHands) and, at most every
+/// map_period_s and once the stream pauses, the map (GetMap); another holds a Subscribe connection and passes each pushed event on.
 /// A daemon that is down, refuses, or answers slower than call_timeout_s is reconnected to with
 /// backoff (0.1 s doubling up to max_backoff_s); the bridge keeps running meanwhile. Knows no DDS:
 /// what arrives goes to the Outputs callbacks. Thread safe: push() from any thread.
@@ -15,6 +15,8 @@
 #include "bridge_stats.h"
 #include "frame_assembler.h"
 #include "frame_queue.h"
+#include "recent_events.h"
+#include "scene_markers.h"
 #include "scenewatch.pb.h"
 #include "scenewatch/service/client.h"
 
@@ -25,6 +27,8 @@ struct Outputs {
   std::function<void(const std::vector<proto::Event>&)> events;
   std::function<void(const proto::ObjectsReply&, double stamp_s)> objects;
   std::function<void(const proto::MapReply&, double stamp_s)> map;
+  std::function<void(const MarkerScene&, double stamp_s)> markers;  ///< unset: no markers
+  std::function<void(const proto::Pose& T_world_odom, double stamp_s)> odom;  ///< unset: no /tf
   std::function<void(const std::string&)> log;
 };
 
@@ -51,6 +55,9 @@ class DaemonLink {
   /// connection broke (it is closed).
   bool send_frame(service::Client& client, const FrameJob& job);
   void publish_map(service::Client& client, double stamp_s);
+  /// After a frame's objects: fetches the hands and publishes the markers. False: the connection
+  /// broke.
+  bool publish_markers(service::Client& client, const proto::IngestReply& ingest, const proto::ObjectsReply& objects, double stamp_s);
   /// One call; a transport error (down, or slower than call_timeout_s) is logged and closes the
   /// connection, and gives nothing.
   std::optional<proto::Response> call(service::Client& client, proto::Request request, const char* what);
@@ -65,6 +72,7 @@ class DaemonLink {
   Outputs out_;
   std::string token_;
   DropOldestQueue<FrameJob> queue_;
+  RecentEvents recent_events_;
   std::atomic<bool> stopping_{false};
   std::thread ingest_thread_, subscribe_thread_;
   double map_stamp_s_ = 0.0;  ///< stamp of the last frame whose map is not published yet

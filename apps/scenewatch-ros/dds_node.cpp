@@ -4,6 +4,7 @@
 
 #include "ros_messages.h"
 #include "scenewatch/io/bag/image_conversion.h"
+#include "visualization_msgs.h"
 
 namespace scenewatch::ros {
 namespace {
@@ -75,7 +76,13 @@ Result<std::unique_ptr<DdsNode>> DdsNode::create(const BridgeConfig& config, Bri
                   entity(ns + "/events", &scenewatch_msgs_msg_dds__EventArray__desc, Profile::kReliable, false, &node->events_writer_),
                   entity(ns + "/objects", &vision_msgs_msg_dds__Detection3DArray__desc, Profile::kReliable, false, &node->objects_writer_),
                   entity(ns + "/octomap_binary", &octomap_msgs_msg_dds__Octomap__desc, Profile::kTransientLocal, false,
-                         &node->map_writer_)}) {
+                         &node->map_writer_),
+                  // As the objects (RViz's Marker display reads reliable, volatile): every frame's array reaches it.
+                  !config.markers ? Status{}
+                                  : entity(ns + "/markers", &visualization_msgs_msg_dds__MarkerArray__desc, Profile::kReliable, false,
+                                           &node->markers_writer_),
+                  // As a tf2_ros TransformBroadcaster (reliable, keep last 100, volatile).
+                  !config.publish_odom_tf ? Status{} : entity("/tf", &tf2_msgs_msg_dds__TFMessage__desc, Profile::kTf, false, &node->tf_writer_)}) {
     if (!st) return st.error();
   }
   return node;
@@ -149,6 +156,16 @@ void DdsNode::write_objects(const proto::ObjectsReply& objects, double stamp_s) 
 
 void DdsNode::write_map(const proto::MapReply& map, double stamp_s) {
   written(write_octomap(map_writer_, map, stamp_s, config_.world_frame), "octomap");
+}
+
+void DdsNode::write_markers(const MarkerScene& scene, double stamp_s) {
+  if (markers_writer_ <= 0) return;
+  written(ros::write_markers(markers_writer_, scene, stamp_s, config_.world_frame), "markers");
+}
+
+void DdsNode::write_odom(const proto::Pose& T_world_odom, double stamp_s) {
+  if (tf_writer_ <= 0) return;
+  written(write_transform(tf_writer_, T_world_odom, stamp_s, config_.world_frame, config_.odom_frame), "tf");
 }
 
 }  // namespace scenewatch::ros

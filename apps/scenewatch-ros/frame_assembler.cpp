@@ -140,7 +140,7 @@ void FrameAssembler::retry_waiting() {
 
 Result<Pose> FrameAssembler::lookup_pose(const FrameJob& job) const {
   const std::string& camera = config_.camera_frame.empty() ? job.depth.frame_id : config_.camera_frame;
-  return tf_.lookup(config_.world_frame, camera, job.depth.stamp_s, config_.tf_tolerance_s);
+  return tf_.lookup(pose_frame(config_), camera, job.depth.stamp_s, config_.tf_tolerance_s);
 }
 
 void FrameAssembler::add_transform(const io::bag::StampedTransform& t, bool is_static) {

@@ -31,6 +31,9 @@ constexpr const char* kDescription =
     "  events          scenewatch_msgs/msg/EventArray      reliable, keep last 10\n"
     "  objects         vision_msgs/msg/Detection3DArray    reliable, keep last 10 (after every frame)\n"
     "  octomap_binary  octomap_msgs/msg/Octomap            reliable, transient local (binary, id OcTree)\n"
+    "  markers         visualization_msgs/msg/MarkerArray  reliable, keep last 10 (after every frame; for RViz:\n"
+    "                  a DELETEALL, then planes, objects, labels, hands, events; --no-markers)\n"
+    "and, with --publish-odom-tf, --world-frame -> --odom-frame on /tf (reliable, keep last 100).\n"
     "Images and camera info are read best effort, keep last 5; /tf reliable; /tf_static transient local.\n"
     "Prints 'ready' on stdout once its DDS entities exist, and a stats line on exit (SIGINT, SIGTERM).\n"
     "Exit codes: 0 stopped by a signal, 1 error (message on stderr), 2 usage.";
@@ -58,6 +61,10 @@ int main(int argc, char** argv) {
     app.add_option(flag, value, help)->check(positive ? CLI::Validator(CLI::PositiveNumber) : CLI::Validator(CLI::NonNegativeNumber))->capture_default_str();
   };
   app.add_option("--world-frame", config.world_frame, "TF frame of the daemon's world: poses are T_world_camera")->capture_default_str();
+  app.add_flag("--publish-odom-tf", config.publish_odom_tf,
+               "publish --world-frame -> --odom-frame on /tf after each frame: the daemon's T_world_odom (its localization's "
+               "correction of the given poses); camera poses are then looked up in --odom-frame");
+  app.add_option("--odom-frame", config.odom_frame, "the robot's odometry TF frame, for --publish-odom-tf")->capture_default_str();
   app.add_option("--camera-frame", config.camera_frame, "the depth camera's optical TF frame (default: the depth images' header.frame_id)");
   seconds_option("--tf-tolerance", config.tf_tolerance_s,
                  "seconds between an image stamp and the nearest /tf sample that still give its pose (between two samples: interpolated)");
@@ -86,6 +93,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   seconds_option("--map-period", config.map_period_s,
                  "seconds between two octomap messages at most (the last frame's map is sent once the stream pauses)");
+  app.add_flag("--no-markers", [&](std::int64_t) { config.markers = false; },
+               "publish no MarkerArray (saves a GetHands call per frame)");
+  app.add_option("--marker-events", config.marker_events, "the newest events drawn as markers (yellow boxes)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   seconds_option("--stats-period", config.stats_period_s,
                  "seconds between two stats lines on stdout (0: only at exit)");
   CLI11_PARSE(app, argc, argv);
@@ -100,6 +112,10 @@ int main(int argc, char** argv) {
   }
   if (config.world_frame.empty()) {
     std::cerr << "scenewatch-ros: --world-frame must name a TF frame\n";
+    return 2;
+  }
+  if (config.publish_odom_tf && (config.odom_frame.empty() || config.odom_frame == config.world_frame)) {
+    std::cerr << "scenewatch-ros: --publish-odom-tf needs an --odom-frame other than --world-frame\n";
     return 2;
   }
   std::signal(SIGINT, on_signal);
@@ -122,6 +138,8 @@ int main(int argc, char** argv) {
   outputs.events = [&](const std::vector<scenewatch::proto::Event>& events) { dds.write_events(events); };
   outputs.objects = [&](const scenewatch::proto::ObjectsReply& objects, double stamp_s) { dds.write_objects(objects, stamp_s); };
   outputs.map = [&](const scenewatch::proto::MapReply& map, double stamp_s) { dds.write_map(map, stamp_s); };
+  if (config.publish_odom_tf) outputs.odom = [&](const scenewatch::proto::Pose& T, double stamp_s) { dds.write_odom(T, stamp_s); };
+  if (config.markers) outputs.markers = [&](const MarkerScene& scene, double stamp_s) { dds.write_markers(scene, stamp_s); };
   outputs.log = log;
   DaemonLink link(config, stats, outputs);
   FrameAssembler assembler(config, stats, [&](FrameJob job) { link.push(std::move(job)); }, log);

@@ -163,6 +163,25 @@ dds_return_t write_detections(dds_entity_t writer, const proto::ObjectsReply& ob
   return dds_write(writer, &array);
 }
 
+dds_return_t write_transform(dds_entity_t writer, const proto::Pose& T_parent_child, double stamp_s, const std::string& parent,
+                             const std::string& child) {
+  if (T_parent_child.matrix_size() != 16) return DDS_RETCODE_BAD_PARAMETER;
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) m(r, c) = T_parent_child.matrix(4 * r + c);
+  }
+  const Eigen::Quaterniond q(m.topLeftCorner<3, 3>());
+  geometry_msgs_msg_dds__TransformStamped_ t{};
+  t.header = header(stamp_s, parent);
+  t.child_frame_id = c_str(child);
+  t.transform.translation = {m(0, 3), m(1, 3), m(2, 3)};
+  t.transform.rotation = {q.x(), q.y(), q.z(), q.w()};
+  tf2_msgs_msg_dds__TFMessage_ message{};
+  message.transforms._length = message.transforms._maximum = 1;
+  message.transforms._buffer = &t;
+  return dds_write(writer, &message);
+}
+
 dds_return_t write_octomap(dds_entity_t writer, const proto::MapReply& map, double stamp_s, const std::string& world_frame) {
   static const std::string kId = "OcTree";
   octomap_msgs_msg_dds__Octomap_ m{};

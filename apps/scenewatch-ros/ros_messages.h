@@ -36,6 +36,10 @@ dds_return_t write_events(dds_entity_t writer, const std::vector<proto::Event>& 
 /// its box (centre, rotation, extents), id = the object's id, one hypothesis (its ontology class, or
 /// "object" with score 1).
 dds_return_t write_detections(dds_entity_t writer, const proto::ObjectsReply& objects, double stamp_s, const std::string& world_frame);
+/// Writes `T_parent_child` (row-major 4x4, the daemon's Pose) as a one-transform TFMessage, as a
+/// tf2_ros TransformBroadcaster does. An ill-formed pose (not 16 values) writes nothing.
+dds_return_t write_transform(dds_entity_t writer, const proto::Pose& T_parent_child, double stamp_s, const std::string& parent,
+                             const std::string& child);
 /// Writes the map as octomap_server does: binary, id "OcTree", data = OcTree::writeBinaryData.
 dds_return_t write_octomap(dds_entity_t writer, const proto::MapReply& map, double stamp_s, const std::string& world_frame);
 

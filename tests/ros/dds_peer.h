@@ -21,6 +21,7 @@
 #include "sensor_msgs.h"
 #include "tf2_msgs.h"
 #include "vision_msgs.h"
+#include "visualization_msgs.h"
 
 namespace scenewatch::test {
 
