@@ -154,6 +154,107 @@ Result<BenchRow> bench_scenario(const fs::path& path, int frames, int width, int
   return row;
 }
 
+/// `scenewatch-sim list`: each shipped scenario with its phases, frames and description.
+int run_list(const std::string& scenario_dir) {
+  const auto files = shipped_scenarios(scenario_dir);
+  if (files.empty()) {
+    std::cerr << "scenewatch-sim: no scenarios in " << scenario_dir << "\n";
+    return 1;
+  }
+  for (const auto& f : files) {
+    auto sc = sim::load_scenario(f);
+    if (!sc) {
+      std::printf("%-24s (invalid: %s)\n", f.stem().c_str(), sc.error().message.c_str());
+      continue;
+    }
+    int total = 0;
+    for (const auto& p : sc->phases) total += p.frames;
+    std::printf("%-24s %zu phase(s), %4d frames  %s\n", f.stem().c_str(), sc->phases.size(), total,
+                sc->description.c_str());
+  }
+  return 0;
+}
+
+/// The options of `scenewatch-sim render`.
+struct RenderOptions {
+  std::string scenario_arg, out_dir;
+  std::optional<int> frames, width, height;
+  std::optional<std::uint64_t> seed;
+  std::string pcd_path;
+  bool quiet = false;
+};
+
+/// `scenewatch-sim render`: writes the scenario's sequences (and, with --pcd, frame 0 as a cloud).
+int run_render(const RenderOptions& o, const std::string& scenario_dir) {
+  auto loaded = resolve_scenario(o.scenario_arg, scenario_dir);
+  if (!loaded) return fail(loaded.error());
+  auto sc = apply_overrides(std::move(*loaded), o.frames, o.seed, o.width, o.height);
+  if (!sc) return fail(sc.error());
+  auto simulator = sim::Simulator::create(std::move(*sc));
+  if (!simulator) return fail(simulator.error());
+  const bool tty = !o.quiet && ::isatty(STDERR_FILENO);
+  sim::ProgressFn progress;
+  if (tty) {
+    progress = [](const std::string& phase, std::size_t done, std::size_t total) {
+      std::fprintf(stderr, "\r%s: frame %zu/%zu", phase.c_str(), done, total);
+      if (done == total) std::fprintf(stderr, "\n");
+    };
+  }
+  auto summary = simulator->write(o.out_dir, progress);
+  if (!summary) return fail(summary.error());
+  for (const auto& d : summary->sequence_dirs) std::printf("%s\n", d.c_str());
+  if (!summary->changes_json.empty()) std::printf("%s\n", summary->changes_json.c_str());
+  if (!o.pcd_path.empty()) {
+    // Rendering is deterministic: frame 0 again gives the images just written.
+    const sim::SimFrame frame = simulator->render(0, 0);
+    auto cloud = io::rgbd_to_cloud(frame.color, frame.depth, simulator->scenario().intrinsics, io::kDepthMillimetres,
+                                   simulator->scenario().sensor.max_depth_m);
+    if (!cloud) return fail(cloud.error());
+    if (auto st = io::write_pcd(o.pcd_path, **cloud); !st) return fail(st.error());
+    std::printf("%s\n", o.pcd_path.c_str());
+  }
+  return 0;
+}
+
+/// The options of `scenewatch-sim bench`.
+struct BenchOptions {
+  int frames = 30;
+  std::vector<std::string> scenarios = {"glasses_removed", "hand_picks_cup_upright", "clutter"};
+  int width = 640, height = 480;
+  int repeats = 3;
+  bool no_baseline = false;
+};
+
+/// `scenewatch-sim bench`: a table of median milliseconds per frame, the fastest of the repeats.
+int run_bench(const BenchOptions& o, const std::string& scenario_dir) {
+  if (o.frames < 1) return fail(invalid_argument("--frames must be at least 1"));
+  const bool pinned = pin_to_one_core();
+  std::printf("scenewatch-sim bench: %dx%d, %d frames per scenario, best of %d runs, %s\n", o.width, o.height, o.frames,
+              std::max(1, o.repeats), pinned ? "pinned to one core" : "NOT pinned (sched_setaffinity failed)");
+  std::printf("%-24s %5s %8s %8s %8s %7s %8s %7s %8s %7s\n", "scenario", "items", "raycast", "sensor", "frame", "fps",
+              "raycast", "frame", "no-cull", "culling");
+  std::printf("%-24s %5s %8s %8s %8s %7s %8s %7s %8s %7s\n", "", "", "cpu ms", "cpu ms", "cpu ms", "", "fps", "wall ms",
+              "cpu ms", "speedup");
+  for (const auto& name : o.scenarios) {
+    const fs::path path = fs::exists(name) ? fs::path(name) : fs::path(scenario_dir) / (name + ".yaml");
+    auto row = bench_scenario(path, o.frames, o.width, o.height, !o.no_baseline);
+    if (!row) return fail(row.error());
+    for (int r = 1; r < o.repeats; ++r) {
+      auto again = bench_scenario(path, o.frames, o.width, o.height, !o.no_baseline);
+      if (!again) return fail(again.error());
+      if (again->frame_ms < row->frame_ms) *row = *again;
+    }
+    std::printf("%-24s %5d %8.2f %8.2f %8.2f %7.1f %8.1f %7.2f", row->scenario.c_str(), row->items, row->raycast_ms,
+                row->sensor_ms, row->frame_ms, 1000.0 / row->frame_ms, 1000.0 / row->raycast_ms, row->wall_ms);
+    if (o.no_baseline) std::printf(" %8s %7s\n", "-", "-");
+    else std::printf(" %8.2f %6.1fx\n", row->nocull_ms, row->nocull_ms / row->raycast_ms);
+  }
+  std::printf("Medians per frame of the fastest run. cpu ms = this thread's CPU time; frame = ray casting + sensor\n"
+              "model (no PNG encoding); fps = 1000 / cpu ms; no-cull = the same ray caster testing every primitive\n"
+              "at every pixel (the baseline for the screen-tile and depth culling).\n");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -163,120 +264,33 @@ int main(int argc, char** argv) {
   std::string scenario_dir = scenewatch::apps::scenarios_dir().string();
   app.add_option("--scenarios", scenario_dir, "Folder of the shipped scenarios")->capture_default_str();
 
-  // render
   auto* render = app.add_subcommand("render", "Render a scenario (a YAML file or a shipped scenario's name)");
-  std::string scenario_arg, out_dir;
-  std::optional<int> frames, width, height;
-  std::optional<std::uint64_t> seed;
-  render->add_option("scenario", scenario_arg, "Scenario YAML file or shipped scenario name")->required();
-  render->add_option("--out", out_dir, "Output folder (one sequence, or one sub-folder per phase)")->required();
-  render->add_option("--frames", frames, "Frames per phase (keys are rescaled in time)");
-  render->add_option("--seed", seed, "Random seed (overrides the scenario's)");
-  render->add_option("--width", width, "Image width (intrinsics scale with it)");
-  render->add_option("--height", height, "Image height");
-  std::string pcd_path;
-  render->add_option("--pcd", pcd_path, "Also write frame 0 of the first phase as an organized XYZRGB PCD (camera frame)");
-  bool quiet = false;
-  render->add_flag("--quiet", quiet, "No progress output");
+  RenderOptions r;
+  render->add_option("scenario", r.scenario_arg, "Scenario YAML file or shipped scenario name")->required();
+  render->add_option("--out", r.out_dir, "Output folder (one sequence, or one sub-folder per phase)")->required();
+  render->add_option("--frames", r.frames, "Frames per phase (keys are rescaled in time)");
+  render->add_option("--seed", r.seed, "Random seed (overrides the scenario's)");
+  render->add_option("--width", r.width, "Image width (intrinsics scale with it)");
+  render->add_option("--height", r.height, "Image height");
+  render->add_option("--pcd", r.pcd_path, "Also write frame 0 of the first phase as an organized XYZRGB PCD (camera frame)");
+  render->add_flag("--quiet", r.quiet, "No progress output");
 
-  // list
   auto* list = app.add_subcommand("list", "List the shipped scenarios");
 
-  // bench
   auto* bench = app.add_subcommand("bench", "Frames per second at 640x480 on one core (median ms/frame)");
-  int bench_frames = 30;
-  std::vector<std::string> bench_scenarios = {"glasses_removed", "hand_picks_cup_upright", "clutter"};
-  int bench_width = 640, bench_height = 480;
-  bench->add_option("--frames", bench_frames, "Frames rendered per scenario")->capture_default_str();
-  bench->add_option("--scenario", bench_scenarios, "Scenarios to time")->capture_default_str();
-  bench->add_option("--width", bench_width, "Image width")->capture_default_str();
-  bench->add_option("--height", bench_height, "Image height")->capture_default_str();
-  int repeats = 3;
-  bench->add_option("--repeat", repeats, "Runs per scenario; the fastest run's medians are reported (robust to other load)")
+  BenchOptions b;
+  bench->add_option("--frames", b.frames, "Frames rendered per scenario")->capture_default_str();
+  bench->add_option("--scenario", b.scenarios, "Scenarios to time")->capture_default_str();
+  bench->add_option("--width", b.width, "Image width")->capture_default_str();
+  bench->add_option("--height", b.height, "Image height")->capture_default_str();
+  bench->add_option("--repeat", b.repeats, "Runs per scenario; the fastest run's medians are reported (robust to other load)")
       ->capture_default_str();
-  bool no_baseline = false;
-  bench->add_flag("--no-baseline", no_baseline, "Skip the ray caster without culling");
+  bench->add_flag("--no-baseline", b.no_baseline, "Skip the ray caster without culling");
 
   CLI11_PARSE(app, argc, argv);
 
-  if (list->parsed()) {
-    const auto files = shipped_scenarios(scenario_dir);
-    if (files.empty()) {
-      std::cerr << "scenewatch-sim: no scenarios in " << scenario_dir << "\n";
-      return 1;
-    }
-    for (const auto& f : files) {
-      auto sc = sim::load_scenario(f);
-      if (!sc) {
-        std::printf("%-24s (invalid: %s)\n", f.stem().c_str(), sc.error().message.c_str());
-        continue;
-      }
-      int total = 0;
-      for (const auto& p : sc->phases) total += p.frames;
-      std::printf("%-24s %zu phase(s), %4d frames  %s\n", f.stem().c_str(), sc->phases.size(), total,
-                  sc->description.c_str());
-    }
-    return 0;
-  }
-
-  if (render->parsed()) {
-    auto loaded = resolve_scenario(scenario_arg, scenario_dir);
-    if (!loaded) return fail(loaded.error());
-    auto sc = apply_overrides(std::move(*loaded), frames, seed, width, height);
-    if (!sc) return fail(sc.error());
-    auto simulator = sim::Simulator::create(std::move(*sc));
-    if (!simulator) return fail(simulator.error());
-    const bool tty = !quiet && ::isatty(STDERR_FILENO);
-    sim::ProgressFn progress;
-    if (tty) {
-      progress = [](const std::string& phase, std::size_t done, std::size_t total) {
-        std::fprintf(stderr, "\r%s: frame %zu/%zu", phase.c_str(), done, total);
-        if (done == total) std::fprintf(stderr, "\n");
-      };
-    }
-    auto summary = simulator->write(out_dir, progress);
-    if (!summary) return fail(summary.error());
-    for (const auto& d : summary->sequence_dirs) std::printf("%s\n", d.c_str());
-    if (!summary->changes_json.empty()) std::printf("%s\n", summary->changes_json.c_str());
-    if (!pcd_path.empty()) {
-      // Rendering is deterministic: frame 0 again gives the images just written.
-      const sim::SimFrame frame = simulator->render(0, 0);
-      auto cloud = io::rgbd_to_cloud(frame.color, frame.depth, simulator->scenario().intrinsics, io::kDepthMillimetres,
-                                     simulator->scenario().sensor.max_depth_m);
-      if (!cloud) return fail(cloud.error());
-      if (auto st = io::write_pcd(pcd_path, **cloud); !st) return fail(st.error());
-      std::printf("%s\n", pcd_path.c_str());
-    }
-    return 0;
-  }
-
-  if (bench->parsed()) {
-    if (bench_frames < 1) return fail(invalid_argument("--frames must be at least 1"));
-    const bool pinned = pin_to_one_core();
-    std::printf("scenewatch-sim bench: %dx%d, %d frames per scenario, best of %d runs, %s\n", bench_width, bench_height,
-                bench_frames, std::max(1, repeats), pinned ? "pinned to one core" : "NOT pinned (sched_setaffinity failed)");
-    std::printf("%-24s %5s %8s %8s %8s %7s %8s %7s %8s %7s\n", "scenario", "items", "raycast", "sensor", "frame",
-                "fps", "raycast", "frame", "no-cull", "culling");
-    std::printf("%-24s %5s %8s %8s %8s %7s %8s %7s %8s %7s\n", "", "", "cpu ms", "cpu ms", "cpu ms", "", "fps",
-                "wall ms", "cpu ms", "speedup");
-    for (const auto& name : bench_scenarios) {
-      const fs::path path = fs::exists(name) ? fs::path(name) : fs::path(scenario_dir) / (name + ".yaml");
-      auto row = bench_scenario(path, bench_frames, bench_width, bench_height, !no_baseline);
-      if (!row) return fail(row.error());
-      for (int r = 1; r < repeats; ++r) {
-        auto again = bench_scenario(path, bench_frames, bench_width, bench_height, !no_baseline);
-        if (!again) return fail(again.error());
-        if (again->frame_ms < row->frame_ms) *row = *again;
-      }
-      std::printf("%-24s %5d %8.2f %8.2f %8.2f %7.1f %8.1f %7.2f", row->scenario.c_str(), row->items, row->raycast_ms,
-                  row->sensor_ms, row->frame_ms, 1000.0 / row->frame_ms, 1000.0 / row->raycast_ms, row->wall_ms);
-      if (no_baseline) std::printf(" %8s %7s\n", "-", "-");
-      else std::printf(" %8.2f %6.1fx\n", row->nocull_ms, row->nocull_ms / row->raycast_ms);
-    }
-    std::printf("Medians per frame of the fastest run. cpu ms = this thread's CPU time; frame = ray casting + sensor\n"
-                "model (no PNG encoding); fps = 1000 / cpu ms; no-cull = the same ray caster testing every primitive\n"
-                "at every pixel (the baseline for the screen-tile and depth culling).\n");
-    return 0;
-  }
+  if (list->parsed()) return run_list(scenario_dir);
+  if (render->parsed()) return run_render(r, scenario_dir);
+  if (bench->parsed()) return run_bench(b, scenario_dir);
   return 0;
 }

@@ -76,15 +76,8 @@ void raise_open_file_limit(const scenewatch::service::ServerConfig& server, Stde
   }
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  scenewatch::keep_frame_buffers_in_heap();
-  CLI::App app{"scenewatchd - the scenewatch perception service.\n"
-               "Serves the scenewatch protocol (4-byte big-endian length + protobuf) over TCP, keeps the\n"
-               "working memory of the scene and saves it to the model directory on SaveModel and on\n"
-               "SIGINT/SIGTERM. Prints 'listening on ADDRESS:PORT' on stdout once ready (and, with --http,\n"
-               "'live view on http://ADDRESS:PORT/' on the next line)."};
+/// The command line: each option given overrides its key of the config file.
+struct Options {
   std::string config_path;
   std::optional<int> port;
   std::optional<std::string> address;
@@ -93,122 +86,140 @@ int main(int argc, char** argv) {
   std::optional<int> http_port;
   std::optional<std::string> http_bind;
   std::string log_level = "info";
+};
+
+/// Parses the command line into `options`; returns the exit code when the process should end
+/// here (--help, --version, a bad option).
+std::optional<int> parse_options(int argc, char** argv, Options& options) {
+  CLI::App app{"scenewatchd - the scenewatch perception service.\n"
+               "Serves the scenewatch protocol (4-byte big-endian length + protobuf) over TCP, keeps the\n"
+               "working memory of the scene and saves it to the model directory on SaveModel and on\n"
+               "SIGINT/SIGTERM. Prints 'listening on ADDRESS:PORT' on stdout once ready (and, with --http,\n"
+               "'live view on http://ADDRESS:PORT/' on the next line)."};
   app.set_version_flag("--version", "scenewatchd " SCENEWATCH_VERSION);
-  app.add_option("--config", config_path,
+  app.add_option("--config", options.config_path,
                  "YAML config file (see config/scenewatchd.yaml); default: an installed daemon's "
                  "scenewatchd.yaml (/etc/scenewatch/, or PREFIX/etc/scenewatch/), else built-in defaults");
-  app.add_option("--port", port, "TCP port, 0 = pick a free one (overrides server.port)")->check(CLI::Range(0, 65535));
-  app.add_option("--address", address, "listen address (overrides server.address)");
-  app.add_option("--model-dir", model_dir, "model directory, '' = none (overrides server.model_dir)");
-  app.add_option("--token-file", token_file,
+  app.add_option("--port", options.port, "TCP port, 0 = pick a free one (overrides server.port)")->check(CLI::Range(0, 65535));
+  app.add_option("--address", options.address, "listen address (overrides server.address)");
+  app.add_option("--model-dir", options.model_dir, "model directory, '' = none (overrides server.model_dir)");
+  app.add_option("--token-file", options.token_file,
                  "access token file, created (mode 0600) when missing (overrides server.token_file; "
                  "default ~/.scenewatch/token)");
-  app.add_option("--http", http_port,
+  app.add_option("--http", options.http_port,
                  "serve the live view in the browser on this HTTP port, 0 = pick a free one (overrides "
                  "server.http_port; read-only)")
       ->check(CLI::Range(0, 65535));
-  app.add_option("--http-bind", http_bind, "the live view's listen address (overrides server.http_bind; default 127.0.0.1)");
-  app.add_option("--log-level", log_level, "debug, info, warn or error")
+  app.add_option("--http-bind", options.http_bind,
+                 "the live view's listen address (overrides server.http_bind; default 127.0.0.1)");
+  app.add_option("--log-level", options.log_level, "debug, info, warn or error")
       ->check(CLI::IsMember({"debug", "info", "warn", "error"}));
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
+  return std::nullopt;
+}
 
-  const LogLevel min_level = log_level == "debug"  ? LogLevel::kDebug
-                             : log_level == "warn" ? LogLevel::kWarning
-                             : log_level == "error" ? LogLevel::kError
-                                                    : LogLevel::kInfo;
-  StderrLog log(min_level);
-  std::signal(SIGPIPE, SIG_IGN);
+LogLevel log_level_named(const std::string& name) {
+  return name == "debug"   ? LogLevel::kDebug
+         : name == "warn"  ? LogLevel::kWarning
+         : name == "error" ? LogLevel::kError
+                           : LogLevel::kInfo;
+}
 
+/// The config file, the command line's overrides on top, validated. Logs why when there is none.
+std::optional<scenewatch::service::DaemonConfig> load_config(Options options, StderrLog& log) {
   // An installed daemon reads the shipped config when given none; one run from the build tree
   // keeps the built-in defaults (the same values), as before it could be installed.
   const std::filesystem::path installed_config = scenewatch::apps::config_dir() / "scenewatchd.yaml";
-  if (config_path.empty() && !scenewatch::apps::installed_prefix().empty()) {
+  if (options.config_path.empty() && !scenewatch::apps::installed_prefix().empty()) {
     std::error_code ec;
     if (std::filesystem::is_regular_file(installed_config, ec)) {
-      config_path = installed_config.string();
+      options.config_path = installed_config.string();
     } else {
       log(LogLevel::kWarning, "config: no " + installed_config.string() + " (was it removed?); using the built-in defaults");
     }
   }
   scenewatch::service::DaemonConfig config;
-  if (!config_path.empty()) {
-    log(LogLevel::kInfo, "config: " + config_path);
-    auto loaded = scenewatch::service::load_daemon_config(config_path);
+  if (!options.config_path.empty()) {
+    log(LogLevel::kInfo, "config: " + options.config_path);
+    auto loaded = scenewatch::service::load_daemon_config(options.config_path);
     if (!loaded) {
       log(LogLevel::kError, "config: " + loaded.error().message);
-      return 1;
+      return std::nullopt;
     }
     config = std::move(*loaded);
   }
-  if (port) config.server.port = static_cast<std::uint16_t>(*port);
-  if (address) config.server.address = *address;
-  if (model_dir) config.server.model_dir = *model_dir;
-  if (token_file) config.server.token_file = *token_file;
-  // The live view is on when --http is given (0: a free port) or server.http_port is set.
-  const bool live_view_on = http_port.has_value() || config.server.http_port != 0;
-  if (http_port) config.server.http_port = static_cast<std::uint16_t>(*http_port);
-  if (http_bind) config.server.http_bind = *http_bind;
+  if (options.port) config.server.port = static_cast<std::uint16_t>(*options.port);
+  if (options.address) config.server.address = *options.address;
+  if (options.model_dir) config.server.model_dir = *options.model_dir;
+  if (options.token_file) config.server.token_file = *options.token_file;
+  if (options.http_port) config.server.http_port = static_cast<std::uint16_t>(*options.http_port);
+  if (options.http_bind) config.server.http_bind = *options.http_bind;
   if (config.server.token_file.empty()) config.server.token_file = scenewatch::service::default_token_path();
   if (auto s = scenewatch::service::validate(config.server); !s) {
     log(LogLevel::kError, "config: " + s.error().message);
-    return 1;
+    return std::nullopt;
   }
   if (auto s = scenewatch::pipeline::validate(config.pipeline); !s) {
     log(LogLevel::kError, "config: " + s.error().message);
-    return 1;
+    return std::nullopt;
   }
+  return config;
+}
 
-  // Calls that change the model need the token of this file (docs/daemon.md, "Access token").
-  auto token = scenewatch::service::ensure_token_file(config.server.token_file);
+/// Reads the access token that calls changing the model need (docs/daemon.md, "Access token").
+bool read_access_token(scenewatch::service::ServerConfig& server, StderrLog& log) {
+  auto token = scenewatch::service::ensure_token_file(server.token_file);
   if (!token) {
     log(LogLevel::kError, "access token: " + token.error().message);
-    return 1;
+    return false;
   }
-  config.server.access_token = std::move(*token);
-  log(LogLevel::kInfo, "calls that change the model need the token in " + config.server.token_file.string());
+  server.access_token = std::move(*token);
+  log(LogLevel::kInfo, "calls that change the model need the token in " + server.token_file.string());
+  return true;
+}
 
-  raise_open_file_limit(config.server, log);
-
-  scenewatch::pipeline::WorkingMemory memory(config.pipeline);
-  const std::filesystem::path& model = config.server.model_dir;
-  // One daemon per model directory, held until this process ends; then what killed or failed
-  // saves left behind goes, before anything is loaded.
-  std::optional<scenewatch::service::ModelDirLock> model_lock;
-  if (!model.empty()) {
-    auto locked = scenewatch::service::ModelDirLock::acquire(model);
-    if (!locked) {
-      log(LogLevel::kError, "model directory: " + locked.error().message);
-      return 1;
-    }
-    model_lock = std::move(*locked);
-    for (const auto& name : scenewatch::service::remove_unfinished_snapshots(model)) {
-      log(LogLevel::kWarning, "removed " + (model / name).string() + ", left behind by a save that did not finish");
-    }
+/// Locks the model directory for this process's lifetime (one daemon per directory) and removes
+/// what killed or failed saves left behind, before anything is loaded.
+bool lock_model_dir(const std::filesystem::path& model, std::optional<scenewatch::service::ModelDirLock>& model_lock,
+                    StderrLog& log) {
+  auto locked = scenewatch::service::ModelDirLock::acquire(model);
+  if (!locked) {
+    log(LogLevel::kError, "model directory: " + locked.error().message);
+    return false;
   }
-  if (!model.empty()) {
-    if (auto s = scenewatch::service::load_newest_good(memory, model); s) {
-      for (const auto& refused : s->refused) log(LogLevel::kError, "refused a damaged snapshot: " + refused);
-      log(s->refused.empty() ? LogLevel::kInfo : LogLevel::kWarning,
-          "loaded the model from " + s->folder.string() + " (" + std::to_string(memory.snapshot()->objects.size()) +
-              " objects)" + (s->refused.empty() ? "" : "; the newer snapshot stays on disk as it is, unused"));
-    } else if (s.error().code == scenewatch::ErrorCode::kNotFound) {
-      log(LogLevel::kInfo, "no model in " + model.string() + " yet; starting empty");
-    } else {
-      // Starting empty would overwrite the damaged model at exit: refuse instead.
-      log(LogLevel::kError, "cannot load the model from " + model.string() + ": " + s.error().message +
-                                " (repair or move the directory, or pass another --model-dir)");
-      return 1;
-    }
+  model_lock = std::move(*locked);
+  for (const auto& name : scenewatch::service::remove_unfinished_snapshots(model)) {
+    log(LogLevel::kWarning, "removed " + (model / name).string() + ", left behind by a save that did not finish");
+  }
+  return true;
+}
+
+/// Loads the newest good snapshot of the model directory into memory; none yet is an empty start.
+bool load_model(scenewatch::pipeline::WorkingMemory& memory, const std::filesystem::path& model, StderrLog& log) {
+  if (auto s = scenewatch::service::load_newest_good(memory, model); s) {
+    for (const auto& refused : s->refused) log(LogLevel::kError, "refused a damaged snapshot: " + refused);
+    log(s->refused.empty() ? LogLevel::kInfo : LogLevel::kWarning,
+        "loaded the model from " + s->folder.string() + " (" + std::to_string(memory.snapshot()->objects.size()) +
+            " objects)" + (s->refused.empty() ? "" : "; the newer snapshot stays on disk as it is, unused"));
+  } else if (s.error().code == scenewatch::ErrorCode::kNotFound) {
+    log(LogLevel::kInfo, "no model in " + model.string() + " yet; starting empty");
   } else {
-    log(LogLevel::kInfo, "no model directory configured: the model is not persisted");
+    // Starting empty would overwrite the damaged model at exit: refuse instead.
+    log(LogLevel::kError, "cannot load the model from " + model.string() + ": " + s.error().message +
+                              " (repair or move the directory, or pass another --model-dir)");
+    return false;
   }
+  return true;
+}
 
-  // The object classes: the classes file, overlaid by those defined through DefineClass, which
-  // ontology.sqlite in the model directory keeps.
+/// The object classes: the classes file, overlaid by those defined through DefineClass, which
+/// ontology.sqlite in the model directory keeps.
+bool open_classes(scenewatch::service::DaemonConfig& config, StderrLog& log) {
+  const std::filesystem::path& model = config.server.model_dir;
   const std::filesystem::path classes_file =
       config.ontology.classes_file.empty() ? scenewatch::apps::config_dir() / "ontology.yaml" : config.ontology.classes_file;
   std::filesystem::path class_store;
@@ -217,71 +228,62 @@ int main(int argc, char** argv) {
     std::filesystem::create_directories(model, ec);
     if (ec) {
       log(LogLevel::kError, "cannot create the model directory " + model.string() + ": " + ec.message());
-      return 1;
+      return false;
     }
     class_store = model / scenewatch::ontology::kClassStoreFile;
   }
   auto classes = scenewatch::ontology::ClassCatalog::open(classes_file, class_store);
   if (!classes) {
     log(LogLevel::kError, "ontology: " + classes.error().message);
-    return 1;
+    return false;
   }
   config.server.classes = std::move(*classes);
   log(LogLevel::kInfo, "object classes: " + std::to_string(config.server.classes->library().classes().size()) + " (" +
                            classes_file.string() + (class_store.empty() ? std::string(", not persisted)") : ", store " + class_store.string() + ")"));
+  return true;
+}
 
-  scenewatch::service::Server server(config.server, memory,
-                                     [&log](LogLevel level, const std::string& message) { log(level, message); });
-  if (auto s = server.listen(); !s) {
-    log(LogLevel::kError, s.error().message);
-    return 1;
-  }
-
-  // The live view: its own thread and socket; it sees the frames the server processes.
-  std::unique_ptr<scenewatch::service::LiveView> live_view;
+/// The live view in the browser: its own thread and socket; it sees the frames the server processes.
+struct LiveViewServer {
+  std::unique_ptr<scenewatch::service::LiveView> view;
   std::unique_ptr<scenewatch::service::HttpServer> http;
-  if (live_view_on) {
-    scenewatch::service::LiveViewConfig view_config;
-    view_config.three_js = config.server.http_three_js;
-    view_config.classes = config.server.classes;
-    live_view = std::make_unique<scenewatch::service::LiveView>(memory, view_config);
-    if (auto s = live_view->check_three_js(); !s) log(LogLevel::kWarning, "live view: " + s.error().message);
-    server.set_frame_observer([view = live_view.get()](const scenewatch::Frame& frame,
-                                                       const scenewatch::pipeline::FrameResult& result) {
-      view->observe(frame, result);
-    });
-    scenewatch::service::HttpServerConfig http_config;
-    http_config.address = config.server.http_bind;
-    http_config.port = config.server.http_port;
-    http_config.max_streams = config.server.http_max_streams;
-    http_config.heartbeat_s = config.server.http_heartbeat_s;
-    http_config.stream_timeout_s = config.server.http_stream_timeout_s;
-    http = std::make_unique<scenewatch::service::HttpServer>(
-        http_config, [view = live_view.get()](const scenewatch::service::HttpRequest& r) { return view->handle(r); },
-        [&log](LogLevel level, const std::string& message) { log(level, message); });
-    if (auto s = http->listen(); !s) {
-      log(LogLevel::kError, "live view: " + s.error().message);
-      return 1;
-    }
+};
+
+/// Starts listening for the live view (not yet serving); false when its port cannot be bound.
+bool listen_live_view(const scenewatch::service::ServerConfig& server_config, scenewatch::pipeline::WorkingMemory& memory,
+                      scenewatch::service::Server& server, StderrLog& log, LiveViewServer& live) {
+  scenewatch::service::LiveViewConfig view_config;
+  view_config.three_js = server_config.http_three_js;
+  view_config.classes = server_config.classes;
+  live.view = std::make_unique<scenewatch::service::LiveView>(memory, view_config);
+  if (auto s = live.view->check_three_js(); !s) log(LogLevel::kWarning, "live view: " + s.error().message);
+  server.set_frame_observer([view = live.view.get()](const scenewatch::Frame& frame,
+                                                     const scenewatch::pipeline::FrameResult& result) {
+    view->observe(frame, result);
+  });
+  scenewatch::service::HttpServerConfig http_config;
+  http_config.address = server_config.http_bind;
+  http_config.port = server_config.http_port;
+  http_config.max_streams = server_config.http_max_streams;
+  http_config.heartbeat_s = server_config.http_heartbeat_s;
+  http_config.stream_timeout_s = server_config.http_stream_timeout_s;
+  live.http = std::make_unique<scenewatch::service::HttpServer>(
+      http_config, [view = live.view.get()](const scenewatch::service::HttpRequest& r) { return view->handle(r); },
+      [&log](LogLevel level, const std::string& message) { log(level, message); });
+  if (auto s = live.http->listen(); !s) {
+    log(LogLevel::kError, "live view: " + s.error().message);
+    return false;
   }
+  return true;
+}
 
-  log(LogLevel::kInfo, "scenewatchd listening on " + server.endpoint() + " (max message " +
-                           std::to_string(config.server.max_message_bytes) + " bytes, " +
-                           std::to_string(config.server.data_roots.size()) + " data roots)");
-  std::cout << "listening on " << server.endpoint() << std::endl;
-  if (http) {
-    http->start();
-    log(LogLevel::kInfo, "live view (read-only) on http://" + http->endpoint() + "/");
-    std::cout << "live view on http://" << http->endpoint() << "/" << std::endl;
-  }
-
-  server.run();
-  // No frame is processed any more: the live view's streams can close.
-  if (http) http->stop();
-
+/// Saves the model at exit; the process's exit code.
+int save_at_exit(const scenewatch::pipeline::WorkingMemory& memory, const scenewatch::service::ServerConfig& server,
+                 StderrLog& log) {
   int rc = 0;
+  const std::filesystem::path& model = server.model_dir;
   if (!model.empty()) {
-    if (auto s = scenewatch::service::save_model(memory, model, config.server.keep_snapshots); s) {
+    if (auto s = scenewatch::service::save_model(memory, model, server.keep_snapshots); s) {
       log(LogLevel::kInfo, "saved the model to " + model.string());
     } else {
       log(LogLevel::kError, "cannot save the model to " + model.string() + ": " + s.error().message);
@@ -290,4 +292,55 @@ int main(int argc, char** argv) {
   }
   log(LogLevel::kInfo, "stopped");
   return rc;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  scenewatch::keep_frame_buffers_in_heap();
+  Options options;
+  if (auto rc = parse_options(argc, argv, options)) return *rc;
+  StderrLog log(log_level_named(options.log_level));
+  std::signal(SIGPIPE, SIG_IGN);
+
+  auto config = load_config(options, log);
+  if (!config) return 1;
+  // The live view is on when --http is given (0: a free port) or server.http_port is set.
+  const bool live_view_on = options.http_port.has_value() || config->server.http_port != 0;
+  if (!read_access_token(config->server, log)) return 1;
+  raise_open_file_limit(config->server, log);
+
+  scenewatch::pipeline::WorkingMemory memory(config->pipeline);
+  const std::filesystem::path& model = config->server.model_dir;
+  std::optional<scenewatch::service::ModelDirLock> model_lock;  // held until this process ends
+  if (!model.empty()) {
+    if (!lock_model_dir(model, model_lock, log) || !load_model(memory, model, log)) return 1;
+  } else {
+    log(LogLevel::kInfo, "no model directory configured: the model is not persisted");
+  }
+  if (!open_classes(*config, log)) return 1;
+
+  scenewatch::service::Server server(config->server, memory,
+                                     [&log](LogLevel level, const std::string& message) { log(level, message); });
+  if (auto s = server.listen(); !s) {
+    log(LogLevel::kError, s.error().message);
+    return 1;
+  }
+  LiveViewServer live;
+  if (live_view_on && !listen_live_view(config->server, memory, server, log, live)) return 1;
+
+  log(LogLevel::kInfo, "scenewatchd listening on " + server.endpoint() + " (max message " +
+                           std::to_string(config->server.max_message_bytes) + " bytes, " +
+                           std::to_string(config->server.data_roots.size()) + " data roots)");
+  std::cout << "listening on " << server.endpoint() << std::endl;
+  if (live.http) {
+    live.http->start();
+    log(LogLevel::kInfo, "live view (read-only) on http://" + live.http->endpoint() + "/");
+    std::cout << "live view on http://" << live.http->endpoint() << "/" << std::endl;
+  }
+
+  server.run();
+  // No frame is processed any more: the live view's streams can close.
+  if (live.http) live.http->stop();
+  return save_at_exit(memory, config->server, log);
 }

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "scenewatch/core/yaml_value.h"
 
@@ -46,6 +47,29 @@ TEST(YamlValue, RangeChecksNameTheKey) {
   EXPECT_EQ(message_of(check_in(1.5, 0, 1, "opacity")), "opacity: must be in 0..1");
   EXPECT_EQ(message_of(check_in(9000, 1, 8192, "intrinsics.width")), "intrinsics.width: must be in 1..8192");
   EXPECT_EQ(message_of(key_error("x.y", "unknown key")), "x.y: unknown key");
+}
+
+TEST(YamlValue, AnyValueAsYamlCppReadsIt) {
+  EXPECT_EQ(*read_value<double>(YAML::Load("0.25"), "a.b"), 0.25);
+  EXPECT_TRUE(std::isinf(*read_value<double>(YAML::Load(".inf"), "a.b")));  // as<double> takes it
+  EXPECT_EQ(*read_value<unsigned>(YAML::Load("7"), "a.b"), 7u);
+  EXPECT_EQ((*read_value<std::vector<double>>(YAML::Load("[0, 0, 1]"), "a.b")).size(), 3u);
+  EXPECT_EQ(message_of(read_value<double>(YAML::Load("fast"), "a.b")), "a.b: cannot read value 'fast'");
+  EXPECT_EQ(message_of(read_value<int>(YAML::Load("1.5"), "a.b")), "a.b: cannot read value '1.5'");
+  EXPECT_EQ(message_of(read_value<bool>(YAML::Load("maybe"), "a.b")), "a.b: cannot read value 'maybe'");
+  EXPECT_EQ(message_of(read_value<double>(YAML::Load("[1, 2]"), "a.b")), "a.b: cannot read value '[1, 2]'");
+}
+
+TEST(YamlValue, KeysArePlainNames) {
+  const YAML::Node map = YAML::Load("{plain: 1, [a, b]: 2}");
+  std::vector<std::string> got;
+  for (const auto& kv : map) {
+    const auto key = read_key(kv.first, "section");
+    got.push_back(key ? *key : key.error().message);
+  }
+  ASSERT_EQ(got.size(), 2u);
+  EXPECT_EQ(got[0], "plain");
+  EXPECT_EQ(got[1], "section: a key must be a plain name, got '[a, b]'");
 }
 
 }  // namespace

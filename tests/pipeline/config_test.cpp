@@ -74,6 +74,23 @@ TEST_F(ConfigTest, ErrorsNameTheKey) {
   EXPECT_NE(missing.error().message.find("absent.yaml"), std::string::npos);
 }
 
+// The whole text of each kind of message the reader writes, as users have seen it; moving the
+// reader onto the shared YAML helper (yaml_value.h) kept every word.
+TEST_F(ConfigTest, MessagesKeepTheirWords) {
+  const std::string file = "'" + (dir_ / "c.yaml").string() + "'";
+  EXPECT_EQ(error_of("background:\n  resolution: 0.05\n"), "background.resolution: unknown key");
+  EXPECT_EQ(error_of("background:\n  resolution_m: fast\n"), "background.resolution_m: cannot read value 'fast'");
+  EXPECT_EQ(error_of("tracking:\n  confirm_frames: [1, 2]\n"), "tracking.confirm_frames: cannot read value '[1, 2]'");
+  EXPECT_EQ(error_of("change:\n  enabled: maybe\n"), "change.enabled: cannot read value 'maybe'");
+  EXPECT_EQ(error_of("tracking: 5\n"), "tracking: must be a mapping of keys to values");
+  EXPECT_EQ(error_of("segmentation:\n  up_vector: [0, 1]\n"), "segmentation.up_vector: must be [x, y, z] or null");
+  EXPECT_EQ(error_of("localization:\n  mode: fly\n"),
+            "localization.mode: localization mode 'fly': expected given, refine or track");
+  EXPECT_EQ(error_of("background:\n  ? {x: 1}\n  : 2\n"), "background: a key must be a plain name, got '{x: 1}'");
+  EXPECT_EQ(error_of("? [a, b]\n: 1\n"), file + ": a key must be a plain name, got '[a, b]'");
+  EXPECT_EQ(error_of("segmentaton:\n  seed: 1\n"), file + ": unknown section 'segmentaton'");
+}
+
 TEST_F(ConfigTest, ShippedConfigIsValid) {
   const fs::path shipped = test::source_dir() / "config/scenewatchd.yaml";
   if (!fs::exists(shipped)) GTEST_SKIP() << "no shipped config yet";

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <tuple>
 
 namespace scenewatch::change {
 
@@ -15,7 +16,18 @@ constexpr std::size_t kMaxZones = 256;
 std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeCluster>& clusters,
                                                     std::vector<ChangeCluster>* pending,
                                                     std::vector<ChangeCluster>* absorbed, std::uint32_t camera) {
-  const int k = config_.persistence_frames;
+  std::vector<char> matched = match(clusters, absorbed, camera);
+  drop_missing(matched);
+  std::vector<char> done(candidates_.size(), 0);
+  std::vector<ObjectChange> out = pair_moves(done);
+  fire_singles(done, out, absorbed);
+  remember_zones(out);
+  keep_unfired(done, matched, pending);
+  return out;
+}
+
+std::vector<char> PersistenceFilter::match(const std::vector<ChangeCluster>& clusters,
+                                           std::vector<ChangeCluster>* absorbed, std::uint32_t camera) {
   std::vector<char> matched(candidates_.size(), 0);
   for (const auto& c : clusters) {
     bool in_zone = false;
@@ -48,20 +60,26 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
   for (std::size_t i = 0; i < candidates_.size(); ++i) {
     if (!matched[i] && candidates_[i].camera == camera) ++candidates_[i].misses;
   }
+  return matched;
+}
+
+void PersistenceFilter::drop_missing(std::vector<char>& matched) {
   // A candidate not seen for k frames in a row was noise (or left the view before it could be
   // confirmed).
   std::vector<Candidate> kept;
   std::vector<char> kept_matched;
   for (std::size_t i = 0; i < candidates_.size(); ++i) {
-    if (candidates_[i].misses >= k) continue;
+    if (candidates_[i].misses >= config_.persistence_frames) continue;
     kept.push_back(std::move(candidates_[i]));
     kept_matched.push_back(matched[i]);
   }
   candidates_.swap(kept);
   matched.swap(kept_matched);
+}
 
-  auto ready = [&](const Candidate& c) { return c.hits >= k; };
-  std::vector<char> done(candidates_.size(), 0);
+bool PersistenceFilter::ready(const Candidate& c) const { return c.hits >= config_.persistence_frames; }
+
+std::vector<ObjectChange> PersistenceFilter::pair_moves(std::vector<char>& done) const {
   std::vector<ObjectChange> out;
   // Moves: a ready removed candidate with the most similar ready added one.
   std::vector<std::tuple<double, int, int>> pairs;
@@ -84,18 +102,27 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
     c.similarity = -neg;
     out.push_back(std::move(c));
   }
+  return out;
+}
+
+bool PersistenceFilter::partner_coming(std::size_t i, const std::vector<char>& done) const {
+  const Candidate& c = candidates_[i];
+  for (std::size_t j = 0; j < candidates_.size(); ++j) {
+    if (j == i || done[j] || ready(candidates_[j]) || candidates_[j].latest.kind == c.latest.kind) continue;
+    const auto& removed = c.latest.kind == ChangeKind::kRemoved ? c.latest : candidates_[j].latest;
+    const auto& added = c.latest.kind == ChangeKind::kAdded ? c.latest : candidates_[j].latest;
+    if (move_similarity(removed, added, config_) > 0) return true;
+  }
+  return false;
+}
+
+void PersistenceFilter::fire_singles(std::vector<char>& done, std::vector<ObjectChange>& out,
+                                     std::vector<ChangeCluster>* absorbed) {
   // Singles; one that may still become half of a move waits up to k frames for its partner.
   for (std::size_t i = 0; i < candidates_.size(); ++i) {
     Candidate& c = candidates_[i];
     if (done[i] || !ready(c)) continue;
-    bool partner_coming = false;
-    for (std::size_t j = 0; j < candidates_.size() && !partner_coming; ++j) {
-      if (j == i || done[j] || ready(candidates_[j]) || candidates_[j].latest.kind == c.latest.kind) continue;
-      const auto& removed = c.latest.kind == ChangeKind::kRemoved ? c.latest : candidates_[j].latest;
-      const auto& added = c.latest.kind == ChangeKind::kAdded ? c.latest : candidates_[j].latest;
-      partner_coming = move_similarity(removed, added, config_) > 0;
-    }
-    if (partner_coming && c.waited < k) {
+    if (partner_coming(i, done) && c.waited < config_.persistence_frames) {
       ++c.waited;
       continue;
     }
@@ -122,14 +149,21 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
     }
     out.push_back(std::move(change));
   }
+}
+
+void PersistenceFilter::remember_zones(const std::vector<ObjectChange>& fired) {
   auto add_zone = [&](const ChangeCluster& c) {
     zones_.push_back(Zone{c.kind, c.box_world.grown(kZoneMargin_m)});
   };
-  for (const auto& c : out) {
+  for (const auto& c : fired) {
     if (c.before) add_zone(*c.before);
     if (c.after) add_zone(*c.after);
   }
   if (zones_.size() > kMaxZones) zones_.erase(zones_.begin(), zones_.end() - kMaxZones);
+}
+
+void PersistenceFilter::keep_unfired(const std::vector<char>& done, const std::vector<char>& matched,
+                                     std::vector<ChangeCluster>* pending) {
   std::vector<Candidate> rest;
   for (std::size_t i = 0; i < candidates_.size(); ++i) {
     if (done[i]) continue;
@@ -137,7 +171,6 @@ std::vector<ObjectChange> PersistenceFilter::update(const std::vector<ChangeClus
     rest.push_back(std::move(candidates_[i]));
   }
   candidates_.swap(rest);
-  return out;
 }
 
 void PersistenceFilter::forget_camera(std::uint32_t camera) {

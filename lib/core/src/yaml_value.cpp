@@ -33,6 +33,15 @@ Result<std::string> read_string(const YAML::Node& node, const std::string& key_p
   return node.as<std::string>();
 }
 
+Result<std::string> read_key(const YAML::Node& key, const std::string& where) {
+  if (key.IsScalar()) return key.Scalar();
+  // Converting such a key to a string threw out of the config reader and ended the daemon (found
+  // by fuzz_config); write it back as flow YAML for the message instead.
+  YAML::Emitter flow;
+  flow << YAML::Flow << key;
+  return key_error(where, "a key must be a plain name, got '" + std::string(flow.c_str()) + "'");
+}
+
 Status check_positive(double v, const std::string& key_path) {
   if (!(v > 0)) return key_error(key_path, "must be positive");
   return {};

@@ -2,33 +2,24 @@
 
 #include <system_error>
 
+#include "scenewatch/core/yaml_value.h"
+
 namespace scenewatch::pipeline {
 namespace fs = std::filesystem;
-
-namespace {
-/// A mapping key as text. YAML allows any node as a key (`? [a, b]: 1`); converting such a key
-/// to a string threw out of the config reader and ended the daemon (found by fuzz_config).
-Result<std::string> key_name(const YAML::Node& key, const std::string& where) {
-  if (key.IsScalar()) return key.Scalar();
-  YAML::Emitter flow;
-  flow << YAML::Flow << key;
-  return invalid_argument(where + ": a key must be a plain name, got '" + std::string(flow.c_str()) + "'");
-}
-}  // namespace
 
 YamlSection::YamlSection(const YAML::Node& node, std::string name) : node_(node), name_(std::move(name)) {}
 
 Status YamlSection::check_is_map() const {
   if (!node_.IsDefined() || node_.IsNull() || node_.IsMap()) return {};
-  return invalid_argument(name_ + ": must be a mapping of keys to values");
+  return yaml::key_error(name_, "must be a mapping of keys to values");
 }
 
 Status YamlSection::finish() const {
   if (!node_.IsDefined() || node_.IsNull() || !node_.IsMap()) return {};
   for (const auto& kv : node_) {
-    auto key = key_name(kv.first, name_);
+    auto key = yaml::read_key(kv.first, name_);
     if (!key) return key.error();
-    if (seen_.count(*key) == 0) return invalid_argument(path(*key) + ": unknown key");
+    if (seen_.count(*key) == 0) return yaml::key_error(path(*key), "unknown key");
   }
   return {};
 }
@@ -104,7 +95,7 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
       !st)
     return st;
   auto parsed = localization::parse_mode(mode);
-  if (!parsed) return invalid_argument("localization.mode: " + parsed.error().message);
+  if (!parsed) return yaml::key_error(s.path("mode"), parsed.error().message);
   l.mode = *parsed;
   return s.finish();
 }
@@ -156,7 +147,7 @@ Status read_segmentation(const YAML::Node& node, Config& c) {
       !st)
     return st;
   if (!up.empty()) {
-    if (up.size() != 3) return invalid_argument("segmentation.up_vector: must be [x, y, z] or null");
+    if (up.size() != 3) return yaml::key_error(s.path("up_vector"), "must be [x, y, z] or null");
     g.up = Eigen::Vector3d(up[0], up[1], up[2]);
   }
   return s.finish();
@@ -342,7 +333,7 @@ Result<YAML::Node> load_yaml_file(const fs::path& path, const std::vector<std::s
   if (root.IsNull()) return root;  // an empty file means all defaults
   if (!root.IsMap()) return invalid_argument("'" + path.string() + "': the top level must be a mapping of sections");
   for (const auto& kv : root) {
-    auto key = key_name(kv.first, "'" + path.string() + "'");
+    auto key = yaml::read_key(kv.first, "'" + path.string() + "'");
     if (!key) return key.error();
     if (std::find(known_sections.begin(), known_sections.end(), *key) == known_sections.end()) {
       return invalid_argument("'" + path.string() + "': unknown section '" + *key + "'");

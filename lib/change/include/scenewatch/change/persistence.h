@@ -44,6 +44,25 @@ class PersistenceFilter {
     ChangeKind kind;
     Aabb box_world;  ///< the confirmed change's box, grown by a margin
   };
+  // The steps of update(), in order. `matched` and `done` run parallel to candidates_.
+  /// Matches each cluster to a candidate of its camera and kind (or starts one; absorbs those in a
+  /// zone) and counts a miss for this camera's others. Returns which candidates were matched.
+  std::vector<char> match(const std::vector<ChangeCluster>& clusters, std::vector<ChangeCluster>* absorbed,
+                          std::uint32_t camera);
+  /// Drops the candidates missed persistence_frames times in a row, and their `matched` entries.
+  void drop_missing(std::vector<char>& matched);
+  bool ready(const Candidate& c) const;
+  /// The moves among the ready candidates, most similar pairs first; marks their halves done.
+  std::vector<ObjectChange> pair_moves(std::vector<char>& done) const;
+  /// Whether an unready candidate of the other kind could still pair with candidate i.
+  bool partner_coming(std::size_t i, const std::vector<char>& done) const;
+  /// Appends the ready candidates that fire alone to `out` (or absorbs them as parts of one that did).
+  void fire_singles(std::vector<char>& done, std::vector<ObjectChange>& out, std::vector<ChangeCluster>* absorbed);
+  /// Keeps the boxes of the changes that fired as zones (bounded).
+  void remember_zones(const std::vector<ObjectChange>& fired);
+  /// Drops the candidates that fired; reports this frame's matched rest as pending.
+  void keep_unfired(const std::vector<char>& done, const std::vector<char>& matched, std::vector<ChangeCluster>* pending);
+
   Config config_;
   std::vector<Candidate> candidates_;
   std::vector<Zone> zones_;  ///< confirmed changes, most recent last (bounded)

@@ -1,8 +1,8 @@
 #pragma once
 /// Typed values of a YAML file read into structs, with the checks every hand-written reader makes
-/// (the simulator's scenarios, the ontology's classes): each error is "<key path>: <what>", the
-/// key's dotted path first ("objects[0].radius_m: expected a number"). yaml-cpp is linked by the
-/// modules that read YAML; include this only from them.
+/// (the simulator's scenarios, the ontology's classes, the pipeline's config): each error is
+/// "<key path>: <what>", the key's dotted path first ("objects[0].radius_m: expected a number").
+/// yaml-cpp is linked by the modules that read YAML; include this only from them.
 #include <yaml-cpp/yaml.h>
 
 #include <string>
@@ -25,6 +25,22 @@ Result<int> read_integer(const YAML::Node& node, const std::string& key_path);
 Result<bool> read_bool(const YAML::Node& node, const std::string& key_path);
 /// A scalar as text ("expected a string").
 Result<std::string> read_string(const YAML::Node& node, const std::string& key_path);
+
+/// Any type yaml-cpp converts to (numbers, booleans, strings, lists of them), accepted exactly as
+/// YAML::Node::as<T> accepts it; "cannot read value '<the value as YAML>'" otherwise. The
+/// pipeline's config reader reads every key this way (its users have always seen these words).
+template <typename T>
+Result<T> read_value(const YAML::Node& node, const std::string& key_path) {
+  try {
+    return node.as<T>();
+  } catch (const YAML::Exception&) {
+    return key_error(key_path, "cannot read value '" + YAML::Dump(node) + "'");
+  }
+}
+
+/// A mapping key as text. YAML allows any node as a key (`? [a, b]: 1`), which is an error at
+/// `where`: "<where>: a key must be a plain name, got '[a, b]'".
+Result<std::string> read_key(const YAML::Node& key, const std::string& where);
 
 /// v > 0 ("must be positive").
 Status check_positive(double v, const std::string& key_path);

@@ -7,9 +7,11 @@
 #include <functional>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "scenewatch/core/result.h"
+#include "scenewatch/core/yaml_value.h"
 #include "scenewatch/pipeline/config.h"
 
 namespace scenewatch::pipeline {
@@ -28,11 +30,9 @@ class YamlSection {
     seen_.insert(key);
     const YAML::Node value = node_[key];
     if (!value.IsDefined() || value.IsNull()) return {};
-    try {
-      out = value.as<T>();
-    } catch (const YAML::Exception&) {
-      return invalid_argument(path(key) + ": cannot read value '" + YAML::Dump(value) + "'");
-    }
+    auto read = yaml::read_value<T>(value, path(key));
+    if (!read) return read.error();
+    out = std::move(*read);
     return {};
   }
 
