@@ -6,6 +6,8 @@
 #include <cstdlib>
 #include <iostream>
 #include <mutex>
+#include <optional>
+#include <thread>
 
 #include "bridge_config.h"
 #include "daemon_link.h"
@@ -38,14 +40,8 @@ constexpr const char* kDescription =
     "Prints 'ready' on stdout once its DDS entities exist, and a stats line on exit (SIGINT, SIGTERM).\n"
     "Exit codes: 0 stopped by a signal, 1 error (message on stderr), 2 usage.";
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  BridgeConfig config;
-  if (const char* domain = std::getenv("ROS_DOMAIN_ID"); domain != nullptr && *domain != '\0') {
-    config.domain_id = static_cast<std::uint32_t>(std::strtoul(domain, nullptr, 10));
-  }
-  CLI::App app{kDescription};
+/// The command line: every flag writes into `config`; --without-tf into `without_tf`.
+void add_options(CLI::App& app, BridgeConfig& config, std::string& without_tf) {
   app.set_version_flag("--version", "scenewatch-ros " SCENEWATCH_VERSION);
   app.add_option("--domain", config.domain_id, "DDS domain = ROS_DOMAIN_ID (default: $ROS_DOMAIN_ID, else 0)")
       ->check(CLI::Range(0, 232))
@@ -57,7 +53,7 @@ int main(int argc, char** argv) {
   app.add_option("--info-topic", config.info_topic, "sensor_msgs/CameraInfo of the depth images (K and size are used)")
       ->capture_default_str();
   // A duration in seconds, >= 0 (> 0 when `positive`).
-  auto seconds_option = [&](const char* flag, double& value, const char* help, bool positive = false) {
+  auto seconds_option = [&app](const char* flag, double& value, const char* help, bool positive = false) {
     app.add_option(flag, value, help)->check(positive ? CLI::Validator(CLI::PositiveNumber) : CLI::Validator(CLI::NonNegativeNumber))->capture_default_str();
   };
   app.add_option("--world-frame", config.world_frame, "TF frame of the daemon's world: poses are T_world_camera")->capture_default_str();
@@ -72,7 +68,6 @@ int main(int argc, char** argv) {
                  "seconds between a colour and a depth stamp that still make one frame");
   seconds_option("--tf-wait", config.tf_wait_s,
                  "seconds a frame waits for its TF to arrive before it is dropped");
-  std::string without_tf = "drop";
   app.add_option("--without-tf", without_tf,
                  "a frame with no TF in time: 'drop' it (counted, logged), or 'track': send it without a pose for the daemon's "
                  "tracking to place (localization TRACK; the daemon must have a memory to track against)")
@@ -93,29 +88,69 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   seconds_option("--map-period", config.map_period_s,
                  "seconds between two octomap messages at most (the last frame's map is sent once the stream pauses)");
-  app.add_flag("--no-markers", [&](std::int64_t) { config.markers = false; },
+  app.add_flag("--no-markers", [&config](std::int64_t) { config.markers = false; },
                "publish no MarkerArray (saves a GetHands call per frame)");
   app.add_option("--marker-events", config.marker_events, "the newest events drawn as markers (yellow boxes)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   seconds_option("--stats-period", config.stats_period_s,
                  "seconds between two stats lines on stdout (0: only at exit)");
-  CLI11_PARSE(app, argc, argv);
-  config.without_tf = without_tf == "track" ? WithoutTf::kTrack : WithoutTf::kDrop;
+}
+
+/// What CLI11 cannot check alone; the usage message, or none.
+std::optional<std::string> usage_error(const BridgeConfig& config) {
   for (const auto& [flag, topic] : {std::pair<const char*, const std::string*>{"--depth-topic", &config.depth_topic},
                                     {"--info-topic", &config.info_topic}, {"--color-topic", &config.color_topic}}) {
     if (topic->empty() && topic == &config.color_topic) continue;  // depth only
-    if (auto name = dds_topic_name(*topic); !name) {
-      std::cerr << "scenewatch-ros: " << flag << ": " << name.error().message << "\n";
-      return 2;
-    }
+    if (auto name = dds_topic_name(*topic); !name) return std::string(flag) + ": " + name.error().message;
   }
-  if (config.world_frame.empty()) {
-    std::cerr << "scenewatch-ros: --world-frame must name a TF frame\n";
-    return 2;
-  }
+  if (config.world_frame.empty()) return std::string("--world-frame must name a TF frame");
   if (config.publish_odom_tf && (config.odom_frame.empty() || config.odom_frame == config.world_frame)) {
-    std::cerr << "scenewatch-ros: --publish-odom-tf needs an --odom-frame other than --world-frame\n";
+    return std::string("--publish-odom-tf needs an --odom-frame other than --world-frame");
+  }
+  return std::nullopt;
+}
+
+/// Where the daemon's answers go: the DDS writers (markers and /tf only when asked).
+Outputs outputs_to(DdsNode& dds, const BridgeConfig& config, std::function<void(const std::string&)> log) {
+  Outputs outputs;
+  outputs.events = [&dds](const std::vector<scenewatch::proto::Event>& events) { dds.write_events(events); };
+  outputs.objects = [&dds](const scenewatch::proto::ObjectsReply& objects, double stamp_s) { dds.write_objects(objects, stamp_s); };
+  outputs.map = [&dds](const scenewatch::proto::MapReply& map, double stamp_s) { dds.write_map(map, stamp_s); };
+  if (config.publish_odom_tf) outputs.odom = [&dds](const scenewatch::proto::Pose& T, double stamp_s) { dds.write_odom(T, stamp_s); };
+  if (config.markers) outputs.markers = [&dds](const MarkerScene& scene, double stamp_s) { dds.write_markers(scene, stamp_s); };
+  outputs.log = std::move(log);
+  return outputs;
+}
+
+/// Prints the stats line every `period_s` seconds until the stop signal (none when period_s <= 0).
+std::thread stats_printer(BridgeStats& stats, double period_s) {
+  if (period_s <= 0) return {};
+  return std::thread([&stats, period_s] {
+    auto next = Clock::now() + std::chrono::duration<double>(period_s);
+    while (!g_stop) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+      if (Clock::now() < next) continue;
+      std::cout << stats.line() << std::endl;
+      next += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(period_s));
+    }
+  });
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  BridgeConfig config;
+  if (const char* domain = std::getenv("ROS_DOMAIN_ID"); domain != nullptr && *domain != '\0') {
+    config.domain_id = static_cast<std::uint32_t>(std::strtoul(domain, nullptr, 10));
+  }
+  CLI::App app{kDescription};
+  std::string without_tf = "drop";
+  add_options(app, config, without_tf);
+  CLI11_PARSE(app, argc, argv);
+  config.without_tf = without_tf == "track" ? WithoutTf::kTrack : WithoutTf::kDrop;
+  if (auto usage = usage_error(config)) {
+    std::cerr << "scenewatch-ros: " << *usage << "\n";
     return 2;
   }
   std::signal(SIGINT, on_signal);
@@ -134,30 +169,13 @@ int main(int argc, char** argv) {
     return 1;
   }
   DdsNode& dds = **node;
-  Outputs outputs;
-  outputs.events = [&](const std::vector<scenewatch::proto::Event>& events) { dds.write_events(events); };
-  outputs.objects = [&](const scenewatch::proto::ObjectsReply& objects, double stamp_s) { dds.write_objects(objects, stamp_s); };
-  outputs.map = [&](const scenewatch::proto::MapReply& map, double stamp_s) { dds.write_map(map, stamp_s); };
-  if (config.publish_odom_tf) outputs.odom = [&](const scenewatch::proto::Pose& T, double stamp_s) { dds.write_odom(T, stamp_s); };
-  if (config.markers) outputs.markers = [&](const MarkerScene& scene, double stamp_s) { dds.write_markers(scene, stamp_s); };
-  outputs.log = log;
+  Outputs outputs = outputs_to(dds, config, log);
   DaemonLink link(config, stats, outputs);
   FrameAssembler assembler(config, stats, [&](FrameJob job) { link.push(std::move(job)); }, log);
   link.start();
   std::cout << "ready" << std::endl;
 
-  std::thread stats_thread;
-  if (config.stats_period_s > 0) {
-    stats_thread = std::thread([&] {
-      auto next = Clock::now() + std::chrono::duration<double>(config.stats_period_s);
-      while (!g_stop) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        if (Clock::now() < next) continue;
-        std::cout << stats.line() << std::endl;
-        next += std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(config.stats_period_s));
-      }
-    });
-  }
+  std::thread stats_thread = stats_printer(stats, config.stats_period_s);
   dds.run(assembler, g_stop);
   link.stop();
   if (stats_thread.joinable()) stats_thread.join();
