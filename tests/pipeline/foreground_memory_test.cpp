@@ -32,6 +32,8 @@ TEST(ForegroundMemoryTest, LearntDofsAndTheModelSurviveARestart) {
   };
   const auto before = foreground_of(*memory.snapshot());
   ASSERT_EQ(before.size(), 1u) << "the cup, promoted";
+  // Stats count the object list a planner gets (GetObjects): the promoted cup with the rest.
+  EXPECT_EQ(memory.stats().tracked_objects, memory.snapshot()->objects.size());
   const auto& handlings = before[0].foreground->handlings;
   for (const auto& h : handlings) std::printf("handling %.2f s .. %.2f s\n", h.start_s, h.end_s);
   ASSERT_GE(handlings.size(), 1u);
@@ -43,6 +45,7 @@ TEST(ForegroundMemoryTest, LearntDofsAndTheModelSurviveARestart) {
   ASSERT_TRUE(restarted.load(dir.path()).ok());
   const auto after = foreground_of(*restarted.snapshot());
   ASSERT_EQ(after.size(), 1u);
+  EXPECT_EQ(restarted.stats().tracked_objects, restarted.snapshot()->objects.size());
   const ForegroundState& a = *after[0].foreground;
   const ForegroundState& b = *before[0].foreground;
   EXPECT_EQ(after[0].id, before[0].id);

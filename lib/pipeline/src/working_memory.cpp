@@ -202,7 +202,7 @@ Stats WorkingMemory::stats() const {
     s.points_processed = impl_->points;
     s.last_frame_ms = impl_->last_ms;
     s.mean_frame_ms = impl_->frames ? impl_->total_ms / impl_->frames : 0.0;
-    s.tracked_objects = impl_->tracker.objects().size();
+    s.tracked_objects = impl_->tracker.objects().size() + impl_->foreground.tracker().objects().size();
     s.keyframes = impl_->appearance.keyframes();
     s.mesh_triangles = impl_->appearance.triangles();
     s.appearance_memory_bytes = impl_->appearance.memory_bytes();

@@ -45,7 +45,7 @@ struct Stats {
   std::size_t map_leaf_nodes = 0, map_occupied_leaves = 0, map_memory_bytes = 0;
   double map_resolution_m = 0;
   double last_frame_ms = 0, mean_frame_ms = 0;
-  std::size_t tracked_objects = 0;
+  std::size_t tracked_objects = 0;  ///< the object list's length (snapshot().objects): background and foreground
   std::size_t keyframes = 0, mesh_triangles = 0, appearance_memory_bytes = 0;
 };
 
