@@ -168,15 +168,20 @@ TEST(ViewScorer, GivesTheReferenceWalksGainsOnTheClutterTable) {
 }
 
 TEST(ViewScorer, GivesTheReferenceWalksGainsOnAMixedGrid) {
-  // Free, unknown and occupied voxels mixed at random around the object, which sits at the grid's
+  // Free, unknown and occupied voxels, in uniform and mixed patches, around the object, which sits at the grid's
   // side so that the target box is clipped by the grid; a second scorer with a target entirely
   // outside the grid counts nothing.
   DenseGrid g = front_seen_object();
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   g.occupied.clear();
+  // Cells of 5 voxels a side (across the scorer's blocks): all free, all unknown or mixed.
+  std::vector<double> cell(16 * 16 * 16);
+  for (double& c : cell) c = u(rng);
   for (std::size_t i = 0; i < g.size(); ++i) {
-    const double x = u(rng);
+    const long x_cell = static_cast<long>(i % 80) / 5, y_cell = static_cast<long>(i / 80 % 80) / 5, z_cell = static_cast<long>(i / 6400) / 5;
+    const double c = cell[static_cast<std::size_t>((z_cell * 16 + y_cell) * 16 + x_cell)];
+    const double x = c < 0.4 ? 0.5 : c < 0.7 ? 0.1 : u(rng);
     const Occupancy s = x < 0.015 ? Occupancy::kOccupied : x < 0.2 ? Occupancy::kUnknown : Occupancy::kFree;
     if (g.center(static_cast<long>(i)).norm() > 0.2) g.state[i] = static_cast<std::uint8_t>(s);
     if (g.at(static_cast<long>(i)) == Occupancy::kOccupied) g.occupied.push_back({i, 0, static_cast<std::uint8_t>(128 + i % 127)});

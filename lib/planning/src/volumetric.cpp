@@ -17,6 +17,7 @@ using background::Occupancy;
 namespace {
 
 constexpr std::uint8_t kUnknown = static_cast<std::uint8_t>(Occupancy::kUnknown);
+constexpr std::uint8_t kFree = static_cast<std::uint8_t>(Occupancy::kFree);
 constexpr std::uint8_t kOccupied = static_cast<std::uint8_t>(Occupancy::kOccupied);
 
 double binary_entropy(double p) {
@@ -67,6 +68,24 @@ ViewScorer::ViewScorer(const DenseGrid& grid, const Aabb& target, VolumetricConf
   for (int a = 0; a < 3; ++a) span_[a] = std::max(0L, hi_[a] - lo_[a] + 1);
   reached_.assign(static_cast<std::size_t>(span_[0] * span_[1] * span_[2]), 0);
   rear_.assign(reached_.size(), 0);
+  // The uniform blocks: the states present in each (a bit per state), then the target's blocks
+  // mixed whatever their states.
+  constexpr long kSide = 1L << kBlockShift;
+  for (int a = 0; a < 3; ++a) blocks_[a] = (n[a] + kSide - 1) >> kBlockShift;
+  block_.assign(static_cast<std::size_t>(blocks_[0] * blocks_[1] * blocks_[2]), 0);
+  const std::uint8_t* voxel = grid.state.data();
+  for (long k = 0; k < n[2]; ++k)
+    for (long j = 0; j < n[1]; ++j) {
+      std::uint8_t* const row = &block_[static_cast<std::size_t>(((k >> kBlockShift) * blocks_[1] + (j >> kBlockShift)) * blocks_[0])];
+      for (long i = 0; i < n[0]; ++i, ++voxel) row[i >> kBlockShift] |= static_cast<std::uint8_t>(1u << *voxel);
+    }
+  for (std::uint8_t& b : block_) {
+    b = b == 1u << kFree ? kFreeBlock : b == 1u << kUnknown ? kUnknownBlock : kMixedBlock;
+  }
+  for (long k = lo_[2] >> kBlockShift; k <= hi_[2] >> kBlockShift; ++k)
+    for (long j = lo_[1] >> kBlockShift; j <= hi_[1] >> kBlockShift; ++j)
+      for (long i = lo_[0] >> kBlockShift; i <= hi_[0] >> kBlockShift; ++i)
+        block_[static_cast<std::size_t>((k * blocks_[1] + j) * blocks_[0] + i)] = kMixedBlock;
   for (long k = lo_[2]; k <= hi_[2]; ++k)
     for (long j = lo_[1]; j <= hi_[1]; ++j)
       for (long i = lo_[0]; i <= hi_[0]; ++i) {
@@ -196,6 +215,50 @@ inline int nearest_axis(const double t[3]) {
 
 }  // namespace
 
+// The voxel-by-voxel walk crosses the boundaries of the three axes in the order of (t_next, the
+// later axis first on a tie), and each axis's crossings come at t_next, t_next + t_delta, ... added
+// one at a time: the walk is a merge of three sorted lists. Through a block where no voxel counts,
+// (all free or all unknown, outside the target: no stop, no count, at most the visibility halved
+// per voxel) only the crossing that leaves the block matters, and how many crossings of the other axes come
+// before it. These are found from the same sums in the same order, so the state past the block is
+// bit for bit the walk's, and the walk goes on from there exactly as the reference would.
+bool ViewScorer::cross_block(Traversal& r, double t_exit, long& walked) const {
+  constexpr long kSide = 1L << kBlockShift;
+  const long n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  double crossing[3][kSide];  // crossing[a][c]: when axis a's boundary c + 1 is crossed, c + 1 < leave[a]
+  long leave[3] = {0, 0, 0};  // the crossing of axis a that leaves the block (1-based)
+  double t_leave[3];
+  for (int a = 0; a < 3; ++a) {
+    t_leave[a] = std::numeric_limits<double>::infinity();
+    if (r.step[a] == 0) continue;
+    const long block_lo = (r.ijk[a] >> kBlockShift) << kBlockShift;
+    const long face = r.step[a] > 0 ? std::min(block_lo + kSide, n[a]) - 1 : block_lo;
+    leave[a] = (face - r.ijk[a]) * r.step[a] + 1;
+    double t = r.t_next[a];
+    for (long c = 0; c + 1 < leave[a]; ++c) {
+      crossing[a][c] = t;
+      t += r.t_delta[a];
+    }
+    t_leave[a] = t;
+  }
+  const int e = nearest_axis(t_leave);
+  if (t_leave[e] > t_exit) return false;
+  walked = leave[e];  // the voxel the block was entered by, then one per crossing in it
+  for (int a = 0; a < 3; ++a) {
+    if (a == e || r.step[a] == 0) continue;
+    long c = 0;  // crossings of axis a before the one that leaves the block
+    while (c + 1 < leave[a] && (crossing[a][c] < t_leave[e] || (crossing[a][c] == t_leave[e] && a > e))) ++c;
+    walked += c;
+    r.ijk[a] += c * r.step[a];
+    r.t_next[a] = c + 1 < leave[a] ? crossing[a][c] : t_leave[a];
+  }
+  r.ijk[e] += leave[e] * r.step[e];
+  if (r.ijk[e] < 0 || r.ijk[e] >= n[e]) return false;
+  r.t_next[e] = t_leave[e] + r.t_delta[e];
+  r.index = r.ijk[0] + r.ijk[1] * grid_.nx + r.ijk[2] * static_cast<long>(grid_.nx) * grid_.ny;
+  return true;
+}
+
 // The reference walk's result in three phases. The box of target voxels is convex in index
 // space and each index moves one way along a ray, so a ray is in the target over one stretch.
 // Before it, no voxel is in the target: only an occupied voxel (the ray stops, nothing counted,
@@ -216,26 +279,42 @@ void ViewScorer::walk_ray(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, 
   long* const ijk = r.ijk;
   // Crosses the nearest boundary; false when the ray ends there (t_exit or the grid's side).
   int a = 0;
+  double tx = r.t_next[0], ty = r.t_next[1], tz = r.t_next[2];
   const auto advance = [&] {
-    a = nearest_axis(r.t_next);
-    if (r.t_next[a] > t_exit) return false;
+    const bool x_before_y = tx < ty;
+    const double t_xy = x_before_y ? tx : ty;
+    const bool z = !(t_xy < tz);
+    a = z ? 2 : (x_before_y ? 0 : 1);
+    if ((z ? tz : t_xy) > t_exit) return false;
     ijk[a] += r.step[a];
     if (ijk[a] < 0 || ijk[a] >= n[a]) return false;
     r.index += r.step[a] * stride[a];
-    r.t_next[a] += r.t_delta[a];
+    tx += a == 0 ? r.t_delta[0] : 0.0;
+    ty += a == 1 ? r.t_delta[1] : 0.0;
+    tz += a == 2 ? r.t_delta[2] : 0.0;
     return true;
   };
   const std::uint8_t* const state = grid_.state.data();
 
-  // Before the target.
-  double visibility = 1.0;
+  // Before the target. The visibility is 0.5^(unknown voxels walked): a power of two, halved
+  // exactly (to 0 past 2^-1074 as ldexp rounds too), so a count of them gives it.
+  long unknown_walked = 0;
   while (!(in_range(ijk, 0) && in_range(ijk, 1) && in_range(ijk, 2))) {
+    if (const std::uint8_t b = block_of(ijk); b != kMixedBlock) {
+      long walked = 0;
+      r.t_next[0] = tx, r.t_next[1] = ty, r.t_next[2] = tz;
+      if (!cross_block(r, t_exit, walked)) return;
+      tx = r.t_next[0], ty = r.t_next[1], tz = r.t_next[2];
+      if (b == kUnknownBlock) unknown_walked += walked;
+      continue;
+    }
     ++out.steps;
     const std::uint8_t s = state[r.index];
     if (s == kOccupied) return;
-    if (s == kUnknown) visibility *= 0.5;  // an unknown voxel is occupied with probability 0.5
+    if (s == kUnknown) ++unknown_walked;  // an unknown voxel is occupied with probability 0.5
     if (!advance()) return;
   }
+  const double visibility = std::ldexp(1.0, -static_cast<int>(std::min(unknown_walked, 2000L)));
 
   // In the target.
   long mark = mark_of(ijk);

@@ -76,6 +76,15 @@ class ViewScorer {
                                     RaySums&);
   ViewGain score_with(const Pose& T_world_camera, const Intrinsics& K, Measure measure, Walk walk);
   Traversal start(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_enter) const;
+  /// Crosses the uniform block holding r.ijk (see block_) in one go, to the first voxel past it,
+  /// with the traversal state the voxel-by-voxel walk would have there; the voxels walked in the
+  /// block into `walked`. False when the ray ends in the block or leaves the grid.
+  bool cross_block(Traversal& r, double t_exit, long& walked) const;
+  /// The block_ entry of voxel (i, j, k).
+  std::uint8_t block_of(const long ijk[3]) const {
+    return block_[static_cast<std::size_t>(((ijk[2] >> kBlockShift) * blocks_[1] + (ijk[1] >> kBlockShift)) * blocks_[0] +
+                                           (ijk[0] >> kBlockShift))];
+  }
   /// The mark slot of target voxel (i, j, k): reached_ and rear_ cover the target box only.
   long mark_of(const long ijk[3]) const { return ((ijk[2] - lo_[2]) * span_[1] + (ijk[1] - lo_[1])) * span_[0] + ijk[0] - lo_[0]; }
   double occupied_probability(long index) const;
@@ -106,6 +115,12 @@ class ViewScorer {
   long lo_[3] = {0, 0, 0}, hi_[3] = {-1, -1, -1};  ///< the target's voxel index range, inclusive
   long span_[3] = {0, 0, 0};                        ///< hi_ - lo_ + 1, at least 0
   std::size_t target_voxels_ = 0, target_known_ = 0;
+  /// Empty-space skipping: blocks of 2^kBlockShift voxels a side (clipped by the grid), outside
+  /// the target, all free or all unknown; built once per scorer.
+  static constexpr int kBlockShift = 3;
+  static constexpr std::uint8_t kMixedBlock = 0, kFreeBlock = 1, kUnknownBlock = 2;
+  long blocks_[3] = {0, 0, 0};
+  std::vector<std::uint8_t> block_;
   std::vector<std::uint32_t> reached_, rear_;       ///< marks per target voxel (mark_of): == stamp_ when counted in this call
   std::uint32_t stamp_ = 0;
   std::vector<long> ray_unknown_;                   ///< scratch: one ray's unknown target voxels (mark slots)
