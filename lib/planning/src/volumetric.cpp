@@ -17,6 +17,7 @@ using background::Occupancy;
 namespace {
 
 constexpr std::uint8_t kUnknown = static_cast<std::uint8_t>(Occupancy::kUnknown);
+constexpr std::uint8_t kFree = static_cast<std::uint8_t>(Occupancy::kFree);
 constexpr std::uint8_t kOccupied = static_cast<std::uint8_t>(Occupancy::kOccupied);
 
 double binary_entropy(double p) {
@@ -53,7 +54,7 @@ Status validate(const VolumetricConfig& c) {
 }
 
 ViewScorer::ViewScorer(const DenseGrid& grid, const Aabb& target, VolumetricConfig config)
-    : grid_(grid), config_(config), reached_(grid.size(), 0), rear_(grid.size(), 0) {
+    : grid_(grid), config_(config) {
   const long n[3] = {grid.nx, grid.ny, grid.nz};
   for (int a = 0; a < 3; ++a) {
     // The voxels overlapping the box's inside: a face on a voxel boundary takes no extra layer.
@@ -64,6 +65,27 @@ ViewScorer::ViewScorer(const DenseGrid& grid, const Aabb& target, VolumetricConf
     hi_[0] = hi_[1] = hi_[2] = -1;
     return;
   }
+  for (int a = 0; a < 3; ++a) span_[a] = std::max(0L, hi_[a] - lo_[a] + 1);
+  reached_.assign(static_cast<std::size_t>(span_[0] * span_[1] * span_[2]), 0);
+  rear_.assign(reached_.size(), 0);
+  // The uniform blocks: the states present in each (a bit per state), then the target's blocks
+  // mixed whatever their states.
+  constexpr long kSide = 1L << kBlockShift;
+  for (int a = 0; a < 3; ++a) blocks_[a] = (n[a] + kSide - 1) >> kBlockShift;
+  block_.assign(static_cast<std::size_t>(blocks_[0] * blocks_[1] * blocks_[2]), 0);
+  const std::uint8_t* voxel = grid.state.data();
+  for (long k = 0; k < n[2]; ++k)
+    for (long j = 0; j < n[1]; ++j) {
+      std::uint8_t* const row = &block_[static_cast<std::size_t>(((k >> kBlockShift) * blocks_[1] + (j >> kBlockShift)) * blocks_[0])];
+      for (long i = 0; i < n[0]; ++i, ++voxel) row[i >> kBlockShift] |= static_cast<std::uint8_t>(1u << *voxel);
+    }
+  for (std::uint8_t& b : block_) {
+    b = b == 1u << kFree ? kFreeBlock : b == 1u << kUnknown ? kUnknownBlock : kMixedBlock;
+  }
+  for (long k = lo_[2] >> kBlockShift; k <= hi_[2] >> kBlockShift; ++k)
+    for (long j = lo_[1] >> kBlockShift; j <= hi_[1] >> kBlockShift; ++j)
+      for (long i = lo_[0] >> kBlockShift; i <= hi_[0] >> kBlockShift; ++i)
+        block_[static_cast<std::size_t>((k * blocks_[1] + j) * blocks_[0] + i)] = kMixedBlock;
   for (long k = lo_[2]; k <= hi_[2]; ++k)
     for (long j = lo_[1]; j <= hi_[1]; ++j)
       for (long i = lo_[0]; i <= hi_[0]; ++i) {
@@ -77,6 +99,51 @@ double ViewScorer::occupied_probability(long index) const {
                                    [](const DenseGrid::Surface& s, std::size_t i) { return s.index < i; });
   if (it == grid_.occupied.end() || it->index != static_cast<std::size_t>(index)) return 1.0;
   return it->probability / 255.0;
+}
+
+void ViewScorer::count_surface(long index, double visibility, RaySums& sums) const {
+  const double h = binary_entropy(occupied_probability(index));
+  sums.known_entropy += h;
+  sums.occlusion_aware += visibility * h;
+}
+
+bool ViewScorer::visit_target_voxel(long index, long mark, std::uint32_t stamp, RayState& ray, ViewGain& out, RaySums& sums) {
+  const std::uint8_t s = grid_.state[static_cast<std::size_t>(index)];
+  const bool first = reached_[mark] != stamp;
+  if (first) {
+    reached_[mark] = stamp;
+    ++out.target_reached;
+  }
+  if (s == kOccupied) {
+    if (first) count_surface(index, ray.visibility, sums);
+    if (ray.previous_unknown_target >= 0) count_rear_side(ray.previous_unknown_target, stamp, out, sums);
+    return true;
+  }
+  if (s == kUnknown) {
+    ray_unknown_.push_back(mark);
+    if (first) {
+      ++out.unknown_reached;
+      sums.unknown_entropy += 1.0;
+      sums.occlusion_aware += ray.visibility;
+    }
+    ray.previous_unknown_target = mark;
+    ray.visibility *= 0.5;  // an unknown voxel is occupied with probability 0.5
+  } else {
+    ray.previous_unknown_target = -1;
+  }
+  return false;
+}
+
+// Rear side (Isler et al.): the ray crossed unknown space and met a surface, so it approached that
+// surface from a side not yet seen.
+void ViewScorer::count_rear_side(long previous, std::uint32_t stamp, ViewGain& out, RaySums& sums) {
+  if (rear_[previous] != stamp) ++out.rear_side;
+  for (long w : ray_unknown_) {
+    if (rear_[w] == stamp || rear_[w] == stamp + 1) continue;
+    rear_[w] = stamp + 1;
+    sums.rear_entropy += 1.0;  // an unknown voxel: p = 0.5, one bit
+  }
+  rear_[previous] = stamp;
 }
 
 // Clip the ray to the grid: [t_enter, t_exit] in metres. Only target voxels count, and only the
@@ -111,88 +178,170 @@ bool ViewScorer::clip_ray(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, 
   return t_enter < t_exit;
 }
 
-void ViewScorer::walk_ray(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_enter, double t_exit,
-                          std::uint32_t stamp, ViewGain& out, RaySums& sums) {
+ViewScorer::Traversal ViewScorer::start(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_enter) const {
   const long n[3] = {grid_.nx, grid_.ny, grid_.nz};
-  const long stride[3] = {1, grid_.nx, static_cast<long>(grid_.nx) * grid_.ny};
-  long ijk[3], step[3];
-  double t_next[3], t_delta[3];
+  Traversal r;
   const Eigen::Vector3d start = g0 + (t_enter + 1e-9) * dg;
   for (int a = 0; a < 3; ++a) {
-    ijk[a] = std::clamp(static_cast<long>(std::floor(start(a))), 0L, n[a] - 1);
+    r.ijk[a] = std::clamp(static_cast<long>(std::floor(start(a))), 0L, n[a] - 1);
     if (dg(a) > 0.0) {
-      step[a] = 1;
-      t_delta[a] = 1.0 / dg(a);
-      t_next[a] = (ijk[a] + 1 - g0(a)) / dg(a);
+      r.step[a] = 1;
+      r.t_delta[a] = 1.0 / dg(a);
+      r.t_next[a] = (r.ijk[a] + 1 - g0(a)) / dg(a);
     } else if (dg(a) < 0.0) {
-      step[a] = -1;
-      t_delta[a] = -1.0 / dg(a);
-      t_next[a] = (ijk[a] - g0(a)) / dg(a);
+      r.step[a] = -1;
+      r.t_delta[a] = -1.0 / dg(a);
+      r.t_next[a] = (r.ijk[a] - g0(a)) / dg(a);
     } else {
-      step[a] = 0;
-      t_delta[a] = t_next[a] = std::numeric_limits<double>::infinity();
+      r.step[a] = 0;
+      r.t_delta[a] = r.t_next[a] = std::numeric_limits<double>::infinity();
     }
   }
-  long index = ijk[0] * stride[0] + ijk[1] * stride[1] + ijk[2] * stride[2];
-  double visibility = 1.0;
-  long previous_unknown_target = -1;  // the voxel just walked, when unknown and in the target
+  r.index = r.ijk[0] + r.ijk[1] * grid_.nx + r.ijk[2] * static_cast<long>(grid_.nx) * grid_.ny;
+  return r;
+}
+
+namespace {
+
+// The axis whose boundary is nearest, ties as in the reference walk (the later axis of a tie),
+// written as selects rather than branches: which axis comes next is what a branch predictor
+// guesses worst.
+inline int nearest_axis(const double t[3]) {
+  const bool x_before_y = t[0] < t[1];
+  const double t_xy = x_before_y ? t[0] : t[1];
+  const int a_xy = x_before_y ? 0 : 1;
+  return t_xy < t[2] ? a_xy : 2;
+}
+
+}  // namespace
+
+// The voxel-by-voxel walk crosses the boundaries of the three axes in the order of (t_next, the
+// later axis first on a tie), and each axis's crossings come at t_next, t_next + t_delta, ... added
+// one at a time: the walk is a merge of three sorted lists. Through a block where no voxel counts,
+// (all free or all unknown, outside the target: no stop, no count, at most the visibility halved
+// per voxel) only the crossing that leaves the block matters, and how many crossings of the other axes come
+// before it. These are found from the same sums in the same order, so the state past the block is
+// bit for bit the walk's, and the walk goes on from there exactly as the reference would.
+bool ViewScorer::cross_block(Traversal& r, double t_exit, long& walked) const {
+  constexpr long kSide = 1L << kBlockShift;
+  const long n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  double crossing[3][kSide];  // crossing[a][c]: when axis a's boundary c + 1 is crossed, c + 1 < leave[a]
+  long leave[3] = {0, 0, 0};  // the crossing of axis a that leaves the block (1-based)
+  double t_leave[3];
+  for (int a = 0; a < 3; ++a) {
+    t_leave[a] = std::numeric_limits<double>::infinity();
+    if (r.step[a] == 0) continue;
+    const long block_lo = (r.ijk[a] >> kBlockShift) << kBlockShift;
+    const long face = r.step[a] > 0 ? std::min(block_lo + kSide, n[a]) - 1 : block_lo;
+    leave[a] = (face - r.ijk[a]) * r.step[a] + 1;
+    double t = r.t_next[a];
+    for (long c = 0; c + 1 < leave[a]; ++c) {
+      crossing[a][c] = t;
+      t += r.t_delta[a];
+    }
+    t_leave[a] = t;
+  }
+  const int e = nearest_axis(t_leave);
+  if (t_leave[e] > t_exit) return false;
+  walked = leave[e];  // the voxel the block was entered by, then one per crossing in it
+  for (int a = 0; a < 3; ++a) {
+    if (a == e || r.step[a] == 0) continue;
+    long c = 0;  // crossings of axis a before the one that leaves the block
+    while (c + 1 < leave[a] && (crossing[a][c] < t_leave[e] || (crossing[a][c] == t_leave[e] && a > e))) ++c;
+    walked += c;
+    r.ijk[a] += c * r.step[a];
+    r.t_next[a] = c + 1 < leave[a] ? crossing[a][c] : t_leave[a];
+  }
+  r.ijk[e] += leave[e] * r.step[e];
+  if (r.ijk[e] < 0 || r.ijk[e] >= n[e]) return false;
+  r.t_next[e] = t_leave[e] + r.t_delta[e];
+  r.index = r.ijk[0] + r.ijk[1] * grid_.nx + r.ijk[2] * static_cast<long>(grid_.nx) * grid_.ny;
+  return true;
+}
+
+// The reference walk's result in three phases. The box of target voxels is convex in index
+// space and each index moves one way along a ray, so a ray is in the target over one stretch.
+// Before it, no voxel is in the target: only an occupied voxel (the ray stops, nothing counted,
+// no unknown target voxel before it) and the visibility matter. In it, everything. Past it, only
+// the first voxel can count (an occupied one ends a rear-side run); after that the reference
+// resets its run and meets no target voxel again.
+void ViewScorer::walk_ray(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_enter, double t_exit,
+                          std::uint32_t stamp, ViewGain& out, RaySums& sums) {
+  if (reached_.empty()) return;  // no target voxel in the grid: nothing to count
+  const long n[3] = {grid_.nx, grid_.ny, grid_.nz};
+  const long stride[3] = {1, grid_.nx, static_cast<long>(grid_.nx) * grid_.ny};
+  const long mark_stride[3] = {1, span_[0], span_[0] * span_[1]};
+  // Offsets from lo_ as unsigned: one compare per axis for "in the target's range".
+  const unsigned long last[3] = {static_cast<unsigned long>(span_[0] - 1), static_cast<unsigned long>(span_[1] - 1),
+                                 static_cast<unsigned long>(span_[2] - 1)};
+  const auto in_range = [&](const long ijk[3], int a) { return static_cast<unsigned long>(ijk[a] - lo_[a]) <= last[a]; };
+  Traversal r = start(g0, dg, t_enter);
+  long* const ijk = r.ijk;
+  // Crosses the nearest boundary; false when the ray ends there (t_exit or the grid's side).
+  int a = 0;
+  double tx = r.t_next[0], ty = r.t_next[1], tz = r.t_next[2];
+  const auto advance = [&] {
+    const bool x_before_y = tx < ty;
+    const double t_xy = x_before_y ? tx : ty;
+    const bool z = !(t_xy < tz);
+    a = z ? 2 : (x_before_y ? 0 : 1);
+    if ((z ? tz : t_xy) > t_exit) return false;
+    ijk[a] += r.step[a];
+    if (ijk[a] < 0 || ijk[a] >= n[a]) return false;
+    r.index += r.step[a] * stride[a];
+    tx += a == 0 ? r.t_delta[0] : 0.0;
+    ty += a == 1 ? r.t_delta[1] : 0.0;
+    tz += a == 2 ? r.t_delta[2] : 0.0;
+    return true;
+  };
+  const std::uint8_t* const state = grid_.state.data();
+
+  // Before the target. The visibility is 0.5^(unknown voxels walked): a power of two, halved
+  // exactly (to 0 past 2^-1074 as ldexp rounds too), so a count of them gives it.
+  long unknown_walked = 0;
+  while (!(in_range(ijk, 0) && in_range(ijk, 1) && in_range(ijk, 2))) {
+    if (const std::uint8_t b = block_of(ijk); b != kMixedBlock) {
+      long walked = 0;
+      r.t_next[0] = tx, r.t_next[1] = ty, r.t_next[2] = tz;
+      if (!cross_block(r, t_exit, walked)) return;
+      tx = r.t_next[0], ty = r.t_next[1], tz = r.t_next[2];
+      if (b == kUnknownBlock) unknown_walked += walked;
+      continue;
+    }
+    ++out.steps;
+    const std::uint8_t s = state[r.index];
+    if (s == kOccupied) return;
+    if (s == kUnknown) ++unknown_walked;  // an unknown voxel is occupied with probability 0.5
+    if (!advance()) return;
+  }
+  const double visibility = std::ldexp(1.0, -static_cast<int>(std::min(unknown_walked, 2000L)));
+
+  // In the target.
+  long mark = mark_of(ijk);
+  RayState ray{visibility, -1};
   ray_unknown_.clear();
   for (;;) {
     ++out.steps;
-    const bool in_target = ijk[0] >= lo_[0] && ijk[0] <= hi_[0] && ijk[1] >= lo_[1] && ijk[1] <= hi_[1] &&
-                           ijk[2] >= lo_[2] && ijk[2] <= hi_[2];
-    const std::uint8_t s = grid_.state[static_cast<std::size_t>(index)];
-    const bool first = in_target && reached_[index] != stamp;
-    if (first) {
-      reached_[index] = stamp;
-      ++out.target_reached;
-    }
-    if (s == kOccupied) {
-      if (first) {
-        const double h = binary_entropy(occupied_probability(index));
-        sums.known_entropy += h;
-        sums.occlusion_aware += visibility * h;
-      }
-      // Rear side (Isler et al.): the ray crossed unknown space and met a surface, so it
-      // approached that surface from a side not yet seen.
-      if (previous_unknown_target >= 0) {
-        if (rear_[previous_unknown_target] != stamp) ++out.rear_side;
-        for (long w : ray_unknown_) {
-          if (rear_[w] == stamp || rear_[w] == stamp + 1) continue;
-          rear_[w] = stamp + 1;
-          sums.rear_entropy += 1.0;  // an unknown voxel: p = 0.5, one bit
-        }
-        rear_[previous_unknown_target] = stamp;
-      }
-      break;
-    }
-    if (s == kUnknown) {
-      if (in_target) {
-        ray_unknown_.push_back(index);
-        if (first) {
-          ++out.unknown_reached;
-          sums.unknown_entropy += 1.0;
-          sums.occlusion_aware += visibility;
-        }
-        previous_unknown_target = index;
-      } else {
-        previous_unknown_target = -1;
-      }
-      visibility *= 0.5;  // an unknown voxel is occupied with probability 0.5
-    } else {
-      previous_unknown_target = -1;
-    }
-    // Next voxel: cross the nearest boundary.
-    const int a = t_next[0] < t_next[1] ? (t_next[0] < t_next[2] ? 0 : 2) : (t_next[1] < t_next[2] ? 1 : 2);
-    if (t_next[a] > t_exit) break;
-    ijk[a] += step[a];
-    if (ijk[a] < 0 || ijk[a] >= n[a]) break;
-    index += step[a] * stride[a];
-    t_next[a] += t_delta[a];
+    if (visit_target_voxel(r.index, mark, stamp, ray, out, sums)) return;
+    if (!advance()) return;
+    if (!in_range(ijk, a)) break;
+    mark += r.step[a] * mark_stride[a];
   }
+
+  // The first voxel past the target: only a surface right after unknown target space counts.
+  ++out.steps;
+  if (ray.previous_unknown_target >= 0 && state[r.index] == kOccupied) count_rear_side(ray.previous_unknown_target, stamp, out, sums);
 }
 
 ViewGain ViewScorer::score(const Pose& T_world_camera, const Intrinsics& K, Measure measure) {
+  return score_with(T_world_camera, K, measure, &ViewScorer::walk_ray);
+}
+
+ViewGain ViewScorer::score_reference(const Pose& T_world_camera, const Intrinsics& K, Measure measure) {
+  return score_with(T_world_camera, K, measure, &ViewScorer::walk_ray_reference);
+}
+
+ViewGain ViewScorer::score_with(const Pose& T_world_camera, const Intrinsics& K, Measure measure, Walk walk) {
   ViewGain out;
   if (grid_.size() == 0 || !K.valid()) return out;
   // Two marks per call: the stamp counts a voxel as reached, the stamp + 1 (in rear_) as counted
@@ -217,7 +366,7 @@ ViewGain ViewScorer::score(const Pose& T_world_camera, const Intrinsics& K, Meas
       const Eigen::Vector3d dg = R * d_camera.normalized() / res;  // grid units per metre
       double t_enter = 0.0, t_exit = 0.0;
       if (!clip_ray(g0, dg, t_max, t_enter, t_exit)) continue;
-      walk_ray(g0, dg, t_enter, t_exit, stamp, out, sums);
+      (this->*walk)(g0, dg, t_enter, t_exit, stamp, out, sums);
     }
   }
   // rear_ may hold stamp + 1 from this call: the next call's stamp skips past it.

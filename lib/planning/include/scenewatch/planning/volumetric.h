@@ -42,7 +42,8 @@ struct ViewGain {
   std::size_t target_reached = 0;   ///< distinct target voxels on the rays, any state
   double entropy_bits = 0.0;        ///< summed entropy of the distinct target voxels reached
   double expected_coverage = 0.0;   ///< fraction of the target's voxels known after the view
-  std::size_t steps = 0;            ///< voxels walked, all rays
+  std::size_t steps = 0;            ///< voxels whose state a ray read, all rays (score() stops a ray at
+                                    ///< the first voxel past the target, score_reference() at the clip)
 };
 
 /// Scores views against one grid and one target box. Keeps per-voxel marks between calls: NOT
@@ -52,6 +53,9 @@ class ViewScorer {
   /// `grid` should hold the target and every camera position (rays leaving it stop there).
   ViewScorer(const background::DenseGrid& grid, const Aabb& target_world, VolumetricConfig config = {});
   ViewGain score(const Pose& T_world_camera, const Intrinsics& K, Measure measure);
+  /// The same gains by the straightforward walk (every voxel up to the clip with the full
+  /// bookkeeping): slower, the oracle of score() in the tests.
+  ViewGain score_reference(const Pose& T_world_camera, const Intrinsics& K, Measure measure);
   std::size_t target_voxels() const { return target_voxels_; }
   std::size_t target_known() const { return target_known_; }
   /// Fraction of the target's voxels known (free or occupied) now.
@@ -62,19 +66,64 @@ class ViewScorer {
   struct RaySums {
     double unknown_entropy = 0.0, rear_entropy = 0.0, occlusion_aware = 0.0, known_entropy = 0.0;
   };
+  /// One ray's 3D-DDA state (Amanatides & Woo): voxel, grid index, and the ray parameter (metres)
+  /// at the next boundary per axis, advanced by repeated addition of t_delta.
+  struct Traversal {
+    long ijk[3], step[3], index;
+    double t_next[3], t_delta[3];
+  };
+  using Walk = void (ViewScorer::*)(const Eigen::Vector3d&, const Eigen::Vector3d&, double, double, std::uint32_t, ViewGain&,
+                                    RaySums&);
+  ViewGain score_with(const Pose& T_world_camera, const Intrinsics& K, Measure measure, Walk walk);
+  Traversal start(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_enter) const;
+  /// Crosses the uniform block holding r.ijk (see block_) in one go, to the first voxel past it,
+  /// with the traversal state the voxel-by-voxel walk would have there; the voxels walked in the
+  /// block into `walked`. False when the ray ends in the block or leaves the grid.
+  bool cross_block(Traversal& r, double t_exit, long& walked) const;
+  /// The block_ entry of voxel (i, j, k).
+  std::uint8_t block_of(const long ijk[3]) const {
+    return block_[static_cast<std::size_t>(((ijk[2] >> kBlockShift) * blocks_[1] + (ijk[1] >> kBlockShift)) * blocks_[0] +
+                                           (ijk[0] >> kBlockShift))];
+  }
+  /// The mark slot of target voxel (i, j, k): reached_ and rear_ cover the target box only.
+  long mark_of(const long ijk[3]) const { return ((ijk[2] - lo_[2]) * span_[1] + (ijk[1] - lo_[1])) * span_[0] + ijk[0] - lo_[0]; }
   double occupied_probability(long index) const;
+  /// An occupied target voxel reached for the first time in this call: its entropy into the sums.
+  void count_surface(long index, double visibility, RaySums& sums) const;
+  /// One ray's running state: the visibility (prod of 1 - p so far) and the mark slot of the
+  /// voxel just walked when it is unknown and in the target, else -1.
+  struct RayState {
+    double visibility = 1.0;
+    long previous_unknown_target = -1;
+  };
+  /// A target voxel (grid index, mark slot) on a ray: counts it; true when the ray stops there.
+  bool visit_target_voxel(long index, long mark, std::uint32_t stamp, RayState& ray, ViewGain& out, RaySums& sums);
+  /// A ray met a surface right after the unknown target voxel in mark slot `previous`: Isler's
+  /// rear side, and the rear-side entropy of the ray's unknown target voxels (ray_unknown_).
+  void count_rear_side(long previous, std::uint32_t stamp, ViewGain& out, RaySums& sums);
   /// The part of a ray (from g0 along dg, grid units) worth walking, in metres; false: none.
   bool clip_ray(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_max, double& t_enter, double& t_exit) const;
-  /// Walks one clipped ray voxel by voxel, counting into `out` and `sums`.
+  /// Walks one clipped ray voxel by voxel, counting into `out` and `sums`: before the target only
+  /// the stop at a surface and the visibility, in the target everything, past it one voxel.
   void walk_ray(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_enter, double t_exit, std::uint32_t stamp,
+                ViewGain& out, RaySums& sums);
+  /// walk_ray's straightforward form: every voxel to t_exit, each tested for everything.
+  void walk_ray_reference(const Eigen::Vector3d& g0, const Eigen::Vector3d& dg, double t_enter, double t_exit, std::uint32_t stamp,
                 ViewGain& out, RaySums& sums);
   const background::DenseGrid& grid_;
   VolumetricConfig config_;
   long lo_[3] = {0, 0, 0}, hi_[3] = {-1, -1, -1};  ///< the target's voxel index range, inclusive
+  long span_[3] = {0, 0, 0};                        ///< hi_ - lo_ + 1, at least 0
   std::size_t target_voxels_ = 0, target_known_ = 0;
-  std::vector<std::uint32_t> reached_, rear_;       ///< marks: == stamp_ when counted in this call
+  /// Empty-space skipping: blocks of 2^kBlockShift voxels a side (clipped by the grid), outside
+  /// the target, all free or all unknown; built once per scorer.
+  static constexpr int kBlockShift = 3;
+  static constexpr std::uint8_t kMixedBlock = 0, kFreeBlock = 1, kUnknownBlock = 2;
+  long blocks_[3] = {0, 0, 0};
+  std::vector<std::uint8_t> block_;
+  std::vector<std::uint32_t> reached_, rear_;       ///< marks per target voxel (mark_of): == stamp_ when counted in this call
   std::uint32_t stamp_ = 0;
-  std::vector<long> ray_unknown_;                   ///< scratch: one ray's unknown target voxels
+  std::vector<long> ray_unknown_;                   ///< scratch: one ray's unknown target voxels (mark slots)
 };
 
 }  // namespace scenewatch::planning
