@@ -65,7 +65,9 @@ void add_next_view_command(CLI::App& app, RemoteOptions& remote, Action& action)
   auto* event_opt = next->add_option("--event", target->event, "an event's id (confirm or dismiss it)");
   auto* box_opt = next->add_option("--box", next_view.box, "MINX MINY MINZ MAXX MAXY MAXZ (world)")->expected(6);
   auto* workspace_opt = next->add_flag("--workspace", next_view.workspace, "every tracked object");
-  next->add_option("--measure", next_view.measure, "unobserved, rear_side, rear_side_entropy, occlusion_aware, visible");
+  next->add_option("--measure", next_view.measure,
+                   "unobserved, rear_side, rear_side_entropy, occlusion_aware, visible; or the seed's planner for --object: "
+                   "covariance (rule 3.23), covariance_321, covariance_322 (one view on the --radius sphere)");
   next->add_option("-n", next_view.n, "views to return")->capture_default_str()->check(CLI::Range(1, 1000));
   next->add_option("--radius", next_view.radius_m, "distance from the target's centre, m (0: the daemon's 0.7)");
   add_remote_options(next, remote);

@@ -2,6 +2,8 @@
 // next-view` against it: the simulator's cup_added seen by a hand-held camera from one side.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <nlohmann/json.hpp>
 
 #include "daemon_harness.h"
@@ -93,6 +95,32 @@ TEST_F(NextViewTest, ObjectsAndEventsGetViewsOfWhatIsUnseen) {
   const Eigen::Vector3d best = matrix_of(reply.views(0).pose()).block<3, 1>(0, 3);
   EXPECT_GT((best - centre).x(), 0.0) << reply.views(0).why();
 
+  // The seed's planner: one view on the sphere around the box, on the side the camera did not see.
+  auto seed = call(client, request([&](proto::Request& r) {
+    r.mutable_next_best_view()->set_object_id(box->id());
+    r.mutable_next_best_view()->set_measure("covariance");
+    r.mutable_next_best_view()->set_n(4);
+    r.mutable_next_best_view()->set_radius_m(0.6);
+  }));
+  ASSERT_EQ(seed.status().code(), proto::Status::OK) << seed.status().message();
+  EXPECT_EQ(seed.next_best_view().measure(), "covariance");
+  ASSERT_EQ(seed.next_best_view().views_size(), 1) << "one view whatever n";
+  const auto& planned = seed.next_best_view().views(0);
+  EXPECT_TRUE(validate_rigid(matrix_of(planned.pose())));
+  const Eigen::Vector3d planned_at = matrix_of(planned.pose()).block<3, 1>(0, 3);
+  EXPECT_NEAR((planned_at - centre).norm(), 0.6, 1e-6) << planned.why();
+  EXPECT_GT((planned_at - centre).x(), 0.0) << "the camera came from -x: " << planned.why();  // measured +0.53
+  EXPECT_NE(planned.why().find("3.23"), std::string::npos) << planned.why();
+  EXPECT_NE(planned.why().find("observed by keyframes"), std::string::npos) << planned.why();
+  std::printf("covariance: camera at (%.3f %.3f %.3f), %s\n", planned_at.x(), planned_at.y(), planned_at.z(), planned.why().c_str());
+  auto seed_box = call(client, request([&](proto::Request& r) {
+    *r.mutable_next_best_view()->mutable_box() = reply.target();
+    r.mutable_next_best_view()->set_measure("covariance_322");
+  }));
+  EXPECT_EQ(seed_box.status().code(), proto::Status::INVALID_ARGUMENT);
+  EXPECT_NE(seed_box.status().message().find("covariance_322"), std::string::npos) << seed_box.status().message();
+  EXPECT_NE(seed_box.status().message().find("object_id"), std::string::npos) << seed_box.status().message();
+
   // A list of two reachable poses: where the camera was, and its mirror image through the box.
   Pose mirrored = last_camera;
   mirrored.translation() = 2.0 * centre - last_camera.translation();
@@ -149,6 +177,14 @@ TEST_F(NextViewTest, ObjectsAndEventsGetViewsOfWhatIsUnseen) {
   EXPECT_EQ(j.at("views")[0].at("pose").size(), 16u);
   EXPECT_GT(j.at("views")[0].at("score").get<double>(), 0.0);
   EXPECT_TRUE(j.at("views")[0].contains("expected_coverage"));
+  auto cli_seed = run_command({cli_binary().string(), "next-view", "--object", std::to_string(box->id()), "--measure", "covariance",
+                               "--json", "--port", std::to_string(daemon_.port())},
+                              tmp_);
+  ASSERT_EQ(cli_seed.exit_code, 0) << cli_seed.err;
+  const json js = json::parse(cli_seed.out);
+  EXPECT_EQ(js.at("measure"), "covariance");
+  ASSERT_EQ(js.at("views").size(), 1u);
+  EXPECT_EQ(js.at("views")[0].at("pose").size(), 16u);
   auto usage = run_command({cli_binary().string(), "next-view", "--port", std::to_string(daemon_.port())}, tmp_);
   EXPECT_EQ(usage.exit_code, 2) << usage.err;
 }

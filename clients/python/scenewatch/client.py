@@ -234,7 +234,9 @@ class Client:
         """Where to look next: give exactly one target (an object id, a box ((min xyz), (max xyz)),
         an event id, or workspace=True). pb.NextBestViewReply: ``views`` best first, each with
         ``pose.matrix`` (16 numbers, row-major T_world_camera), ``score``, ``expected_coverage``
-        and ``why``. ``current_pose`` (16 numbers) adds the cost of moving there."""
+        and ``why``. ``current_pose`` (16 numbers) adds the cost of moving there. ``measure``
+        "covariance" (or "covariance_321", "covariance_322") with an object_id: the seed's planner,
+        one view on the sphere of radius_m; the daemon checks the name."""
         message = pb.NextBestView(measure=measure, n=n, radius_m=radius_m)
         given = [object_id is not None, box is not None, event_id is not None, bool(workspace)]
         if sum(given) != 1:

@@ -262,6 +262,10 @@ Result<background::DenseGrid> WorkingMemory::dense_grid(const Aabb& box, std::si
   return impl_->map.read([&](const background::OccupancyMap& map) { return map.dense_grid(box, max_voxels); });
 }
 
+std::vector<std::shared_ptr<const background::Keyframe>> WorkingMemory::keyframes() const {
+  return impl_->appearance.all_keyframes();
+}
+
 std::size_t WorkingMemory::clear_box(const Aabb& box) {
   std::lock_guard<std::mutex> lock(impl_->writer);
   return impl_->map.write([&](background::OccupancyMap& map) { return map.clear_box(box); });

@@ -1,6 +1,8 @@
 #include "next_best_view_call.h"
 
 #include "proto_convert.h"
+#include "scenewatch/pipeline/covariance_view_request.h"
+#include "scenewatch/planning/covariance_view.h"
 #include "scenewatch/planning/next_best_view.h"
 
 namespace scenewatch::service {
@@ -63,7 +65,7 @@ Result<planning::NextBestViewRequest> to_request(const pipeline::WorkingMemory& 
   }
   if (!msg.measure().empty()) {
     auto m = planning::parse_measure(msg.measure());
-    if (!m) return m.error();
+    if (!m) return invalid_argument("measure: unknown '" + msg.measure() + "' (" + planning::all_measure_names() + ")");
     r.measure = *m;
   }
   if (msg.n() > 0) r.n = static_cast<int>(std::min<std::uint32_t>(msg.n(), 1001));
@@ -81,9 +83,42 @@ Result<planning::NextBestViewRequest> to_request(const pipeline::WorkingMemory& 
   return r;
 }
 
+// The seed's planner (measure covariance*): one view, on the sphere of radius_m around an object.
+Status covariance_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, planning::WeightRule rule,
+                       proto::NextBestViewReply* out) {
+  const std::string measure = planning::covariance_measure_name(rule);
+  if (msg.target_case() != proto::NextBestView::kObjectId) {
+    return invalid_argument("measure " + measure + ": plans from a tracked object's points; give object_id, not a box, "
+                            "an event or the workspace");
+  }
+  if (msg.constraint() != proto::NextBestView::CONSTRAINT_CAP && msg.constraint() != proto::NextBestView::CONSTRAINT_SPHERE) {
+    return invalid_argument("constraint: measure " + measure + " plans on the sphere of radius_m (cap or sphere), not a shell or a list");
+  }
+  auto request = pipeline::covariance_view_request(memory, msg.object_id(), rule, msg.radius_m() > 0.0 ? msg.radius_m() : 0.7);
+  if (!request) return request.error();
+  auto answer = planning::covariance_next_view(*request);
+  if (!answer) return answer.error();
+  const auto snapshot = memory.snapshot();
+  for (const auto& o : snapshot->objects) {
+    if (o.id == msg.object_id()) convert::to_proto(o.cluster.box.aabb(), out->mutable_target());
+  }
+  out->set_measure(measure);
+  out->set_candidates(1);
+  auto* v = out->add_views();
+  convert::to_proto(answer->view.T_world_camera, v->mutable_pose());
+  if (msg.has_current_pose()) {
+    auto pose = convert::decode_pose(msg.current_pose(), "current_pose");
+    if (!pose) return pose.error();
+    v->set_motion_m((answer->view.T_world_camera.translation() - pose->translation()).norm());
+  }
+  v->set_why(convert::valid_utf8(answer->why));
+  return {};
+}
+
 }  // namespace
 
 Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, proto::NextBestViewReply* out) {
+  if (const auto rule = planning::parse_covariance_measure(msg.measure())) return covariance_view(memory, msg, *rule, out);
   auto request = to_request(memory, msg);
   if (!request) return request.error();
   auto region = planning::planning_region(*request);

@@ -101,6 +101,9 @@ class WorkingMemory {
   /// A dense copy of the map in a box (background::OccupancyMap::dense_grid), for the view
   /// planner. Thread safe: a consistent copy while frames go on being processed.
   Result<background::DenseGrid> dense_grid(const Aabb& box_world, std::size_t max_voxels) const;
+  /// The appearance memory's keyframes (posed colour and depth images, immutable and shared): what
+  /// the memory keeps of where each surface was seen from. Thread safe.
+  std::vector<std::shared_ptr<const background::Keyframe>> keyframes() const;
   std::size_t clear_box(const Aabb& box_world);
   void reset();
 
