@@ -3,6 +3,9 @@
 // within the sensor model's tolerance; the faces of a box but the one it rests on.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "scenewatch/planning/covariance_view.h"
 #include "scenewatch/planning/observation_history.h"
 
@@ -90,6 +93,54 @@ TEST(CovarianceView, UnseenPointsPullTheCamera) {
   EXPECT_GT(answer->view.T_world_camera.translation().x(), 0.5) << answer->why;
   EXPECT_NE(answer->why.find("3.23"), std::string::npos);
   r.observers_world.pop_back();
+  EXPECT_FALSE(covariance_next_view(r).ok());
+}
+
+// The cap: unseen points under the object pull the sphere's minimum below the table; with a cap
+// the answer stays within its angle of up, and is the cap's minimum (against a finer grid).
+TEST(CovarianceView, ACapKeepsTheCameraAboveTheTable) {
+  CovarianceViewRequest r;
+  for (int i = 0; i < 10; ++i) {
+    r.points_world.emplace_back(0.01 * i - 0.05, 0.0, 0.05);
+    r.observers_world.push_back({Eigen::Vector3d(0.0, -0.3, 1.0)});
+    r.points_world.emplace_back(0.01 * i - 0.05, 0.02, -0.05);
+    r.observers_world.emplace_back();
+  }
+  r.radius_m = 0.7;
+  auto free = covariance_next_view(r);
+  ASSERT_TRUE(free.ok()) << free.error().message;
+  const auto polar = [](const Eigen::Vector3d& x) { return std::acos(x.normalized().z()) * 180.0 / M_PI; };
+  ASSERT_GT(polar(free->view.minimum.x_world), 90.0) << "the sphere's minimum is below the table: " << free->why;
+  EXPECT_FALSE(free->capped);
+
+  r.max_polar_deg = 60.0;
+  auto capped = covariance_next_view(r);
+  ASSERT_TRUE(capped.ok()) << capped.error().message;
+  EXPECT_TRUE(capped->capped);
+  EXPECT_NE(capped->why.find("below the cap"), std::string::npos) << capped->why;
+  const Eigen::Vector3d x = capped->view.T_world_camera.translation();
+  EXPECT_NEAR(x.norm(), 0.7, 1e-9);
+  EXPECT_LE(polar(x), 60.0 + 1e-9);
+  std::vector<Eigen::Matrix3d> covariances;
+  for (std::size_t i = 0; i < r.points_world.size(); ++i) {
+    covariances.push_back(depth_point_covariance(r.points_world[i], r.observers_world[i], r.sensor, r.focal_px, r.prior_sigma_m));
+  }
+  const PlaneQuadratic f = plane_quadratic(r.points_world, covariances, r.rule);
+  double finest = std::numeric_limits<double>::infinity();
+  for (double theta = 0.0; theta <= 60.0; theta += 0.25)
+    for (double phi = 0.0; phi < 360.0; phi += 0.25) {
+      const double t = theta * M_PI / 180.0, p = phi * M_PI / 180.0;
+      finest = std::min(finest, f(0.7 * Eigen::Vector3d(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t))));
+    }
+  EXPECT_LE(f(x), finest + 1e-3 * std::abs(finest)) << "the 1-degree grid's minimum is the cap's to 0.1 %";
+
+  // A minimum inside the cap is kept exactly; a cap angle out of range is refused.
+  r.max_polar_deg = 179.0;
+  auto wide = covariance_next_view(r);
+  ASSERT_TRUE(wide.ok());
+  EXPECT_FALSE(wide->capped);
+  EXPECT_TRUE(wide->view.minimum.x_world.isApprox(free->view.minimum.x_world, 1e-12));
+  r.max_polar_deg = 1e9;
   EXPECT_FALSE(covariance_next_view(r).ok());
 }
 

@@ -96,6 +96,9 @@ Status covariance_view(const pipeline::WorkingMemory& memory, const proto::NextB
   }
   auto request = pipeline::covariance_view_request(memory, msg.object_id(), rule, msg.radius_m() > 0.0 ? msg.radius_m() : 0.7);
   if (!request) return request.error();
+  if (msg.constraint() == proto::NextBestView::CONSTRAINT_CAP) {
+    request->max_polar_deg = msg.max_polar_deg() > 0.0 ? msg.max_polar_deg() : planning::ViewConstraint{}.max_polar_deg;
+  }
   auto answer = planning::covariance_next_view(*request);
   if (!answer) return answer.error();
   const auto snapshot = memory.snapshot();

@@ -33,6 +33,9 @@ struct CovarianceViewRequest {
   Eigen::Vector3d center_world = Eigen::Vector3d::Zero();  ///< the sphere's centre: the target's
   double radius_m = 0.7;
   Eigen::Vector3d up_world = Eigen::Vector3d::UnitZ();
+  /// The cap constraint: the camera within this angle of up (none: the whole sphere). When the
+  /// sphere's minimum lies outside, the cap's own minimum is searched on a 1-degree grid of it.
+  std::optional<double> max_polar_deg;
 };
 
 /// Checks the request; the message names the field.
@@ -43,6 +46,7 @@ struct CovarianceViewAnswer {
   std::size_t points = 0;     ///< points planned for
   std::size_t observed = 0;   ///< of them, those some keyframe observed
   std::string why;            ///< the rule, the counts, the sphere case, the angle from up
+  bool capped = false;        ///< the sphere's minimum lay outside the cap: the cap's grid minimum instead
 };
 
 /// The seed's planned view for the request.
