@@ -201,7 +201,7 @@ TEST(Localizer, TrackModeFollowsTheKitchenWithoutPoses) {
   double sum_sq = 0;
   std::size_t lost = 0;
   Pose first_truth = Pose::Identity(), first = Pose::Identity();
-  const std::size_t n = 40;
+  const std::size_t n = seq.frames.size();  // 250: every second frame of 16.6 s of the recording
   for (std::size_t i = 0; i < n; ++i) {
     Frame f = load(seq, i);
     const Pose truth = *f.T_world_camera;
@@ -222,10 +222,11 @@ TEST(Localizer, TrackModeFollowsTheKitchenWithoutPoses) {
     ASSERT_TRUE(kf.ok());
     ASSERT_TRUE(memory.consider(std::move(*kf)).ok());
   }
-  std::cout << "track, 40 frames: RMSE " << 1000 * std::sqrt(sum_sq / n) << " mm, lost " << lost << "\n";
+  std::cout << "track, " << n << " frames: RMSE " << 1000 * std::sqrt(sum_sq / n) << " mm, lost " << lost << "\n";
   EXPECT_EQ(lost, 0u);
-  // Measured: 11.1 mm RMS over these 40 frames (2.7 s of the recording).
-  EXPECT_LT(std::sqrt(sum_sq / n), 0.013);
+  // Measured: 87.4 mm RMS over the 250 frames, none lost (frame-to-frame steps; before them, 529 mm
+  // with 161 frames lost: the track left the keyframes' basin at frame 33 and diverged).
+  EXPECT_LT(std::sqrt(sum_sq / n), 0.095);
 }
 
 TEST(WorkingMemoryLocalization, ALostFrameChangesNothingAndRaisesNoEvent) {

@@ -35,6 +35,8 @@ struct Localizer::Track {
   double var_m2 = 0.0, var_rad2 = 0.0;
   bool homed = false;       ///< placed against the memory (or started it) since the camera's first frame
   int lost_in_row = 0;
+  /// Without given poses: the last placed frame, prepared as a reference, for the frame-to-frame step.
+  std::shared_ptr<const RgbdPyramid> previous;
   Localization result;
 };
 
@@ -119,16 +121,15 @@ bool Localizer::must_relocalize(const Track& track, LocalizationMode mode) const
   return track.lost_in_row >= config_.rehome_after_lost_frames;
 }
 
-bool Localizer::accept(Localization& r, const Alignment& a, const background::Keyframe& keyframe) const {
-  r.T_world_camera = keyframe.T_world_camera * a.T_reference_current;
+bool Localizer::accept(Localization& r, const Alignment& a, const Pose& T_world_reference, const std::string& what) const {
+  r.T_world_camera = T_world_reference * a.T_reference_current;
   r.inlier_fraction = a.inlier_fraction;
   r.residual_m = a.residual_m;
   r.conditioning = a.conditioning;
-  const Mat6 A = twist_adjoint(keyframe.T_world_camera);
+  const Mat6 A = twist_adjoint(T_world_reference);
   r.covariance = A * a.covariance * A.transpose();
-  r.reference_keyframe = keyframe.id;
   if (a.inlier_fraction < config_.min_inlier_fraction) {
-    r.reason = "alignment with keyframe " + std::to_string(keyframe.id) + " poor: " +
+    r.reason = "alignment with " + what + " poor: " +
                std::to_string(static_cast<int>(std::lround(100 * a.inlier_fraction))) + " % of the depth pixels agree";
     return false;
   }
@@ -172,7 +173,8 @@ Localization Localizer::relocalize(const Frame& frame, const std::vector<std::sh
     r.relocalized = true;
     r.feature_matches = h.matches;
     r.feature_inliers = h.inliers;
-    if (accept(r, a, *h.keyframe)) return finish(r);
+    r.reference_keyframe = h.keyframe->id;
+    if (accept(r, a, h.keyframe->T_world_camera, "keyframe " + std::to_string(h.keyframe->id))) return finish(r);
     r.state = State::kLost;
     r.T_world_camera = out.T_world_camera;
     r.reason = "relocalization: " + r.reason;
@@ -199,6 +201,8 @@ struct Localizer::Attempt {
   // left out), and how uncertain the frame's placement is; the prior's until an alignment says more.
   std::optional<Pose> odom_pose;
   double placed_var_m2 = 0, placed_var_rad2 = 0;
+  /// The frame's pyramid, when built (a reference one without given poses: it is the next frame's previous).
+  std::shared_ptr<const RgbdPyramid> current;
 };
 
 Localization Localizer::localize(const Frame& frame, std::uint32_t camera, const KeyframeSource& keyframes, const AllKeyframes& all) {
@@ -263,6 +267,13 @@ Localization Localizer::relocalize_track(Attempt& at, LocalizationMode mode,
 Localization Localizer::align_with_keyframes(Attempt& at, const Localization& out, const KeyframeSource& keyframes) {
   const Frame& frame = at.frame;
   const Track& track = at.track;
+  const bool tracking = !at.use_given;
+  // Without a given pose the frame is aligned to the camera's previous frame: a frame's motion
+  // lies inside the alignment's basin, where a keyframe up to a spacing away may not (on
+  // redkitchen_long, keyframes 5 cm and 2.5 degrees off led it into false minima and the track
+  // diverged). The keyframes place the frame only when that step fails (docs/localization.md).
+  if (tracking && track.started && track.previous)
+    if (auto step = step_from_previous(at, out)) return *step;
   const Pose& prior = at.prior;
   auto candidates = keyframes ? keyframes(prior, config_.reference_keyframes) : decltype(keyframes(prior, 1)){};
   if (at.use_given) {
@@ -285,7 +296,9 @@ Localization Localizer::align_with_keyframes(Attempt& at, const Localization& ou
     }
     return r;
   }
-  const RgbdPyramid current = build_pyramid(*frame.cloud, *frame.intrinsics, sensor_, config_.pyramid, false);
+  if (!at.current)
+    at.current = std::make_shared<const RgbdPyramid>(build_pyramid(*frame.cloud, *frame.intrinsics, sensor_, config_.pyramid, tracking));
+  const RgbdPyramid& current = *at.current;
   Localization best = out;
   best.state = State::kLost;
   std::optional<Alignment> aligned;
@@ -293,7 +306,7 @@ Localization Localizer::align_with_keyframes(Attempt& at, const Localization& ou
   for (const auto& keyframe : candidates) {
     const auto ref = reference(*keyframe);
     Alignment a = align(*ref, current, keyframe->T_world_camera.inverse() * prior, sensor_, config_.alignment);
-    if (!at.use_given && track.started) {
+    if (tracking && track.started) {
       // Without a given pose the prior assumes the camera kept its last motion; when it stopped
       // or turned back, that prior lies twice as far off as the last pose. Both are tried; the
       // one more of the frame agrees with wins.
@@ -301,12 +314,14 @@ Localization Localizer::align_with_keyframes(Attempt& at, const Localization& ou
       if (still.inlier_fraction > a.inlier_fraction) a = std::move(still);
     }
     Localization r = out;
-    if (accept(r, a, *keyframe)) {
+    if (accept(r, a, keyframe->T_world_camera, "keyframe " + std::to_string(keyframe->id))) {
+      r.reference_keyframe = keyframe->id;
       best = r;
       aligned = a;
       aligned_to = keyframe.get();
       break;
     }
+    r.reference_keyframe = keyframe->id;
     if (best.reference_keyframe == 0 || r.inlier_fraction > best.inlier_fraction) best = r;
   }
   if (!aligned) {
@@ -316,6 +331,21 @@ Localization Localizer::align_with_keyframes(Attempt& at, const Localization& ou
   }
   if (at.use_given) weigh_against_given(at, best, *aligned, *aligned_to);
   return best;
+}
+
+std::optional<Localization> Localizer::step_from_previous(Attempt& at, const Localization& out) {
+  Track& track = at.track;
+  at.current = std::make_shared<const RgbdPyramid>(
+      build_pyramid(*at.frame.cloud, *at.frame.intrinsics, sensor_, config_.pyramid, true));
+  // From the last motion, and from standing still: a wrong rotation in the last motion (0.6-0.9
+  // degrees a frame on redkitchen_long) can lead the alignment into a false minimum where fewer
+  // pixels agree. The one more of the frame agrees with wins.
+  Alignment a = align(*track.previous, *at.current, track.motion, sensor_, config_.alignment);
+  Alignment still = align(*track.previous, *at.current, Pose::Identity(), sensor_, config_.alignment);
+  if (still.inlier_fraction > a.inlier_fraction) a = std::move(still);
+  Localization r = out;
+  if (!accept(r, a, track.last, "the previous frame")) return std::nullopt;
+  return r;
 }
 
 void Localizer::weigh_against_given(Attempt& at, Localization& best, const Alignment& aligned,
@@ -346,6 +376,7 @@ Localization Localizer::finish(Attempt& at, Localization r) {
     if (track.started && !r.relocalized) track.motion = track.last.inverse() * r.T_world_camera;
     if (r.relocalized) track.motion = Pose::Identity();
     track.last = r.T_world_camera;
+    track.previous = at.use_given ? nullptr : at.current;  // a relocalized frame's is not built: null
     track.started = true;
     track.homed = true;
     track.lost_in_row = 0;

@@ -2,8 +2,9 @@
 /// Where each frame was taken, against the memory (issue 29; DESIGN.md's `localization`). Per
 /// camera, a frame is aligned to the memory's nearest keyframe from a prior: in `refine` mode the
 /// given pose carried by the camera's running correction (T_world_odom: the given poses' frame
-/// and drift undone), in `track` mode (or a frame without a pose) the last pose moved on by the
-/// camera's last motion. A poor alignment leaves the camera `lost`: its frame must change nothing.
+/// and drift undone). In `track` mode (or a frame without a pose) a frame is aligned to the
+/// camera's previous frame, and to the keyframes near the last pose moved on by the camera's last
+/// motion only when that fails. A poor alignment leaves the camera `lost`: its frame must change nothing.
 #include <cstdint>
 #include <deque>
 #include <functional>
@@ -156,8 +157,9 @@ class Localizer {
   std::pair<double, double> keyframe_variance(const background::Keyframe& keyframe);
   void remember_placement(const Pose& pose, double var_m2, double var_rad2);
   bool must_relocalize(const Track& track, LocalizationMode mode) const;
-  /// Fills r's quality from an alignment with a keyframe; true when it passes the checks.
-  bool accept(Localization& r, const Alignment& a, const background::Keyframe& keyframe) const;
+  /// Fills r's pose and quality from an alignment with a reference view (`what` names it in the
+  /// reason); true when it passes the checks.
+  bool accept(Localization& r, const Alignment& a, const Pose& T_world_reference, const std::string& what) const;
   // The steps of localize() (localizer.cpp), on one frame's Attempt.
   struct Attempt;
   /// A camera that must relocalize, against every keyframe.
@@ -165,6 +167,8 @@ class Localizer {
                                 const std::vector<std::shared_ptr<const background::Keyframe>>& every);
   /// Alignment with the keyframes near the prior; `out` is the result so far.
   Localization align_with_keyframes(Attempt& at, const Localization& out, const KeyframeSource& keyframes);
+  /// Without a given pose: the frame aligned to the camera's previous frame, when that passes the checks.
+  std::optional<Localization> step_from_previous(Attempt& at, const Localization& out);
   /// In `refine` or given-pose mode: the alignment fused with the given pose, or refused.
   void weigh_against_given(Attempt& at, Localization& best, const Alignment& aligned, const background::Keyframe& aligned_to);
   /// Times the result and moves the camera's track on by it.
