@@ -296,8 +296,8 @@ void add_replay_command(CLI::App& app, Action& action) {
   add_depth_scale_option(replay, options->depth_scale_m);
   add_bag_options(replay, options->bag);
   replay->add_option("--localization", options->localization,
-                     "where frames were taken: given (trust their poses), refine (align the given pose to the memory; "
-                     "the default), track (no poses needed); overrides localization.mode")
+                     "where frames were taken: given (trust their poses; the default), refine (align the given pose to "
+                     "the memory), track (no poses needed); overrides localization.mode")
       ->check(CLI::IsMember({"given", "refine", "track"}));
   replay->add_option("--trajectory", options->trajectory,
                      "write the poses the memory used (aligned frames) as a TUM trajectory: t tx ty tz qx qy qz qw");

@@ -251,8 +251,9 @@ TEST(Stream, RealKitchenStretchHeldOutFromTuningIsCalm) {
   // Nobody is in it either: 13 frames with "hands" when a hand's points had to fall in an occupied
   // voxel to count as furniture, 10 since they count within the sensor's axial tolerance along
   // their ray (a wooden cupboard side entering the view, files 410-442, blanked as an arm and so
-  // never put in the map). Known shortfall of issue 28's item 4.
-  EXPECT_LE(with_hands, 10u);
+  // never put in the map), 9 since that tolerance holds the camera's measured misalignment against
+  // the map, as the change detector's does. Known shortfall of issue 28's item 4.
+  EXPECT_LE(with_hands, 9u);
 }
 
 TEST(Stream, TwoCamerasOnOneRoomInterleaved) {

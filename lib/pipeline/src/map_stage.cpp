@@ -58,6 +58,10 @@ ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const 
   auto mismatch = change::mismatch_against_map(map_, *frame.cloud, T, *K, config, &map_grid_,
                                                config.witness_per_camera ? &witness_ : nullptr, camera);
   if (!mismatch) return out;
+  {
+    std::lock_guard<std::mutex> lock(pose_mutex_);
+    last_pose_[camera] = mismatch->pose;
+  }
   change::ClusterInput input;
   input.after_camera = frame.cloud.get();
   input.T_world_after = T;
@@ -99,15 +103,20 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
 }
 
 std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d&)> MapStage::occupied_fraction(
-    const change::Config& change_config) {
-  return [this, change_config](const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& camera) {
+    const change::Config& change_config, std::uint32_t camera_id) {
+  change::PoseAgreement pose;
+  {
+    std::lock_guard<std::mutex> lock(pose_mutex_);
+    if (auto it = last_pose_.find(camera_id); it != last_pose_.end()) pose = it->second;
+  }
+  return [this, change_config, pose](const std::vector<Eigen::Vector3d>& pts, const Eigen::Vector3d& camera) {
     std::shared_lock<std::shared_mutex> read(mutex_);
     const double step = 0.5 * map_.resolution();
     std::size_t n = 0;
     for (const auto& p : pts) {
       const Eigen::Vector3d ray = p - camera;
       const double range = ray.norm();
-      const double reach = change::map_tolerance_m(change_config, range);
+      const double reach = change::map_tolerance_m(change_config, range, pose.shift_at(p));
       bool on = map_.query(p) == background::Occupancy::kOccupied;
       for (double t = step; !on && range > 0 && t <= reach + 1e-9; t += step) {
         const Eigen::Vector3d d = (t / range) * ray;
@@ -125,6 +134,10 @@ void MapStage::reset() {
     map_.reset();
     witness_.reset();
   }
+  {
+    std::lock_guard<std::mutex> lock(pose_mutex_);
+    last_pose_.clear();
+  }
   changes_.reset();
 }
 
@@ -133,6 +146,10 @@ void MapStage::replace(background::OccupancyMap map) {
     std::unique_lock<std::shared_mutex> write(mutex_);
     map_ = std::move(map);
     witness_ = change::SurfaceWitness(map_.resolution());  // the loaded surfaces: seen by none of this session
+  }
+  {
+    std::lock_guard<std::mutex> lock(pose_mutex_);
+    last_pose_.clear();
   }
   changes_.reset();
 }

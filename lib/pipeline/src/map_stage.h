@@ -6,6 +6,7 @@
 // writer lock; read() takes the map's shared lock and may run beside update()'s change detection.
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
@@ -39,9 +40,12 @@ class MapStage {
                        bool detect, FrameResult& result, std::uint32_t camera);
 
   /// The share of world points on surfaces the map remembers (occupied, within the change
-  /// detector's tolerance along the ray from `camera`), for the foreground.
+  /// detector's tolerance along the ray from `camera`), for the foreground. The tolerance holds,
+  /// as the change detector's does, how far the misalignment the detector last measured for this
+  /// camera (change::PoseAgreement) moves each point: given poses that disagree with the map by a
+  /// few centimetres would otherwise make remembered furniture look new.
   std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d& camera)> occupied_fraction(
-      const change::Config& change_config);
+      const change::Config& change_config, std::uint32_t camera_id);
 
   /// `fn(map)` under the map's shared lock.
   template <typename F>
@@ -57,7 +61,11 @@ class MapStage {
   }
 
   /// Forgets what is kept of a camera that is no longer followed.
-  void forget_camera(std::uint32_t camera) { changes_.forget_camera(camera); }
+  void forget_camera(std::uint32_t camera) {
+    changes_.forget_camera(camera);
+    std::lock_guard<std::mutex> lock(pose_mutex_);
+    last_pose_.erase(camera);
+  }
   /// An empty map; no candidates.
   void reset();
   /// A loaded map in place of this one (its surfaces seen by no camera of this session); no candidates.
@@ -73,6 +81,9 @@ class MapStage {
   background::DenseGrid map_grid_;  // the change detector's dense copy of the map, its buffers kept between frames
   change::SurfaceWitness witness_;  // which cameras saw each surface of the map (guarded with it)
   change::PersistenceFilter changes_;  // owned by the writer
+  // The pose agreement the change detector last measured, per camera.
+  mutable std::mutex pose_mutex_;
+  std::map<std::uint32_t, change::PoseAgreement> last_pose_;
 };
 
 }  // namespace scenewatch::pipeline

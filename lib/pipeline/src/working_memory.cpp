@@ -137,7 +137,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   // The planes this camera saw last (world frame); a camera's first frame starts from the model's.
   const auto own_planes = m.planes_by_camera.find(camera_id);
   const Frame seen = m.foreground.prepare(frame, m.frames, own_planes != m.planes_by_camera.end() ? own_planes->second : m.planes,
-                                          config_.segmentation.up, m.map.occupied_fraction(config_.change), result, camera_id);
+                                          config_.segmentation.up, m.map.occupied_fraction(config_.change, camera_id), result, camera_id);
 
   // Three independent parts, each against the memory as it stands before this frame: the
   // geometric change detection with the map update (the octree), the image surprise (keyframes
