@@ -43,6 +43,7 @@ struct BridgeConfig {
   std::size_t queue_frames = 2;    ///< frames waiting for the daemon; the oldest is dropped beyond
   double map_period_s = 1.0;       ///< the octomap is published at most this often (and once idle)
   bool markers = true;             ///< publish the MarkerArray after each frame (one GetHands more per frame)
+  bool surprise = true;            ///< publish the surprise heatmap after each frame (one GetSurpriseMap more per frame)
   std::size_t marker_events = 10;  ///< the newest events drawn as markers
   double stats_period_s = 0.0;     ///< a stats line on stdout this often (0: only at exit)
 };

@@ -1,5 +1,7 @@
 #include "daemon_link.h"
 
+#include <cmath>
+
 #include <algorithm>
 
 #include "scenewatch/io/bag/image_conversion.h"
@@ -158,6 +160,8 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
     stats_.sample_ms("out.reply_to_objects_written", ms_between(replied, Clock::now()));
     if (out_.markers && !publish_markers(client, reply->ingest(), answer->objects(), frame.stamp_s)) return false;
   }
+  if (out_.surprise && !publish_surprise(client, frame.stamp_s, config_.camera_frame.empty() ? job.depth.frame_id : config_.camera_frame))
+    return false;
   map_stamp_s_ = frame.stamp_s;
   map_dirty_ = true;
   if (Clock::now() - map_published_ >= std::chrono::duration<double>(config_.map_period_s)) publish_map(client, frame.stamp_s);
@@ -209,6 +213,30 @@ bool DaemonLink::publish_markers(service::Client& client, const proto::IngestRep
   scene.events = recent_events_.newest();
   out_.markers(scene, stamp_s);
   stats_.count("markers_sent");
+  return true;
+}
+
+bool DaemonLink::publish_surprise(service::Client& client, double stamp_s, const std::string& camera_frame) {
+  proto::Request request;
+  request.mutable_get_surprise_map();
+  auto answer = call(client, std::move(request), "surprise");
+  if (!answer) return false;
+  if (auto st = service::status_of(*answer); !st) {
+    // NOT_FOUND until the memory has keyframes: expected at the start, not worth a log line.
+    if (st.error().code == ErrorCode::kNotFound) {
+      stats_.count("surprise_none");
+    } else if (const auto n = stats_.count("surprise_refused"); worth_logging(n)) {
+      out_.log("the daemon refused GetSurpriseMap: " + st.error().message);
+    }
+    return true;
+  }
+  // The daemon answers with the last frame that had a map: an older frame's is not this one's.
+  if (std::abs(answer->surprise_map().stamp_s() - stamp_s) > 1e-6) {
+    stats_.count("surprise_none");
+    return true;
+  }
+  out_.surprise(answer->surprise_map(), stamp_s, camera_frame);
+  stats_.count("surprise_sent");
   return true;
 }
 

@@ -29,6 +29,8 @@ struct Outputs {
   std::function<void(const proto::MapReply&, double stamp_s)> map;
   std::function<void(const MarkerScene&, double stamp_s)> markers;  ///< unset: no markers
   std::function<void(const proto::Pose& T_world_odom, double stamp_s)> odom;  ///< unset: no /tf
+  /// The frame's surprise heatmap, in the camera's frame; unset: no GetSurpriseMap calls.
+  std::function<void(const proto::SurpriseMapReply&, double stamp_s, const std::string& camera_frame)> surprise;
   std::function<void(const std::string&)> log;
 };
 
@@ -58,6 +60,9 @@ class DaemonLink {
   /// After a frame's objects: fetches the hands and publishes the markers. False: the connection
   /// broke.
   bool publish_markers(service::Client& client, const proto::IngestReply& ingest, const proto::ObjectsReply& objects, double stamp_s);
+  /// After a frame: fetches its surprise map and publishes it, when the daemon has one for this very
+  /// frame (none before the memory has keyframes). False: the connection broke.
+  bool publish_surprise(service::Client& client, double stamp_s, const std::string& camera_frame);
   /// One call; a transport error (down, or slower than call_timeout_s) is logged and closes the
   /// connection, and gives nothing.
   std::optional<proto::Response> call(service::Client& client, proto::Request request, const char* what);

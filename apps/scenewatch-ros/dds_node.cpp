@@ -81,6 +81,10 @@ Result<std::unique_ptr<DdsNode>> DdsNode::create(const BridgeConfig& config, Bri
                   !config.markers ? Status{}
                                   : entity(ns + "/markers", &visualization_msgs_msg_dds__MarkerArray__desc, Profile::kReliable, false,
                                            &node->markers_writer_),
+                  // An image like the camera's own: best effort, keep last 5 (rmw_qos_profile_sensor_data).
+                  !config.surprise ? Status{}
+                                   : entity(ns + "/surprise", &sensor_msgs_msg_dds__Image__desc, Profile::kSensorData, false,
+                                            &node->surprise_writer_),
                   // As a tf2_ros TransformBroadcaster (reliable, keep last 100, volatile).
                   !config.publish_odom_tf ? Status{} : entity("/tf", &tf2_msgs_msg_dds__TFMessage__desc, Profile::kTf, false, &node->tf_writer_)}) {
     if (!st) return st.error();
@@ -161,6 +165,11 @@ void DdsNode::write_map(const proto::MapReply& map, double stamp_s) {
 void DdsNode::write_markers(const MarkerScene& scene, double stamp_s) {
   if (markers_writer_ <= 0) return;
   written(ros::write_markers(markers_writer_, scene, stamp_s, config_.world_frame), "markers");
+}
+
+void DdsNode::write_surprise(const proto::SurpriseMapReply& map, double stamp_s, const std::string& camera_frame) {
+  if (surprise_writer_ <= 0) return;
+  written(write_surprise_image(surprise_writer_, map, stamp_s, camera_frame), "surprise");
 }
 
 void DdsNode::write_odom(const proto::Pose& T_world_odom, double stamp_s) {

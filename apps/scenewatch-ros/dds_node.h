@@ -35,6 +35,8 @@ class DdsNode {
   void write_markers(const MarkerScene& scene, double stamp_s);
   /// Only when config.publish_odom_tf: world -> odom on /tf.
   void write_odom(const proto::Pose& T_world_odom, double stamp_s);
+  /// Only when config.surprise: the heatmap as a 32FC1 sensor_msgs/Image in the camera's frame.
+  void write_surprise(const proto::SurpriseMapReply& map, double stamp_s, const std::string& camera_frame);
 
  private:
   DdsNode(const BridgeConfig& config, BridgeStats& stats) : config_(config), stats_(stats) {}
@@ -44,7 +46,7 @@ class DdsNode {
   BridgeStats& stats_;
   dds_entity_t participant_ = 0;
   dds_entity_t depth_reader_ = 0, color_reader_ = 0, info_reader_ = 0, tf_reader_ = 0, tf_static_reader_ = 0;
-  dds_entity_t events_writer_ = 0, objects_writer_ = 0, map_writer_ = 0, markers_writer_ = 0, tf_writer_ = 0;
+  dds_entity_t events_writer_ = 0, objects_writer_ = 0, map_writer_ = 0, markers_writer_ = 0, tf_writer_ = 0, surprise_writer_ = 0;
 };
 
 }  // namespace scenewatch::ros

@@ -35,6 +35,9 @@ constexpr const char* kDescription =
     "  octomap_binary  octomap_msgs/msg/Octomap            reliable, transient local (binary, id OcTree)\n"
     "  markers         visualization_msgs/msg/MarkerArray  reliable, keep last 10 (after every frame; for RViz:\n"
     "                  a DELETEALL, then planes, objects, labels, hands, events; --no-markers)\n"
+    "  surprise        sensor_msgs/msg/Image 32FC1         best effort, keep last 5 (after every frame the memory\n"
+    "                  predicts: the image surprise in nats per pixel, NaN where unknown, in the camera's frame;\n"
+    "                  --no-surprise)\n"
     "and, with --publish-odom-tf, --world-frame -> --odom-frame on /tf (reliable, keep last 100).\n"
     "Images and camera info are read best effort, keep last 5; /tf reliable; /tf_static transient local.\n"
     "Prints 'ready' on stdout once its DDS entities exist, and a stats line on exit (SIGINT, SIGTERM).\n"
@@ -90,6 +93,8 @@ void add_options(CLI::App& app, BridgeConfig& config, std::string& without_tf) {
                  "seconds between two octomap messages at most (the last frame's map is sent once the stream pauses)");
   app.add_flag("--no-markers", [&config](std::int64_t) { config.markers = false; },
                "publish no MarkerArray (saves a GetHands call per frame)");
+  app.add_flag("--no-surprise", [&config](std::int64_t) { config.surprise = false; },
+               "publish no surprise heatmap (saves a GetSurpriseMap call per frame)");
   app.add_option("--marker-events", config.marker_events, "the newest events drawn as markers (yellow boxes)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
@@ -119,6 +124,11 @@ Outputs outputs_to(DdsNode& dds, const BridgeConfig& config, std::function<void(
   outputs.map = [&dds](const scenewatch::proto::MapReply& map, double stamp_s) { dds.write_map(map, stamp_s); };
   if (config.publish_odom_tf) outputs.odom = [&dds](const scenewatch::proto::Pose& T, double stamp_s) { dds.write_odom(T, stamp_s); };
   if (config.markers) outputs.markers = [&dds](const MarkerScene& scene, double stamp_s) { dds.write_markers(scene, stamp_s); };
+  if (config.surprise) {
+    outputs.surprise = [&dds](const scenewatch::proto::SurpriseMapReply& map, double stamp_s, const std::string& frame) {
+      dds.write_surprise(map, stamp_s, frame);
+    };
+  }
   outputs.log = std::move(log);
   return outputs;
 }

@@ -194,4 +194,20 @@ dds_return_t write_octomap(dds_entity_t writer, const proto::MapReply& map, doub
   return dds_write(writer, &m);
 }
 
+dds_return_t write_surprise_image(dds_entity_t writer, const proto::SurpriseMapReply& map, double stamp_s, const std::string& camera_frame) {
+  static const std::string kEncoding = "32FC1";  // sensor_msgs/image_encodings.hpp TYPE_32FC1
+  const std::uint64_t bytes = std::uint64_t{map.width()} * map.height() * sizeof(float);
+  if (map.width() == 0 || map.height() == 0 || map.total().size() != bytes) return DDS_RETCODE_BAD_PARAMETER;
+  sensor_msgs_msg_dds__Image_ m{};
+  m.header = header(stamp_s, camera_frame);
+  m.height = map.height();
+  m.width = map.width();
+  m.encoding = c_str(kEncoding);
+  m.is_bigendian = 0;  // the reply's floats are little-endian, as this machine's
+  m.step = map.width() * static_cast<std::uint32_t>(sizeof(float));
+  m.data._length = m.data._maximum = static_cast<std::uint32_t>(bytes);
+  m.data._buffer = reinterpret_cast<std::uint8_t*>(const_cast<char*>(map.total().data()));
+  return dds_write(writer, &m);
+}
+
 }  // namespace scenewatch::ros

@@ -42,5 +42,9 @@ dds_return_t write_transform(dds_entity_t writer, const proto::Pose& T_parent_ch
                              const std::string& child);
 /// Writes the map as octomap_server does: binary, id "OcTree", data = OcTree::writeBinaryData.
 dds_return_t write_octomap(dds_entity_t writer, const proto::MapReply& map, double stamp_s, const std::string& world_frame);
+/// Writes a surprise map as a sensor_msgs/Image, encoding 32FC1 (nats per pixel, NaN where the
+/// memory predicts nothing), little-endian, in the camera's frame. A reply whose pixel bytes do not
+/// match its size writes nothing (DDS_RETCODE_BAD_PARAMETER).
+dds_return_t write_surprise_image(dds_entity_t writer, const proto::SurpriseMapReply& map, double stamp_s, const std::string& camera_frame);
 
 }  // namespace scenewatch::ros

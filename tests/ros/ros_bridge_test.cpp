@@ -18,6 +18,7 @@
 #include <memory>
 #include <numeric>
 #include <sstream>
+#include <cmath>
 #include <cstring>
 
 #include "daemon_harness.h"
@@ -110,6 +111,8 @@ class CameraPeer {
     objects_r_ = peer_.entity("/scenewatch/objects", &vision_msgs_msg_dds__Detection3DArray__desc, true, true, 100);
     map_r_ = peer_.entity("/scenewatch/octomap_binary", &octomap_msgs_msg_dds__Octomap__desc, true, true, 1, true);
     markers_r_ = peer_.entity("/scenewatch/markers", &visualization_msgs_msg_dds__MarkerArray__desc, true, true, 100);
+    // Best effort, as the bridge writes it (a reliable reader would not match a best-effort writer).
+    surprise_r_ = peer_.entity("/scenewatch/surprise", &sensor_msgs_msg_dds__Image__desc, true, false, 100);
     // world -> rig: fixed and not the identity, so the bridge must chain a static and a timed link.
     T_world_rig_.translation() = Eigen::Vector3d(0.3, -0.2, 0.1);
     T_world_rig_.linear() = Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitZ()).toRotationMatrix();
@@ -119,7 +122,7 @@ class CameraPeer {
   /// when `markers`), then sends /tf_static.
   bool connect(double timeout_s, bool markers = true) {
     std::vector<dds_entity_t> readers{events_r_, objects_r_, map_r_};
-    if (markers) readers.push_back(markers_r_);
+    if (markers) readers.push_back(markers_r_), readers.push_back(surprise_r_);
     if (!DdsPeer::wait_matched({depth_w_, color_w_, info_w_, tf_w_, tf_static_w_}, readers, timeout_s)) return false;
     auto t = transform(T_world_rig_, kStamp0, root_frame_.c_str(), "rig");
     tf2_msgs_msg_dds__TFMessage_ m{};
@@ -195,15 +198,38 @@ class CameraPeer {
     return out;
   }
 
+  /// A surprise heatmap as received: its header, layout and pixel bytes.
+  struct Heatmap {
+    double stamp_s = 0;
+    std::string frame_id, encoding;
+    std::uint32_t width = 0, height = 0, step = 0;
+    std::uint8_t is_bigendian = 1;
+    std::string data;
+  };
+  /// Every heatmap that has arrived, until the one stamped `last_stamp` or timeout_s.
+  std::vector<Heatmap> heatmaps_until(double last_stamp, double timeout_s) {
+    std::vector<Heatmap> out;
+    const auto start = Clock::now();
+    while ((out.empty() || std::abs(out.back().stamp_s - last_stamp) > 1e-6) && ms_since(start) < timeout_s * 1000) {
+      DdsPeer::take<sensor_msgs_msg_dds__Image_>(surprise_r_, [&](const sensor_msgs_msg_dds__Image_& m) {
+        out.push_back({ros::seconds(m.header.stamp), m.header.frame_id ? m.header.frame_id : "", m.encoding ? m.encoding : "", m.width,
+                       m.height, m.step, m.is_bigendian, std::string(reinterpret_cast<const char*>(m.data._buffer), m.data._length)});
+      });
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return out;
+  }
+
   dds_entity_t events_reader() const { return events_r_; }
   dds_entity_t markers_reader() const { return markers_r_; }
+  dds_entity_t surprise_reader() const { return surprise_r_; }
   dds_entity_t map_reader() const { return map_r_; }
 
  private:
   DdsPeer peer_;
   std::string root_frame_;
   dds_entity_t depth_w_ = 0, color_w_ = 0, info_w_ = 0, tf_w_ = 0, tf_static_w_ = 0, events_r_ = 0, objects_r_ = 0, map_r_ = 0,
-               markers_r_ = 0;
+               markers_r_ = 0, surprise_r_ = 0;
   Pose T_world_rig_ = Pose::Identity();
 };
 
@@ -435,6 +461,37 @@ TEST_F(RosBridgeTest, CupAddedOverDdsGivesOneEventTheObjectsAndTheMap) {
 
   expect_markers(marker_arrays, objects.objects().objects(), event_boxes.at(0), cup_center, scenario.table.height_m);
 
+  // The surprise heatmaps: one per frame the memory could predict (every frame after the first,
+  // which became its first keyframe), 32FC1 in the camera's frame; the last one is, byte for
+  // byte, the daemon's GetSurpriseMap.
+  const auto heatmaps = camera.heatmaps_until(stamps.back(), kFrameWaitS);
+  const auto surprise = call(client, request([](proto::Request& r) { r.mutable_get_surprise_map(); }));
+  ASSERT_EQ(surprise.status().code(), proto::Status::OK) << surprise.status().message();
+  ASSERT_FALSE(heatmaps.empty()) << "no surprise heatmap";
+  EXPECT_GE(heatmaps.size(), stamps.size() - 1) << "best effort on loopback: none should be lost";
+  for (const auto& h : heatmaps) {
+    EXPECT_EQ(h.encoding, "32FC1");
+    EXPECT_EQ(h.frame_id, "camera_optical");
+    EXPECT_EQ(h.is_bigendian, 0);
+    EXPECT_EQ(h.width, surprise.surprise_map().width());
+    EXPECT_EQ(h.height, surprise.surprise_map().height());
+    EXPECT_EQ(h.step, 4 * h.width);
+    EXPECT_EQ(h.data.size(), static_cast<std::size_t>(h.step) * h.height);
+    EXPECT_NE(std::find_if(stamps.begin(), stamps.end(), [&](double t) { return std::abs(t - h.stamp_s) < 1e-6; }), stamps.end());
+  }
+  ASSERT_LT(std::abs(heatmaps.back().stamp_s - stamps.back()), 1e-6) << "no heatmap of the last frame";
+  EXPECT_LT(std::abs(surprise.surprise_map().stamp_s() - stamps.back()), 1e-6);
+  EXPECT_TRUE(heatmaps.back().data == surprise.surprise_map().total()) << "the last heatmap is not the daemon's";
+  std::size_t finite = 0;
+  for (std::size_t i = 0; i + 4 <= heatmaps.back().data.size(); i += 4) {
+    float v;
+    std::memcpy(&v, heatmaps.back().data.data() + i, 4);
+    finite += std::isfinite(v);
+  }
+  EXPECT_GT(finite, 0u) << "the memory predicts no pixel of the last frame";
+  std::printf("surprise heatmaps: %zu of %zu frames, %ux%u, %zu pixels predicted in the last\n", heatmaps.size(), stamps.size(),
+              heatmaps.back().width, heatmaps.back().height, finite);
+
   // The map: the Octomap of the last frame, read by OctoMap's readBinaryData, is the tree the daemon
   // saves (same resolution, same nodes, same occupancy leaf for leaf).
   std::unique_ptr<octomap::OcTree> received;
@@ -554,7 +611,7 @@ TEST_F(RosBridgeTest, TheDaemonsOdometryCorrectionIsPublishedOnTf) {
 
 // The daemon vanishes (killed) and comes back on the same port: the bridge keeps running,
 // reconnects with backoff and carries on. A frame whose TF never comes is dropped with its reason
-// counted, not sent. Run with --no-markers, which must leave no markers topic.
+// counted, not sent. Run with --no-markers and --no-surprise, which must leave neither topic.
 TEST_F(RosBridgeTest, AVanishedDaemonIsReconnectedToAndAFrameWithoutTfIsDropped) {
   const std::uint32_t domain = configure_loopback_dds();
   ShippedScenario shipped = shipped_scenario("cup_added", 320, 240, 4);
@@ -589,7 +646,8 @@ TEST_F(RosBridgeTest, AVanishedDaemonIsReconnectedToAndAFrameWithoutTfIsDropped)
   std::vector<std::string> argv{bridge_binary().string(), "--port", std::to_string(port), "--token-file", (tmp_ / "token").string(),
                                 "--world-frame", "world", "--camera-frame", "camera_optical", "--depth-topic",
                                 "/camera/depth/image_rect_raw", "--color-topic", "/camera/color/image_raw", "--info-topic",
-                                "/camera/depth/camera_info", "--max-backoff", "0.5", "--tf-wait", "0.2", "--no-markers"};
+                                "/camera/depth/camera_info", "--max-backoff", "0.5", "--tf-wait", "0.2", "--no-markers",
+                                "--no-surprise"};
   auto child = ChildProcess::start(argv, tmp_ / "scenewatch-ros.log");
   ASSERT_TRUE(child.has_value());
   bridge_ = std::make_unique<ChildProcess>(std::move(*child));
@@ -621,13 +679,17 @@ TEST_F(RosBridgeTest, AVanishedDaemonIsReconnectedToAndAFrameWithoutTfIsDropped)
   daemon = start_daemon(2);
   EXPECT_TRUE(sent_and_answered(kFrameWaitS)) << "no objects after the daemon came back";
 
-  // --no-markers: no MarkerArray writer at all, and no GetHands per frame.
-  dds_subscription_matched_status_t markers_matched{};
-  dds_get_subscription_matched_status(camera.markers_reader(), &markers_matched);
-  EXPECT_EQ(markers_matched.total_count, 0u);
+  // --no-markers, --no-surprise: no MarkerArray or heatmap writer at all, no GetHands or
+  // GetSurpriseMap per frame.
+  for (dds_entity_t reader : {camera.markers_reader(), camera.surprise_reader()}) {
+    dds_subscription_matched_status_t matched{};
+    dds_get_subscription_matched_status(reader, &matched);
+    EXPECT_EQ(matched.total_count, 0u);
+  }
   const auto [code, stats] = stop_bridge();
   EXPECT_EQ(code, std::optional<int>(0)) << bridge_->stderr_text();
   EXPECT_EQ(stats.find("markers_sent"), std::string::npos) << stats;
+  EXPECT_EQ(stats.find("surprise_"), std::string::npos) << stats;
   EXPECT_NE(stats.find("dropped.no_tf=1"), std::string::npos) << stats;
   EXPECT_NE(stats.find("reconnects.ingest="), std::string::npos) << stats;
   EXPECT_NE(bridge_->stderr_text().find("(no_tf, 1 so far)"), std::string::npos) << bridge_->stderr_text();
