@@ -294,6 +294,10 @@ Localization Localizer::align_with_keyframes(Attempt& at, const Localization& ou
       r.state = State::kLost;
       r.reason = "no keyframe of the memory sees towards the prior";
     }
+    // A camera starting without a pose and without keyframes (a memory that keeps none) steps
+    // from this frame on.
+    if (tracking && r.placed() && !at.current)
+      at.current = std::make_shared<const RgbdPyramid>(build_pyramid(*frame.cloud, *frame.intrinsics, sensor_, config_.pyramid, true));
     return r;
   }
   if (!at.current)
