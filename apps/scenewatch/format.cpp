@@ -284,7 +284,13 @@ std::string text(const proto::LocalizationResult& l) {
   out << "  last correction " << fixed(1000 * l.odom_change_m(), 1) << " mm, " << fixed(l.odom_change_deg(), 2) << " deg of T_world_odom; "
       << fixed(1000 * l.correction_m(), 1) << " mm, " << fixed(l.correction_deg(), 2) << " deg from the given pose\n"
       << "  quality         " << fixed(100 * l.inlier_fraction(), 1) << " % depth inliers, residual " << fixed(1000 * l.residual_m(), 1)
-      << " mm, keyframe " << l.reference_keyframe();
+      << " mm";
+  // Aligned to a keyframe, or (track mode, reference 0 with a measured fit) to the camera's previous frame.
+  if (l.reference_keyframe() != 0) {
+    out << ", keyframe " << l.reference_keyframe();
+  } else if (l.inlier_fraction() > 0) {
+    out << ", the previous frame";
+  }
   if (l.relocalized()) out << "; relocalized: " << l.feature_inliers() << " of " << l.feature_matches() << " feature matches, "
                            << fixed(l.relocalization_ms(), 1) << " ms";
   out << "\n";

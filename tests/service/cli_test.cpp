@@ -544,6 +544,9 @@ TEST_F(CliTest, IngestTakesOneFrameOrARangeOfASequence) {
   result = remote({"localization"});
   ASSERT_EQ(result.exit_code, 0) << result.err;
   EXPECT_NE(result.out.find("camera 'arm': given"), std::string::npos) << result.out;
+  // Given poses are aligned to nothing: the quality line names no keyframe and no previous frame.
+  EXPECT_EQ(result.out.find("keyframe"), std::string::npos) << result.out;
+  EXPECT_EQ(result.out.find("the previous frame"), std::string::npos) << result.out;
   result = remote({"localization", "--camera", "nope"});
   EXPECT_EQ(result.exit_code, 1);
   EXPECT_NE(result.err.find("camera 'nope'"), std::string::npos) << result.err;
