@@ -24,6 +24,14 @@ bool organized_with_intrinsics(const Frame& f) {
          f.cloud->height == static_cast<std::uint32_t>(f.intrinsics->height);
 }
 
+/// A frame's pyramid in `slot`, built on first use: once per frame whichever step asks first (a
+/// reference one when tracking, as it becomes the camera's previous frame).
+const RgbdPyramid& frame_pyramid(std::shared_ptr<const RgbdPyramid>& slot, const Frame& f, const SensorModel& sensor,
+                                 const PyramidConfig& config, bool reference) {
+  if (!slot) slot = std::make_shared<const RgbdPyramid>(build_pyramid(*f.cloud, *f.intrinsics, sensor, config, reference));
+  return *slot;
+}
+
 }  // namespace
 
 struct Localizer::Track {
@@ -296,13 +304,10 @@ Localization Localizer::align_with_keyframes(Attempt& at, const Localization& ou
     }
     // A camera starting without a pose and without keyframes (a memory that keeps none) steps
     // from this frame on.
-    if (tracking && r.placed() && !at.current)
-      at.current = std::make_shared<const RgbdPyramid>(build_pyramid(*frame.cloud, *frame.intrinsics, sensor_, config_.pyramid, true));
+    if (tracking && r.placed()) frame_pyramid(at.current, frame, sensor_, config_.pyramid, true);
     return r;
   }
-  if (!at.current)
-    at.current = std::make_shared<const RgbdPyramid>(build_pyramid(*frame.cloud, *frame.intrinsics, sensor_, config_.pyramid, tracking));
-  const RgbdPyramid& current = *at.current;
+  const RgbdPyramid& current = frame_pyramid(at.current, frame, sensor_, config_.pyramid, tracking);
   Localization best = out;
   best.state = State::kLost;
   std::optional<Alignment> aligned;
@@ -339,13 +344,12 @@ Localization Localizer::align_with_keyframes(Attempt& at, const Localization& ou
 
 std::optional<Localization> Localizer::step_from_previous(Attempt& at, const Localization& out) {
   Track& track = at.track;
-  at.current = std::make_shared<const RgbdPyramid>(
-      build_pyramid(*at.frame.cloud, *at.frame.intrinsics, sensor_, config_.pyramid, true));
+  const RgbdPyramid& current = frame_pyramid(at.current, at.frame, sensor_, config_.pyramid, true);
   // From the last motion, and from standing still: a wrong rotation in the last motion (0.6-0.9
   // degrees a frame on redkitchen_long) can lead the alignment into a false minimum where fewer
   // pixels agree. The one more of the frame agrees with wins.
-  Alignment a = align(*track.previous, *at.current, track.motion, sensor_, config_.alignment);
-  Alignment still = align(*track.previous, *at.current, Pose::Identity(), sensor_, config_.alignment);
+  Alignment a = align(*track.previous, current, track.motion, sensor_, config_.alignment);
+  Alignment still = align(*track.previous, current, Pose::Identity(), sensor_, config_.alignment);
   if (still.inlier_fraction > a.inlier_fraction) a = std::move(still);
   Localization r = out;
   if (!accept(r, a, track.last, "the previous frame")) return std::nullopt;
