@@ -159,11 +159,13 @@ int run_sensor_model(const Options& o) {
       {"every pixel evidence", [](pipeline::Config& c) { c.change.trusted_pixels_only = false; }},
       {"no per-camera witness", [](pipeline::Config& c) { c.change.witness_per_camera = false; }},
       {"head-on noise only", [](pipeline::Config& c) { c.change.incidence_aware = false; }},
+      {"colour not registered", [](pipeline::Config& c) { c.sensor.fit_colour_registration = false; }},
       {"none of these", [](pipeline::Config& c) {
          c.change.measure_pose = false;
          c.change.trusted_pixels_only = false;
          c.change.witness_per_camera = false;
          c.change.incidence_aware = false;
+         c.sensor.fit_colour_registration = false;
        }},
   });
   return 0;

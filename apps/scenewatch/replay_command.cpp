@@ -157,6 +157,9 @@ void print_summary(const Tally& t, const pipeline::Stats& stats, double wall_s, 
                                                 {"median_correction_deg", percentile(t.located.correction_deg, 0.5)},
                                                 {"median_ms", percentile(t.located.ms, 0.5)}}}};
     for (const auto& [stage, v] : t.stage_ms) summary["median_stage_ms"][stage] = percentile(v, 0.5);
+    for (const auto& [camera, r] : stats.colour_registration) {
+      summary["colour_registration"][camera] = {{"scale", r.scale}, {"shift_x_px", r.shift_x_px}, {"shift_y_px", r.shift_y_px}};
+    }
     std::cout << summary.dump() << "\n";
     return;
   }
@@ -169,6 +172,10 @@ void print_summary(const Tally& t, const pipeline::Stats& stats, double wall_s, 
   std::printf("\nmodel: %zu tracked objects, %zu keyframes, %zu occupied voxels; hands seen in %zu frames\n",
               stats.tracked_objects, stats.keyframes, stats.map_occupied_leaves, t.frames_with_hands);
   std::printf("%s\n", t.located.line().c_str());
+  for (const auto& [camera, r] : stats.colour_registration) {
+    std::printf("colour registered to depth (%s): scale %.4f, shift %+.1f, %+.1f px\n", camera.empty() ? "default camera" : camera.c_str(),
+                r.scale, r.shift_x_px, r.shift_y_px);
+  }
 }
 
 }  // namespace

@@ -59,6 +59,7 @@ Status read_sensor(const YAML::Node& node, SensorModel& sensor) {
                          [&] { return s.read("max_range_m", sensor.max_range_m); },
                          [&] { return s.read("border_px", sensor.border_px); },
                          [&] { return s.read("registration_px", sensor.registration_px); },
+                         [&] { return s.read("fit_colour_registration", sensor.fit_colour_registration); },
                          [&] { return s.read("pose_sigma_m", sensor.pose_sigma_m); },
                          [&] { return s.read("pose_sigma_deg", sensor.pose_sigma_deg); });
       !st)

@@ -10,6 +10,7 @@
 
 #include "appearance_stage.h"
 #include "camera_registry.h"
+#include "colour_registration_stage.h"
 #include "compose_snapshot.h"
 #include "event_log.h"
 #include "foreground_stage.h"
@@ -48,7 +49,7 @@ Config with_sensor(Config c) {
 
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
-      : map(c), appearance(c.appearance, c.surprise), localizer(c.localization, c.sensor), tracker(c.tracking),
+      : map(c), appearance(c.appearance, c.surprise), localizer(c.localization, c.sensor), colour(c.sensor), tracker(c.tracking),
         fusion(c.fusion), foreground(c.foreground), snapshot(std::make_shared<SceneSnapshot>()), up(c.segmentation.up) {}
 
   // process() and the other writers hold this for their whole duration.
@@ -56,6 +57,7 @@ struct WorkingMemory::Impl {
   MapStage map;                       // the background map and the change detection; locks itself for readers
   AppearanceStage appearance;         // keyframes, mesh and image surprise; locks itself for readers
   localization::Localizer localizer;  // where each camera is, against the keyframes (writer only)
+  ColourRegistrationStage colour;     // each camera's colour laid onto its depth (writer only)
 
   // Owned by the writer.
   ObjectTracker tracker;
@@ -103,6 +105,7 @@ struct WorkingMemory::Impl {
       foreground.forget_camera(*forgotten);
       appearance.forget_camera(*forgotten);
       localizer.forget_camera(*forgotten);
+      colour.forget_camera(*forgotten);
       planes_by_camera.erase(*forgotten);
     }
     return id;
@@ -122,16 +125,17 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   result.frame_index = m.frames;
   result.points = *valid_points;
   const std::uint32_t camera_id = m.camera_of(original);
+  const Frame registered = m.colour.registered(original, camera_id);
   // Where the frame was taken, against the memory; a camera that is lost changes nothing.
   result.localization = m.localizer.localize(
-      original, camera_id, [&](const Pose& p, std::size_t n) { return m.appearance.nearest(p, n); },
+      registered, camera_id, [&](const Pose& p, std::size_t n) { return m.appearance.nearest(p, n); },
       [&] { return m.appearance.all_keyframes(); });
   if (!result.localization.placed()) {
     ++m.frames;
     result.total_ms = ms_since(t0);
     return result;
   }
-  const Frame frame = placed(original, result.localization);
+  const Frame frame = placed(registered, result.localization);
   const Pose T = frame.pose_or_identity();
   // Hands, the person and the foreground objects are blanked out of what the background sees.
   // The planes this camera saw last (world frame); a camera's first frame starts from the model's.
@@ -206,6 +210,9 @@ Stats WorkingMemory::stats() const {
     s.keyframes = impl_->appearance.keyframes();
     s.mesh_triangles = impl_->appearance.triangles();
     s.appearance_memory_bytes = impl_->appearance.memory_bytes();
+    const auto measured = impl_->colour.measured();
+    for (const auto& [name, id] : impl_->cameras.names())
+      if (auto it = measured.find(id); it != measured.end()) s.colour_registration[name] = it->second;
     impl_->map.read([&](const background::OccupancyMap& map) {
       s.map_leaf_nodes = map.num_leaf_nodes();
       s.map_occupied_leaves = map.num_occupied_leaves();
@@ -284,6 +291,7 @@ void WorkingMemory::reset() {
   m.foreground.reset();
   m.planes.clear();
   m.planes_by_camera.clear();
+  m.colour.reset();
   m.cameras.reset();
   m.last_camera = Pose::Identity();
   m.frames = m.points = 0;
@@ -370,6 +378,7 @@ Status WorkingMemory::load_snapshot(const fs::path& dir) {
   m.fusion.reset();
   m.planes = std::move(scene->planes);
   m.planes_by_camera.clear();
+  m.colour.reset();
   m.cameras.reset();
   m.frames = scene->frames;
   m.points = scene->points;

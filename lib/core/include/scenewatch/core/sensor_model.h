@@ -45,6 +45,11 @@ struct SensorModel {
   /// Misregistration between colour and depth, pixels: colour at a depth edge may belong to the
   /// other side. 7-Scenes' colour and depth are known not to be registered exactly.
   double registration_px = 2.0;
+  /// Measure each camera's colour-to-depth registration from its first frames (depth contours
+  /// against colour edges, core/colour_registration.h) and lay the colour onto the depth before
+  /// anything reads it. A raw Kinect v1 recording's colour lies 10 % nearer the image centre and
+  /// some pixels aside (7-Scenes); a driver-registered one within a few pixels.
+  bool fit_colour_registration = true;
   /// How well the pose given with a frame is known, 1 sigma: the pose source's accuracy, where
   /// it is known (motion capture: 1 mm; an arm's kinematics; a SLAM system's). The change
   /// detector also measures each frame's misalignment against the map and takes the larger

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/core/colour_registration.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
@@ -47,6 +48,8 @@ struct Stats {
   double last_frame_ms = 0, mean_frame_ms = 0;
   std::size_t tracked_objects = 0;  ///< the object list's length (snapshot().objects): background and foreground
   std::size_t keyframes = 0, mesh_triangles = 0, appearance_memory_bytes = 0;
+  /// Each camera's colour-to-depth registration as its frames measured it (sensor.fit_colour_registration), by camera name.
+  std::map<std::string, ColourRegistration> colour_registration;
 };
 
 using EventCallback = std::function<void(const Event&)>;
