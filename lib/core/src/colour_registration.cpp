@@ -43,28 +43,30 @@ Plane colour_gradient(const Cloud& cloud) {
   return g;
 }
 
-/// A separable box filter of the given radius: widens the gradient's ridges so that a search on
-/// a coarse grid of hypotheses still feels the slope towards the right one.
-Plane box_blur(const Plane& in, int radius) {
-  Plane tmp = in, out = in;
-  const int w = in.width, h = in.height;
+/// One pass of a box filter of the given radius, along rows or along columns.
+Plane box_pass(const Plane& in, int radius, bool along_rows) {
+  Plane out = in;
+  const int w = in.width, h = in.height, n = along_rows ? w : h;
   for (int v = 0; v < h; ++v) {
     for (int u = 0; u < w; ++u) {
+      const int at = along_rows ? u : v;
       float sum = 0;
-      int n = 0;
-      for (int k = std::max(0, u - radius); k <= std::min(w - 1, u + radius); ++k, ++n) sum += in.at(k, v);
-      tmp.values[static_cast<std::size_t>(v) * w + u] = sum / n;
-    }
-  }
-  for (int v = 0; v < h; ++v) {
-    for (int u = 0; u < w; ++u) {
-      float sum = 0;
-      int n = 0;
-      for (int k = std::max(0, v - radius); k <= std::min(h - 1, v + radius); ++k, ++n) sum += tmp.at(u, k);
-      out.values[static_cast<std::size_t>(v) * w + u] = sum / n;
+      int count = 0;
+      for (int k = std::max(0, at - radius); k <= std::min(n - 1, at + radius); ++k, ++count)
+        sum += along_rows ? in.at(k, v) : in.at(u, k);
+      out.values[static_cast<std::size_t>(v) * w + u] = sum / count;
     }
   }
   return out;
+}
+
+/// A separable box filter of the given radius: widens the gradient's ridges so that a search on
+/// a coarse grid of hypotheses still feels the slope towards the right one.
+Plane box_blur(const Plane& in, int radius) { return box_pass(box_pass(in, radius, true), radius, false); }
+
+/// The depth camera's principal point, or the image's centre when the intrinsics are unknown.
+Eigen::Vector2d principal_point(const Intrinsics& K, int width, int height) {
+  return K.fx > 0 && K.fy > 0 ? Eigen::Vector2d(K.cx, K.cy) : Eigen::Vector2d((width - 1) / 2.0, (height - 1) / 2.0);
 }
 
 struct EdgePoint {
@@ -163,8 +165,8 @@ double ColourRegistration::max_displacement_px(int width, int height, double cx,
 std::optional<ColourRegistrationFit> fit_colour_registration(const Cloud& organized, const Intrinsics& K,
                                                              const SensorModel& sensor) {
   if (organized.height < 8 || organized.width < 8) return std::nullopt;
-  const int w = static_cast<int>(organized.width), h = static_cast<int>(organized.height);
-  const double cx = K.fx > 0 ? K.cx : (w - 1) / 2.0, cy = K.fy > 0 ? K.cy : (h - 1) / 2.0;
+  const Eigen::Vector2d c = principal_point(K, static_cast<int>(organized.width), static_cast<int>(organized.height));
+  const double cx = c.x(), cy = c.y();
   const std::vector<EdgePoint> edges = depth_edges(organized, K.fx > 0 ? K.fx : 525.0, sensor);
   if (edges.size() < organized.width) return std::nullopt;
   const Plane gradient = colour_gradient(organized);
@@ -192,7 +194,8 @@ std::optional<ColourRegistrationFit> fit_colour_registration(const Cloud& organi
 ColourRemap::ColourRemap(int width, int height, const Intrinsics& K, const ColourRegistration& r)
     : width_(width), height_(height) {
   if (width < 2 || height < 2) return;
-  const double cx = K.fx > 0 ? K.cx : (width - 1) / 2.0, cy = K.fy > 0 ? K.cy : (height - 1) / 2.0;
+  const Eigen::Vector2d c = principal_point(K, width, height);
+  const double cx = c.x(), cy = c.y();
   const std::size_t n = static_cast<std::size_t>(width) * height;
   tap_.resize(n);
   ax_.resize(n);

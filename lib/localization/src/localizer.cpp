@@ -323,14 +323,13 @@ Localization Localizer::align_with_keyframes(Attempt& at, const Localization& ou
       if (still.inlier_fraction > a.inlier_fraction) a = std::move(still);
     }
     Localization r = out;
+    r.reference_keyframe = keyframe->id;
     if (accept(r, a, keyframe->T_world_camera, "keyframe " + std::to_string(keyframe->id))) {
-      r.reference_keyframe = keyframe->id;
       best = r;
       aligned = a;
       aligned_to = keyframe.get();
       break;
     }
-    r.reference_keyframe = keyframe->id;
     if (best.reference_keyframe == 0 || r.inlier_fraction > best.inlier_fraction) best = r;
   }
   if (!aligned) {
