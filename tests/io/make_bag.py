@@ -7,8 +7,10 @@ container are theirs, not ours.
 
 rosbag2 SQLite (--format rosbag2): the container (metadata.yaml, .db3 with rosbag2's topics and
 messages tables) written with Python's sqlite3 module, and each message serialized to CDR
-(XCDR1 little-endian) by hand in this script, from the .msg definitions. This part is ours, not an
-independent tool's.
+(XCDR1 little-endian) by hand in this script, from the .msg definitions: ours, not an independent
+tool's. With --cdr-tool (tests/ros/cyclone_cdr), every message is serialized by Cyclone DDS
+instead, as a ROS 2 recorder on rmw_cyclonedds_cpp stores it (its encapsulation options and
+trailing padding included).
 
 Topics: /camera/color/image_raw (bgr8), /camera/depth/image_raw (16UC1 mm or 32FC1 m),
 /camera/depth/camera_info, /tf (world -> camera_link, one per frame), /tf_static
@@ -16,13 +18,15 @@ Topics: /camera/color/image_raw (bgr8), /camera/depth/image_raw (16UC1 mm or 32F
 
 MCAP (--format mcap, chunks none, lz4 or zstd via Debian's python3-lz4 and python3-zstandard): the
 container written by this script from the published specification, messages in the same
-hand-serialized CDR. Also ours.
+hand-serialized CDR (or Cyclone's, with --cdr-tool).
 """
 import argparse
 import math
 import os
 import sqlite3
 import struct
+import subprocess
+import sys
 
 import cv2
 import numpy as np
@@ -257,13 +261,57 @@ def cdr_info(t, frame, height, width, K):
     return bytes(c.b)
 
 
+class HandCdr:
+    """The messages serialized by this script."""
+    image = staticmethod(cdr_image)
+    tf = staticmethod(cdr_tf)
+    info = staticmethod(cdr_info)
+
+
+class CycloneCdr:
+    """The messages serialized by Cyclone DDS (tests/ros/cyclone_cdr.cpp, protocol there)."""
+
+    def __init__(self, tool):
+        self.p = subprocess.Popen([tool], stdin=subprocess.PIPE, stdout=subprocess.PIPE)
+
+    def ask(self, text, data=b""):
+        self.p.stdin.write(text.encode() + b"\n" + data)
+        self.p.stdin.flush()
+        head = self.p.stdout.read(4)
+        if len(head) != 4:
+            sys.exit("cyclone_cdr gave no answer to: " + text.split("\n")[0])
+        return self.p.stdout.read(struct.unpack("<I", head)[0])
+
+    @staticmethod
+    def stamp(t, frame):
+        sec = int(math.floor(t))
+        return "%d %d %s" % (sec, int(round((t - sec) * 1e9)), frame)
+
+    def image(self, t, frame, height, width, encoding, step, data):
+        return self.ask("image %s %d %d %s %d %d" % (self.stamp(t, frame), height, width, encoding, step, len(data)), data)
+
+    def tf(self, transforms):
+        lines = ["tf %d" % len(transforms)]
+        for t, parent, child, T in transforms:
+            values = [float(v) for v in T[:3, 3]] + [float(v) for v in quaternion(T[:3, :3])]
+            lines.append("%s %s %s" % (self.stamp(t, parent), child, " ".join(repr(v) for v in values)))
+        return self.ask("\n".join(lines))
+
+    def info(self, t, frame, height, width, K):
+        P = (K[0, 0], 0, K[0, 2], 0, 0, K[1, 1], K[1, 2], 0, 0, 0, 1, 0)
+        values = [0.0] * 5 + list(K.flatten()) + [1.0, 0, 0, 0, 1.0, 0, 0, 0, 1.0] + list(P)
+        return self.ask("info %s %d %d plumb_bob 5 %s" % (self.stamp(t, frame), height, width,
+                                                          " ".join(repr(float(v)) for v in values)))
+
+
 TOPICS = [("/tf", "tf2_msgs/msg/TFMessage"), ("/tf_static", "tf2_msgs/msg/TFMessage"),
           ("/camera/depth/camera_info", "sensor_msgs/msg/CameraInfo"), ("/camera/depth/image_raw", "sensor_msgs/msg/Image"),
           ("/camera/color/image_raw", "sensor_msgs/msg/Image")]
 
 
-def cdr_rows(K, frames, depth_encoding, t0):
+def cdr_rows(K, frames, depth_encoding, t0, cdr):
     """(topic id in TOPICS from 1, time, CDR bytes) of every message, in order."""
+    cdr_image, cdr_tf, cdr_info = cdr.image, cdr.tf, cdr.info
     rows = []
     T_link_optical = np.eye(4)
     T_link_optical[:3, :3] = R_LINK_OPTICAL
@@ -279,7 +327,7 @@ def cdr_rows(K, frames, depth_encoding, t0):
     return rows
 
 
-def write_rosbag2(folder, K, frames, depth_encoding, t0):
+def write_rosbag2(folder, K, frames, depth_encoding, t0, cdr):
     os.makedirs(folder, exist_ok=True)
     db_name = os.path.basename(folder.rstrip("/")) + "_0.db3"
     db = sqlite3.connect(os.path.join(folder, db_name))
@@ -288,7 +336,7 @@ def write_rosbag2(folder, K, frames, depth_encoding, t0):
     db.execute("CREATE TABLE messages(id INTEGER PRIMARY KEY, topic_id INTEGER NOT NULL, timestamp INTEGER NOT NULL, data BLOB NOT NULL)")
     for i, (name, type_) in enumerate(TOPICS, 1):
         db.execute("INSERT INTO topics VALUES (?, ?, ?, 'cdr', '')", (i, name, type_))
-    rows = cdr_rows(K, frames, depth_encoding, t0)
+    rows = cdr_rows(K, frames, depth_encoding, t0, cdr)
     for topic, t, data in rows:
         db.execute("INSERT INTO messages(topic_id, timestamp, data) VALUES (?, ?, ?)", (topic, int(round(t * 1e9)), data))
     db.commit()
@@ -298,7 +346,7 @@ def write_rosbag2(folder, K, frames, depth_encoding, t0):
                 "  relative_file_paths:\n    - %s\n  message_count: %d\n" % (db_name, len(rows)))
 
 
-def write_mcap(path, K, frames, depth_encoding, compression, t0, lie_crc):
+def write_mcap(path, K, frames, depth_encoding, compression, t0, lie_crc, cdr):
     """MCAP from its specification (mcap.dev/spec): a Header, one Schema and one Channel per
     topic, the messages in chunks of one frame each (CRC-32 of the uncompressed records), Data End,
     an empty summary, Footer. Written by us, not by an independent tool."""
@@ -317,7 +365,7 @@ def write_mcap(path, K, frames, depth_encoding, compression, t0, lie_crc):
     for i, (name, type_) in enumerate(TOPICS, 1):
         out += record(0x03, struct.pack("<H", i) + string(type_) + string("ros2msg") + struct.pack("<I", 0))
         out += record(0x04, struct.pack("<HH", i, i) + string(name) + string("cdr") + struct.pack("<I", 0))
-    rows = cdr_rows(K, frames, depth_encoding, t0)
+    rows = cdr_rows(K, frames, depth_encoding, t0, cdr)
     # One chunk per frame: the rows from one /tf message to the next.
     groups, current = [], []
     for row in rows:
@@ -366,17 +414,19 @@ def main():
     p.add_argument("--lie-crc", action="store_true", help="mcap: every chunk's CRC off by one bit")
     p.add_argument("--oracle", help="also write the frames as a folder with the bag's (rigid) poses here")
     p.add_argument("--depth-encoding", choices=["16UC1", "32FC1"], default="16UC1")
+    p.add_argument("--cdr-tool", help="rosbag2, mcap: serialize the messages with this tests/ros/cyclone_cdr")
     a = p.parse_args()
     K, frames = load(a.folder, a.first, a.count)
     t0 = 1700000000.0
     if a.oracle:
         write_oracle(a.folder, a.oracle, a.first, a.count, frames)
+    cdr = CycloneCdr(a.cdr_tool) if a.cdr_tool else HandCdr
     if a.format == "ros1":
         write_ros1(a.out, K, frames, a.depth_encoding, a.compression, t0)
     elif a.format == "rosbag2":
-        write_rosbag2(a.out, K, frames, a.depth_encoding, t0)
+        write_rosbag2(a.out, K, frames, a.depth_encoding, t0, cdr)
     else:
-        write_mcap(a.out, K, frames, a.depth_encoding, a.compression, t0, a.lie_crc)
+        write_mcap(a.out, K, frames, a.depth_encoding, a.compression, t0, a.lie_crc, cdr)
 
 
 if __name__ == "__main__":

@@ -1,10 +1,11 @@
 #!/usr/bin/python3
 """`scenewatch replay --json --objects` on ROS bags gives the same events, objects and summary as
-on the same frames read from the folder (usage: replay_bag.py SCENEWATCH DATA_DIR).
+on the same frames read from the folder (usage: replay_bag.py SCENEWATCH DATA_DIR [--cdr-tool CYCLONE_CDR]).
 
 The bags are written by tests/io/make_bag.py from the folders' first frames: ROS 1 bags by
 Debian's python3-rosbag (lz4 chunks), a rosbag2 SQLite bag and an MCAP file with zstd chunks
-(containers from their specifications and CDR by hand: ours). Only the
+(containers from their specifications and CDR by hand: ours). With --cdr-tool, only the rosbag2 and
+MCAP bags are written, every message serialized by Cyclone DDS (tests/ros/cyclone_cdr). Only the
 fields that cannot agree are left out: each line's "source" (a file path or BAG:N), an event's
 stamp_s and the timings. The folder read is a copy of the frames whose poses are made exactly rigid (7-Scenes'
 rotations are orthonormal to 1e-5; TF's quaternions cannot carry that). Numbers must agree to
@@ -73,11 +74,17 @@ CASES = [
 
 def main():
     scenewatch, data = sys.argv[1], sys.argv[2]
+    cdr_tool = sys.argv[4] if len(sys.argv) == 5 and sys.argv[3] == "--cdr-tool" else None
+    cases = CASES
+    if cdr_tool:
+        cases = [(sub, frames, [(name, args + ["--cdr-tool", cdr_tool]) for name, args in bags if "ros1" not in args])
+                 for sub, frames, bags in CASES]
+        cases[1][2].append(("pick_toy_1_rosbag2", ["--format", "rosbag2", "--cdr-tool", cdr_tool]))
     if not os.path.isdir(data):
         print("real data not found: %s" % data)
         return 77
     failures = 0
-    for sub, frames, bags in CASES:
+    for sub, frames, bags in cases:
         folder = os.path.join(data, sub)
         with tempfile.TemporaryDirectory(prefix="scenewatch-replay-bag-") as tmp:
             # The folder's frames with their poses made exactly rigid, as TF carries them.
