@@ -19,6 +19,10 @@ struct BridgeConfig {
   std::string depth_topic = "/camera/aligned_depth_to_color/image_raw";
   std::string color_topic = "/camera/color/image_raw";  ///< empty: depth only (grey points)
   std::string info_topic = "/camera/aligned_depth_to_color/camera_info";
+  /// Non-empty: frames are the organized sensor_msgs/PointCloud2 of this topic (FLOAT32 x, y, z in
+  /// the camera's optical frame, optional rgb/rgba) instead of depth and colour images. The
+  /// CameraInfo on info_topic gives the pinhole when one came; else it is estimated from the cloud.
+  std::string cloud_topic;
   std::string world_frame = "map";
   /// With publish_odom_tf: the frame the camera poses are looked up in (the robot's odometry) and
   /// the child of the world -> odom transform the bridge publishes on /tf.

@@ -5,12 +5,45 @@
 #include <algorithm>
 
 #include "scenewatch/io/bag/image_conversion.h"
+#include "scenewatch/io/rgbd.h"
 #include "scenewatch/service/access_token.h"
 
 namespace scenewatch::ros {
 namespace {
 
 double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
+
+/// A frame's points: from its depth and colour images, or its PointCloud2. The error names the
+/// topic at fault; `reason` is the drop counter's name.
+Result<Frame> points_of(const FrameJob& job, const BridgeConfig& config, std::string& reason) {
+  Frame frame;
+  if (job.cloud) {
+    reason = "bad_cloud";
+    const auto view = cloud_view(*job.cloud);
+    auto cloud = io::bag::to_cloud(view);
+    if (!cloud) return Error{cloud.error().code, config.cloud_topic + ": " + cloud.error().message};
+    frame.cloud = *cloud;
+    frame.has_color = std::any_of(view.fields.begin(), view.fields.end(), [](const auto& f) { return f.name == "rgb" || f.name == "rgba"; });
+    frame.intrinsics = job.intrinsics;
+    if (!frame.intrinsics) {
+      if (auto K = io::estimate_intrinsics(*frame.cloud)) frame.intrinsics = *K;
+    }
+    frame.source = config.cloud_topic;
+    return frame;
+  }
+  reason = "bad_image";
+  const auto depth = image_view(job.depth);
+  std::optional<io::bag::ImageMessage> color;
+  if (job.color) color = image_view(*job.color);
+  bool color_at_fault = false;
+  auto rgbd = io::bag::to_rgbd_cloud(depth, color ? &*color : nullptr, *job.intrinsics, config.info_topic, &color_at_fault);
+  if (!rgbd) return Error{rgbd.error().code, (color_at_fault ? config.color_topic : config.depth_topic) + ": " + rgbd.error().message};
+  frame.cloud = rgbd->cloud;
+  frame.intrinsics = rgbd->intrinsics;
+  frame.has_color = rgbd->has_color;
+  frame.source = config.depth_topic;
+  return frame;
+}
 
 }  // namespace
 
@@ -36,7 +69,7 @@ void DaemonLink::push(FrameJob job) {
   if (!dropped) return;
   const auto n = stats_.count("dropped.queue_full");
   if (worth_logging(n)) {
-    out_.log("dropped the frame of " + seconds(dropped->depth.stamp_s) + " s (queue_full, " + std::to_string(n) +
+    out_.log("dropped the frame of " + seconds(dropped->stamp_s()) + " s (queue_full, " + std::to_string(n) +
              " so far): the daemon is slower than the camera; " + std::to_string(config_.queue_frames) +
              " newer frames wait (--queue-frames)");
   }
@@ -96,26 +129,19 @@ void DaemonLink::ingest_loop() {
 
 bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
   const auto dequeued = Clock::now();
-  const auto depth = image_view(job.depth);
-  std::optional<io::bag::ImageMessage> color;
-  if (job.color) color = image_view(*job.color);
-  bool color_at_fault = false;
-  auto rgbd = io::bag::to_rgbd_cloud(depth, color ? &*color : nullptr, job.intrinsics, config_.info_topic, &color_at_fault);
-  if (!rgbd) {
-    const auto n = stats_.count("dropped.bad_image");
+  std::string reason;
+  auto points = points_of(job, config_, reason);
+  if (!points) {
+    const auto n = stats_.count("dropped." + reason);
     if (worth_logging(n)) {
-      out_.log("dropped the frame of " + seconds(job.depth.stamp_s) + " s (bad_image, " + std::to_string(n) + " so far): " +
-               (color_at_fault ? config_.color_topic : config_.depth_topic) + ": " + rgbd.error().message);
+      out_.log("dropped the frame of " + seconds(job.stamp_s()) + " s (" + reason + ", " + std::to_string(n) + " so far): " +
+               points.error().message);
     }
     return true;
   }
-  Frame frame;
-  frame.cloud = rgbd->cloud;
-  frame.intrinsics = rgbd->intrinsics;
-  frame.has_color = rgbd->has_color;
+  Frame frame = std::move(*points);
   frame.T_world_camera = job.T_world_camera;
-  frame.stamp_s = job.depth.stamp_s;
-  frame.source = config_.depth_topic;
+  frame.stamp_s = job.stamp_s();
   frame.camera = config_.camera_name;
   if (!job.T_world_camera) frame.localization = LocalizationMode::kTrack;  // --without-tf track
   proto::Request request;
@@ -160,7 +186,7 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
     stats_.sample_ms("out.reply_to_objects_written", ms_between(replied, Clock::now()));
     if (out_.markers && !publish_markers(client, reply->ingest(), answer->objects(), frame.stamp_s)) return false;
   }
-  if (out_.surprise && !publish_surprise(client, frame.stamp_s, config_.camera_frame.empty() ? job.depth.frame_id : config_.camera_frame))
+  if (out_.surprise && !publish_surprise(client, frame.stamp_s, config_.camera_frame.empty() ? job.frame_id() : config_.camera_frame))
     return false;
   map_stamp_s_ = frame.stamp_s;
   map_dirty_ = true;

@@ -66,10 +66,13 @@ Result<std::unique_ptr<DdsNode>> DdsNode::create(const BridgeConfig& config, Bri
     return {};
   };
   const std::string& ns = config.output_namespace;
-  for (auto st : {entity(config.depth_topic, &sensor_msgs_msg_dds__Image__desc, Profile::kSensorData, true, &node->depth_reader_),
-                  config.color_topic.empty()
+  const bool images = config.cloud_topic.empty();
+  for (auto st : {!images ? Status{} : entity(config.depth_topic, &sensor_msgs_msg_dds__Image__desc, Profile::kSensorData, true, &node->depth_reader_),
+                  !images || config.color_topic.empty()
                       ? Status{}
                       : entity(config.color_topic, &sensor_msgs_msg_dds__Image__desc, Profile::kSensorData, true, &node->color_reader_),
+                  images ? Status{}
+                         : entity(config.cloud_topic, &sensor_msgs_msg_dds__PointCloud2__desc, Profile::kSensorData, true, &node->cloud_reader_),
                   entity(config.info_topic, &sensor_msgs_msg_dds__CameraInfo__desc, Profile::kSensorData, true, &node->info_reader_),
                   entity("/tf", &tf2_msgs_msg_dds__TFMessage__desc, Profile::kTf, true, &node->tf_reader_),
                   entity("/tf_static", &tf2_msgs_msg_dds__TFMessage__desc, Profile::kTransientLocal, true, &node->tf_static_reader_),
@@ -98,7 +101,7 @@ DdsNode::~DdsNode() {
 
 void DdsNode::run(FrameAssembler& assembler, const std::atomic<bool>& stop) {
   const dds_entity_t waitset = dds_create_waitset(participant_);
-  for (dds_entity_t reader : {depth_reader_, color_reader_, info_reader_, tf_reader_, tf_static_reader_}) {
+  for (dds_entity_t reader : {depth_reader_, color_reader_, cloud_reader_, info_reader_, tf_reader_, tf_static_reader_}) {
     if (reader <= 0) continue;
     dds_waitset_attach(waitset, dds_create_readcondition(reader, DDS_ANY_STATE), reader);
   }
@@ -137,9 +140,16 @@ void DdsNode::run(FrameAssembler& assembler, const std::atomic<bool>& stop) {
         assembler.add_color(to_raw_image(*static_cast<sensor_msgs_msg_dds__Image_*>(s), Clock::now()));
       });
     }
-    take_all(depth_reader_, [&](void* s) {
-      assembler.add_depth(to_raw_image(*static_cast<sensor_msgs_msg_dds__Image_*>(s), Clock::now()));
-    });
+    if (depth_reader_ > 0) {
+      take_all(depth_reader_, [&](void* s) {
+        assembler.add_depth(to_raw_image(*static_cast<sensor_msgs_msg_dds__Image_*>(s), Clock::now()));
+      });
+    }
+    if (cloud_reader_ > 0) {
+      take_all(cloud_reader_, [&](void* s) {
+        assembler.add_cloud(to_raw_cloud(*static_cast<sensor_msgs_msg_dds__PointCloud2_*>(s), Clock::now()));
+      });
+    }
   }
   dds_delete(waitset);
 }

@@ -2,7 +2,7 @@
 /// The DDS side of the bridge: one Cyclone DDS participant that is a ROS 2 peer (topics rt/<name>,
 /// types <pkg>::msg::dds_::<Type>_, XCDR1 little-endian, QoS as ROS 2's profiles). It reads depth,
 /// colour, CameraInfo, /tf and /tf_static into the FrameAssembler, and writes events, objects, the
-/// map and the markers. Thread safe: the write functions may be called from any thread (dds_write is).
+/// map and the markers. With a cloud topic, it reads PointCloud2 frames instead of the images. Thread safe: the write functions may be called from any thread (dds_write is).
 #include <dds/dds.h>
 
 #include <atomic>
@@ -45,7 +45,7 @@ class DdsNode {
   const BridgeConfig& config_;
   BridgeStats& stats_;
   dds_entity_t participant_ = 0;
-  dds_entity_t depth_reader_ = 0, color_reader_ = 0, info_reader_ = 0, tf_reader_ = 0, tf_static_reader_ = 0;
+  dds_entity_t depth_reader_ = 0, color_reader_ = 0, cloud_reader_ = 0, info_reader_ = 0, tf_reader_ = 0, tf_static_reader_ = 0;
   dds_entity_t events_writer_ = 0, objects_writer_ = 0, map_writer_ = 0, markers_writer_ = 0, tf_writer_ = 0, surprise_writer_ = 0;
 };
 

@@ -24,6 +24,21 @@ io::bag::ImageMessage image_view(const RawImage& image) {
   return m;
 }
 
+io::bag::PointCloud2Message cloud_view(const RawCloud& cloud) {
+  io::bag::PointCloud2Message m;
+  m.header.stamp_s = cloud.stamp_s;
+  m.header.frame_id = cloud.frame_id;
+  m.width = cloud.width;
+  m.height = cloud.height;
+  m.fields = cloud.fields;
+  m.big_endian = cloud.big_endian;
+  m.point_step = cloud.point_step;
+  m.row_step = cloud.row_step;
+  m.data = cloud.data.data();
+  m.size = cloud.data.size();
+  return m;
+}
+
 FrameAssembler::FrameAssembler(const BridgeConfig& config, BridgeStats& stats, std::function<void(FrameJob)> emit,
                                std::function<void(const std::string&)> log)
     : config_(config), stats_(stats), emit_(std::move(emit)), log_(std::move(log)) {}
@@ -64,6 +79,15 @@ void FrameAssembler::add_color(RawImage image) {
   try_pair();
 }
 
+void FrameAssembler::add_cloud(RawCloud cloud) {
+  stats_.count("cloud_in");
+  FrameJob job;
+  job.arrived = cloud.arrived;
+  job.cloud = std::move(cloud);
+  job.intrinsics = intrinsics_;
+  place(std::move(job));
+}
+
 void FrameAssembler::try_pair() {
   while (!depths_.empty()) {
     RawImage& depth = depths_.front();
@@ -94,18 +118,18 @@ void FrameAssembler::try_pair() {
       drop("no_camera_info", job.depth.stamp_s, "no CameraInfo received on " + config_.info_topic + " yet");
       continue;
     }
-    job.intrinsics = *intrinsics_;
+    job.intrinsics = intrinsics_;
     place(std::move(job));
   }
 }
 
 void FrameAssembler::place(FrameJob job) {
-  const double stamp = job.depth.stamp_s;
+  const double stamp = job.stamp_s();
   tf_.forget_before(stamp - kTfHistoryS);
   auto pose = lookup_pose(job);
   if (pose) {
     job.T_world_camera = *pose;
-    if (waiting_) drop("no_tf", waiting_->depth.stamp_s, waiting_error_ + " (a newer frame found its TF first)");
+    if (waiting_) drop("no_tf", waiting_->stamp_s(), waiting_error_ + " (a newer frame found its TF first)");
     waiting_.reset();
     emit_(std::move(job));
     return;
@@ -115,7 +139,7 @@ void FrameAssembler::place(FrameJob job) {
     emit_(std::move(job));
     return;
   }
-  if (waiting_) drop("no_tf", waiting_->depth.stamp_s, waiting_error_);
+  if (waiting_) drop("no_tf", waiting_->stamp_s(), waiting_error_);
   waiting_error_ = pose.error().message;
   waiting_ = std::move(job);
 }
@@ -123,7 +147,7 @@ void FrameAssembler::place(FrameJob job) {
 void FrameAssembler::retry_waiting() {
   if (!waiting_) return;
   if (Clock::now() - waiting_->arrived > std::chrono::duration<double>(config_.tf_wait_s)) {
-    drop("no_tf", waiting_->depth.stamp_s, waiting_error_ + " (waited " + seconds(config_.tf_wait_s) + " s)");
+    drop("no_tf", waiting_->stamp_s(), waiting_error_ + " (waited " + seconds(config_.tf_wait_s) + " s)");
     waiting_.reset();
     return;
   }
@@ -139,8 +163,8 @@ void FrameAssembler::retry_waiting() {
 }
 
 Result<Pose> FrameAssembler::lookup_pose(const FrameJob& job) const {
-  const std::string& camera = config_.camera_frame.empty() ? job.depth.frame_id : config_.camera_frame;
-  return tf_.lookup(pose_frame(config_), camera, job.depth.stamp_s, config_.tf_tolerance_s);
+  const std::string& camera = config_.camera_frame.empty() ? job.frame_id() : config_.camera_frame;
+  return tf_.lookup(pose_frame(config_), camera, job.stamp_s(), config_.tf_tolerance_s);
 }
 
 void FrameAssembler::add_transform(const io::bag::StampedTransform& t, bool is_static) {

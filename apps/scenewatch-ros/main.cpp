@@ -28,7 +28,8 @@ constexpr const char* kDescription =
     "A DDS participant that is a ROS 2 peer (topics rt/<name>, types <pkg>::msg::dds_::<Type>_, CDR\n"
     "little-endian): run it beside a camera driver whose ROS 2 uses rmw_cyclonedds_cpp, on the same\n"
     "ROS_DOMAIN_ID. It reads sensor_msgs/Image depth (16UC1 mm or 32FC1 m) and colour (rgb8, bgr8,\n"
-    "rgba8, bgra8, mono8) with sensor_msgs/CameraInfo, and the camera pose from /tf and /tf_static,\n"
+    "rgba8, bgra8, mono8) with sensor_msgs/CameraInfo, or an organized sensor_msgs/PointCloud2\n"
+    "(--cloud-topic), and the camera pose from /tf and /tf_static,\n"
     "sends each frame to scenewatchd (IngestFrame), and publishes under --namespace:\n"
     "  events          scenewatch_msgs/msg/EventArray      reliable, keep last 10\n"
     "  objects         vision_msgs/msg/Detection3DArray    reliable, keep last 10 (after every frame)\n"
@@ -39,7 +40,7 @@ constexpr const char* kDescription =
     "                  predicts: the image surprise in nats per pixel, NaN where unknown, in the camera's frame;\n"
     "                  --no-surprise)\n"
     "and, with --publish-odom-tf, --world-frame -> --odom-frame on /tf (reliable, keep last 100).\n"
-    "Images and camera info are read best effort, keep last 5; /tf reliable; /tf_static transient local.\n"
+    "Images, clouds and camera info are read best effort, keep last 5; /tf reliable; /tf_static transient local.\n"
     "Prints 'ready' on stdout once its DDS entities exist, and a stats line on exit (SIGINT, SIGTERM).\n"
     "Exit codes: 0 stopped by a signal, 1 error (message on stderr), 2 usage.";
 
@@ -55,6 +56,10 @@ void add_options(CLI::App& app, BridgeConfig& config, std::string& without_tf) {
       ->capture_default_str();
   app.add_option("--info-topic", config.info_topic, "sensor_msgs/CameraInfo of the depth images (K and size are used)")
       ->capture_default_str();
+  app.add_option("--cloud-topic", config.cloud_topic,
+                 "take frames from this organized sensor_msgs/PointCloud2 (FLOAT32 x, y, z in the optical frame, optional rgb) "
+                 "instead of --depth-topic and --color-topic; the pinhole from --info-topic when it publishes, else estimated "
+                 "from the cloud");
   // A duration in seconds, >= 0 (> 0 when `positive`).
   auto seconds_option = [&app](const char* flag, double& value, const char* help, bool positive = false) {
     app.add_option(flag, value, help)->check(positive ? CLI::Validator(CLI::PositiveNumber) : CLI::Validator(CLI::NonNegativeNumber))->capture_default_str();
@@ -105,8 +110,9 @@ void add_options(CLI::App& app, BridgeConfig& config, std::string& without_tf) {
 /// What CLI11 cannot check alone; the usage message, or none.
 std::optional<std::string> usage_error(const BridgeConfig& config) {
   for (const auto& [flag, topic] : {std::pair<const char*, const std::string*>{"--depth-topic", &config.depth_topic},
-                                    {"--info-topic", &config.info_topic}, {"--color-topic", &config.color_topic}}) {
-    if (topic->empty() && topic == &config.color_topic) continue;  // depth only
+                                    {"--info-topic", &config.info_topic}, {"--color-topic", &config.color_topic},
+                                    {"--cloud-topic", &config.cloud_topic}}) {
+    if (topic->empty() && (topic == &config.color_topic || topic == &config.cloud_topic)) continue;  // depth only; images
     if (auto name = dds_topic_name(*topic); !name) return std::string(flag) + ": " + name.error().message;
   }
   if (config.world_frame.empty()) return std::string("--world-frame must name a TF frame");

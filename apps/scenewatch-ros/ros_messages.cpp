@@ -47,6 +47,24 @@ RawImage to_raw_image(const sensor_msgs_msg_dds__Image_& m, Clock::time_point ar
   return r;
 }
 
+RawCloud to_raw_cloud(const sensor_msgs_msg_dds__PointCloud2_& m, Clock::time_point arrived) {
+  RawCloud r;
+  r.stamp_s = seconds(m.header.stamp);
+  r.frame_id = m.header.frame_id ? m.header.frame_id : "";
+  r.width = m.width;
+  r.height = m.height;
+  r.point_step = m.point_step;
+  r.row_step = m.row_step;
+  r.big_endian = m.is_bigendian;
+  for (std::uint32_t i = 0; i < m.fields._length; ++i) {
+    const auto& f = m.fields._buffer[i];
+    r.fields.push_back({f.name ? f.name : "", f.offset, f.datatype, f.count});
+  }
+  r.data.assign(m.data._buffer, m.data._buffer + m.data._length);
+  r.arrived = arrived;
+  return r;
+}
+
 io::bag::CameraInfoMessage to_camera_info(const sensor_msgs_msg_dds__CameraInfo_& m) {
   io::bag::CameraInfoMessage info;
   info.header.stamp_s = seconds(m.header.stamp);

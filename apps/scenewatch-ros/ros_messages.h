@@ -26,6 +26,8 @@ double seconds(const builtin_interfaces_msg_dds__Time_& t);
 
 /// A sensor_msgs/Image copied out of its sample.
 RawImage to_raw_image(const sensor_msgs_msg_dds__Image_& m, Clock::time_point arrived);
+/// A sensor_msgs/PointCloud2 copied out of its sample.
+RawCloud to_raw_cloud(const sensor_msgs_msg_dds__PointCloud2_& m, Clock::time_point arrived);
 io::bag::CameraInfoMessage to_camera_info(const sensor_msgs_msg_dds__CameraInfo_& m);
 /// A TFMessage's transforms; a rotation that is not a unit quaternion (within 1e-3) is an error.
 Result<std::vector<io::bag::StampedTransform>> to_transforms(const tf2_msgs_msg_dds__TFMessage_& m);

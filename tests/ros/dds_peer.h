@@ -32,6 +32,7 @@ inline std::uint32_t configure_loopback_dds() {
            "<CycloneDDS><Domain><General><Interfaces><NetworkInterface name=\"lo\"/></Interfaces>"
            "<AllowMulticast>false</AllowMulticast></General><Discovery><Peers><Peer address=\"127.0.0.1\"/></Peers>"
            "<ParticipantIndex>auto</ParticipantIndex><MaxAutoParticipantIndex>50</MaxAutoParticipantIndex></Discovery>"
+           "<Internal><SocketReceiveBufferSize min=\"default\" max=\"8MB\"/></Internal>"
            "</Domain></CycloneDDS>",
            1);
   std::mt19937 random(static_cast<unsigned>(::getpid()) ^ static_cast<unsigned>(std::chrono::steady_clock::now().time_since_epoch().count()));
@@ -66,6 +67,15 @@ class DdsPeer {
     dds_delete_qos(q);
     EXPECT_GT(e, 0) << topic << ": " << dds_strretcode(e);
     return e;
+  }
+
+  /// A reader on `topic` (the DDS name, "rt/...") with the QoS given.
+  dds_entity_t reader_with(const std::string& topic, const dds_topic_descriptor_t* type, const dds_qos_t* qos) {
+    const dds_entity_t t = dds_create_topic(participant_, type, topic.c_str(), nullptr, nullptr);
+    EXPECT_GT(t, 0) << topic << ": " << dds_strretcode(t);
+    const dds_entity_t r = dds_create_reader(participant_, t, qos, nullptr);
+    EXPECT_GT(r, 0) << topic << ": " << dds_strretcode(r);
+    return r;
   }
 
   /// Waits until every writer and reader has matched a remote peer.

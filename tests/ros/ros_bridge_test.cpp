@@ -23,6 +23,7 @@
 
 #include "daemon_harness.h"
 #include "dds_peer.h"
+#include "scenewatch/io/rgbd.h"
 #include "shipped_scenario.h"
 
 namespace scenewatch::test {
@@ -105,6 +106,10 @@ class CameraPeer {
     depth_w_ = peer_.entity("/camera/depth/image_rect_raw", &sensor_msgs_msg_dds__Image__desc, false, false, 5);
     color_w_ = peer_.entity("/camera/color/image_raw", &sensor_msgs_msg_dds__Image__desc, false, false, 5);
     info_w_ = peer_.entity("/camera/depth/camera_info", &sensor_msgs_msg_dds__CameraInfo__desc, false, false, 5);
+    // Reliable, as a node on ROS 2's default QoS publishes it: a 1.2 MB best-effort sample is lost
+    // whole when one of its UDP fragments overflows the receive buffer (the bridge's reader is
+    // best effort and takes either).
+    cloud_w_ = peer_.entity("/camera/depth/points", &sensor_msgs_msg_dds__PointCloud2__desc, false, true, 5);
     tf_w_ = peer_.entity("/tf", &tf2_msgs_msg_dds__TFMessage__desc, false, true, 100);
     tf_static_w_ = peer_.entity("/tf_static", &tf2_msgs_msg_dds__TFMessage__desc, false, true, 1, true);
     events_r_ = peer_.entity("/scenewatch/events", &scenewatch_msgs_msg_dds__EventArray__desc, true, true, 100);
@@ -119,11 +124,13 @@ class CameraPeer {
   }
 
   /// Waits for the bridge's participant (every writer and reader matched; the markers reader only
-  /// when `markers`), then sends /tf_static.
-  bool connect(double timeout_s, bool markers = true) {
+  /// when `markers`; the cloud writer instead of the images' when `cloud`), then sends /tf_static.
+  bool connect(double timeout_s, bool markers = true, bool cloud = false) {
     std::vector<dds_entity_t> readers{events_r_, objects_r_, map_r_};
     if (markers) readers.push_back(markers_r_), readers.push_back(surprise_r_);
-    if (!DdsPeer::wait_matched({depth_w_, color_w_, info_w_, tf_w_, tf_static_w_}, readers, timeout_s)) return false;
+    const std::vector<dds_entity_t> writers =
+        cloud ? std::vector<dds_entity_t>{cloud_w_, info_w_, tf_w_, tf_static_w_} : std::vector<dds_entity_t>{depth_w_, color_w_, info_w_, tf_w_, tf_static_w_};
+    if (!DdsPeer::wait_matched(writers, readers, timeout_s)) return false;
     auto t = transform(T_world_rig_, kStamp0, root_frame_.c_str(), "rig");
     tf2_msgs_msg_dds__TFMessage_ m{};
     m.transforms._length = m.transforms._maximum = 1;
@@ -131,10 +138,49 @@ class CameraPeer {
     return dds_write(tf_static_w_, &m) == DDS_RETCODE_OK;
   }
 
+  /// The frame's TF: rig -> camera_optical at `stamp`.
+  void publish_tf(const sim::SimFrame& rendered, double stamp, const Pose& T_drift = Pose::Identity()) {
+    const Pose T_rig_camera = T_world_rig_.inverse() * T_drift * rendered.truth.T_world_camera_reported;
+    auto tf = transform(T_rig_camera, stamp, "rig", "camera_optical");
+    tf2_msgs_msg_dds__TFMessage_ tf_message{};
+    tf_message.transforms._length = tf_message.transforms._maximum = 1;
+    tf_message.transforms._buffer = &tf;
+    EXPECT_EQ(dds_write(tf_w_, &tf_message), DDS_RETCODE_OK);
+  }
+
+  /// Publishes one frame as an organized PointCloud2 (x, y, z, rgb as FLOAT32, 16 bytes a point;
+  /// NaN where there is no depth, as the depth_image_proc nodes do) with its TF, and no CameraInfo.
+  void publish_cloud(const sim::SimFrame& rendered, const Intrinsics& K, double stamp) {
+    auto points = io::rgbd_to_cloud(rendered.color, rendered.depth, K);
+    ASSERT_TRUE(points.ok()) << points.error().message;
+    std::vector<std::uint8_t> data((*points)->size() * 16);
+    for (std::size_t i = 0; i < (*points)->size(); ++i) {
+      const auto& p = (**points)[i];
+      const float xyz[3] = {p.x, p.y, p.z};
+      const std::uint32_t rgb = (std::uint32_t{p.r} << 16) | (std::uint32_t{p.g} << 8) | p.b;
+      std::memcpy(&data[16 * i], xyz, 12);
+      std::memcpy(&data[16 * i + 12], &rgb, 4);
+    }
+    sensor_msgs_msg_dds__PointField_ fields[4] = {{const_cast<char*>("x"), 0, 7, 1}, {const_cast<char*>("y"), 4, 7, 1},
+                                                  {const_cast<char*>("z"), 8, 7, 1}, {const_cast<char*>("rgb"), 12, 7, 1}};
+    sensor_msgs_msg_dds__PointCloud2_ m{};
+    m.header.stamp = ros::ros_time(stamp);
+    m.header.frame_id = const_cast<char*>("camera_optical");
+    m.width = static_cast<std::uint32_t>(K.width);
+    m.height = static_cast<std::uint32_t>(K.height);
+    m.fields._length = m.fields._maximum = 4;
+    m.fields._buffer = fields;
+    m.point_step = 16;
+    m.row_step = 16 * m.width;
+    m.data._length = m.data._maximum = static_cast<std::uint32_t>(data.size());
+    m.data._buffer = data.data();
+    publish_tf(rendered, stamp);
+    EXPECT_EQ(dds_write(cloud_w_, &m), DDS_RETCODE_OK);
+  }
+
   /// Publishes one frame as a driver does: TF (unless `with_tf` is false), CameraInfo, colour, depth.
   /// `T_drift`: an error of the pose source (odometry), applied to the reported pose.
   void publish(const sim::SimFrame& rendered, const Intrinsics& K, double stamp, bool with_tf = true, const Pose& T_drift = Pose::Identity()) {
-    const Pose T_rig_camera = T_world_rig_.inverse() * T_drift * rendered.truth.T_world_camera_reported;
     std::vector<std::uint8_t> rgb = rendered.color.rgb;
     std::vector<std::uint8_t> depth(rendered.depth.depth_mm.size() * 2);
     std::memcpy(depth.data(), rendered.depth.depth_mm.data(), depth.size());  // 16UC1, little-endian like the host
@@ -149,13 +195,9 @@ class CameraPeer {
     info.r[0] = info.r[4] = info.r[8] = 1;
     const double p[12] = {K.fx, 0, K.cx, 0, 0, K.fy, K.cy, 0, 0, 0, 1, 0};
     std::copy(p, p + 12, info.p);
-    auto tf = transform(T_rig_camera, stamp, "rig", "camera_optical");
-    tf2_msgs_msg_dds__TFMessage_ tf_message{};
-    tf_message.transforms._length = tf_message.transforms._maximum = 1;
-    tf_message.transforms._buffer = &tf;
     auto color_message = image(stamp, K.width, K.height, "rgb8", static_cast<std::uint32_t>(3 * K.width), rgb.data(), rgb.size());
     auto depth_message = image(stamp, K.width, K.height, "16UC1", static_cast<std::uint32_t>(2 * K.width), depth.data(), depth.size());
-    if (with_tf) EXPECT_EQ(dds_write(tf_w_, &tf_message), DDS_RETCODE_OK);
+    if (with_tf) publish_tf(rendered, stamp, T_drift);
     EXPECT_EQ(dds_write(info_w_, &info), DDS_RETCODE_OK);
     EXPECT_EQ(dds_write(color_w_, &color_message), DDS_RETCODE_OK);
     EXPECT_EQ(dds_write(depth_w_, &depth_message), DDS_RETCODE_OK);
@@ -228,7 +270,7 @@ class CameraPeer {
  private:
   DdsPeer peer_;
   std::string root_frame_;
-  dds_entity_t depth_w_ = 0, color_w_ = 0, info_w_ = 0, tf_w_ = 0, tf_static_w_ = 0, events_r_ = 0, objects_r_ = 0, map_r_ = 0,
+  dds_entity_t depth_w_ = 0, color_w_ = 0, info_w_ = 0, cloud_w_ = 0, tf_w_ = 0, tf_static_w_ = 0, events_r_ = 0, objects_r_ = 0, map_r_ = 0,
                markers_r_ = 0, surprise_r_ = 0;
   Pose T_world_rig_ = Pose::Identity();
 };
@@ -607,6 +649,81 @@ TEST_F(RosBridgeTest, TheDaemonsOdometryCorrectionIsPublishedOnTf) {
   const auto [code, stats] = stop_bridge();
   EXPECT_EQ(code, std::optional<int>(0));
   EXPECT_NE(stats.find("odom_sent="), std::string::npos) << stats;
+}
+
+// An organized sensor_msgs/PointCloud2 (--cloud-topic), as depth_image_proc or a driver's
+// pointcloud option publishes it, with no CameraInfo: each cloud is a frame, its pinhole estimated
+// from the points, and the change is found once. Meanwhile a bystander subscribes to the outputs
+// and never takes a sample (a stalled subscriber: reliable, keep last 1, as a ROS 2 node whose
+// executor hangs), then vanishes halfway without a word: the bridge neither stalls nor fails a
+// write. (A KEEP_ALL reader whose resource limits are full was tried too: in Cyclone it stalls the
+// delivery of that writer to every reader of its own process, the test's included, so it cannot
+// be tested from inside this process.)
+TEST_F(RosBridgeTest, AnOrganizedPointCloud2IsAFrameAndSlowOrVanishingSubscribersDoNotStallTheBridge) {
+  const std::uint32_t domain = configure_loopback_dds();
+  ShippedScenario shipped = shipped_scenario("cup_added", 320, 240, 12);
+  ASSERT_TRUE(shipped.simulator);
+  auto& simulator = shipped.simulator;
+  const auto truth = simulator->changes();
+  ASSERT_EQ(truth.size(), 1u);
+  const Eigen::Vector2d where = truth[0].added.at(0).T_world_object.translation().head<2>();
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "segmentation:\n  up_vector: [0, 0, 1]\n"));
+  ASSERT_NO_FATAL_FAILURE(start_bridge({"--cloud-topic", "/camera/depth/points", "--no-markers", "--no-surprise", "--map-period", "0.2"}));
+  CameraPeer camera(domain);
+  ASSERT_TRUE(camera.connect(30.0, /*markers=*/false, /*cloud=*/true)) << "the bridge's DDS participant was not discovered";
+
+  auto bystander = std::make_unique<DdsPeer>(domain);
+  std::vector<dds_entity_t> idle_readers;
+  for (const auto& [topic, type] : {std::pair<const char*, const dds_topic_descriptor_t*>{"rt/scenewatch/objects", &vision_msgs_msg_dds__Detection3DArray__desc},
+                                    {"rt/scenewatch/events", &scenewatch_msgs_msg_dds__EventArray__desc},
+                                    {"rt/scenewatch/octomap_binary", &octomap_msgs_msg_dds__Octomap__desc}}) {
+    dds_qos_t* q = dds_create_qos();
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_SECS(1));
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, 1);
+    if (std::string(topic).find("octomap") != std::string::npos) dds_qset_durability(q, DDS_DURABILITY_TRANSIENT_LOCAL);
+    idle_readers.push_back(bystander->reader_with(topic, type, q));
+    dds_delete_qos(q);
+  }
+  ASSERT_TRUE(DdsPeer::wait_matched({}, idle_readers, 30.0)) << "the bystander did not match the bridge's writers";
+
+  std::size_t frames = 0, answered = 0;
+  for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
+    for (int f = 0; f < simulator->frame_count(phase); ++f) {
+      const sim::SimFrame rendered = simulator->render(phase, f);
+      const double stamp = kStamp0 + static_cast<double>(frames++) / 30.0;
+      bool got = false;
+      for (int attempt = 0; attempt < 3 && !got; ++attempt) {
+        ASSERT_NO_FATAL_FAILURE(camera.publish_cloud(rendered, shipped.scenario.intrinsics, stamp));
+        got = camera.objects_of(stamp, kFrameWaitS / 3).has_value();
+      }
+      answered += got;
+      if (frames == 12) bystander.reset();  // vanishes without a word
+    }
+  }
+  EXPECT_EQ(answered, frames) << "every cloud gives its Detection3DArray";
+
+  std::vector<std::pair<std::string, Eigen::Vector2d>> events;
+  const auto waited = Clock::now();
+  while (ms_since(waited) < (events.empty() ? kFrameWaitS * 1000 : 1500)) {
+    DdsPeer::take<scenewatch_msgs_msg_dds__EventArray_>(camera.events_reader(), [&](const scenewatch_msgs_msg_dds__EventArray_& m) {
+      for (std::uint32_t i = 0; i < m.events._length; ++i) {
+        events.emplace_back(m.events._buffer[i].kind_name, Eigen::Vector2d(m.events._buffer[i].centroid.x, m.events._buffer[i].centroid.y));
+      }
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ASSERT_EQ(events.size(), 1u) << "one fact, one event";
+  EXPECT_EQ(events[0].first, "OBJECT_ADDED");
+  EXPECT_LT((events[0].second - where).norm(), 0.10);
+
+  const auto [code, stats] = stop_bridge();
+  EXPECT_EQ(code, std::optional<int>(0)) << bridge_->stderr_text();
+  EXPECT_NE(stats.find("cloud_in="), std::string::npos) << stats;
+  EXPECT_EQ(stats.find("depth_in"), std::string::npos) << "no image reader with --cloud-topic; " << stats;
+  EXPECT_EQ(stats.find("dropped."), std::string::npos) << "lock step: nothing to drop; " << stats;
+  EXPECT_EQ(stats.find("write_failed"), std::string::npos) << "a write blocked on the idle subscriber; " << stats;
+  std::printf("PointCloud2 frames: %zu of %zu answered, event %s %.1f cm from the cup; %s\n", answered, frames, events[0].first.c_str(),
+              100 * (events[0].second - where).norm(), stats.c_str());
 }
 
 // The daemon vanishes (killed) and comes back on the same port: the bridge keeps running,
