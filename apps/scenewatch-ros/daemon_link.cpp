@@ -13,10 +13,15 @@ namespace {
 
 double ms_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double, std::milli>(b - a).count(); }
 
-/// A frame's points: from its depth and colour images, or its PointCloud2. The error names the
-/// topic at fault; `reason` is the drop counter's name.
-Result<Frame> points_of(const FrameJob& job, const BridgeConfig& config, std::string& reason) {
+/// A frame's IngestFrame: its depth and colour images as they are (the daemon back-projects them),
+/// or the points of its PointCloud2. The error names the topic at fault; `reason` is the drop
+/// counter's name.
+Result<proto::IngestFrame> request_of(const FrameJob& job, const BridgeConfig& config, std::string& reason) {
   Frame frame;
+  frame.T_world_camera = job.T_world_camera;
+  frame.stamp_s = job.stamp_s();
+  frame.camera = config.camera_name;
+  if (!job.T_world_camera) frame.localization = LocalizationMode::kTrack;  // --without-tf track
   if (job.cloud) {
     reason = "bad_cloud";
     const auto view = cloud_view(*job.cloud);
@@ -29,20 +34,20 @@ Result<Frame> points_of(const FrameJob& job, const BridgeConfig& config, std::st
       if (auto K = io::estimate_intrinsics(*frame.cloud)) frame.intrinsics = *K;
     }
     frame.source = config.cloud_topic;
-    return frame;
+    return service::make_ingest_frame(frame);
   }
   reason = "bad_image";
   const auto depth = image_view(job.depth);
   std::optional<io::bag::ImageMessage> color;
   if (job.color) color = image_view(*job.color);
   bool color_at_fault = false;
-  auto rgbd = io::bag::to_rgbd_cloud(depth, color ? &*color : nullptr, *job.intrinsics, config.info_topic, &color_at_fault);
-  if (!rgbd) return Error{rgbd.error().code, (color_at_fault ? config.color_topic : config.depth_topic) + ": " + rgbd.error().message};
-  frame.cloud = rgbd->cloud;
-  frame.intrinsics = rgbd->intrinsics;
-  frame.has_color = rgbd->has_color;
+  auto images = io::bag::to_rgbd_images(depth, color ? &*color : nullptr, *job.intrinsics, config.info_topic, &color_at_fault);
+  if (!images) return Error{images.error().code, (color_at_fault ? config.color_topic : config.depth_topic) + ": " + images.error().message};
+  frame.intrinsics = images->intrinsics;
   frame.source = config.depth_topic;
-  return frame;
+  proto::IngestFrame msg = service::make_ingest_frame(frame);
+  service::set_rgbd_images(images->depth, images->has_color ? &images->color : nullptr, &msg);
+  return msg;
 }
 
 }  // namespace
@@ -130,23 +135,19 @@ void DaemonLink::ingest_loop() {
 bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
   const auto dequeued = Clock::now();
   std::string reason;
-  auto points = points_of(job, config_, reason);
-  if (!points) {
+  auto message = request_of(job, config_, reason);
+  if (!message) {
     const auto n = stats_.count("dropped." + reason);
     if (worth_logging(n)) {
       out_.log("dropped the frame of " + seconds(job.stamp_s()) + " s (" + reason + ", " + std::to_string(n) + " so far): " +
-               points.error().message);
+               message.error().message);
     }
     return true;
   }
-  Frame frame = std::move(*points);
-  frame.T_world_camera = job.T_world_camera;
-  frame.stamp_s = job.stamp_s();
-  frame.camera = config_.camera_name;
-  if (!job.T_world_camera) frame.localization = LocalizationMode::kTrack;  // --without-tf track
+  const double stamp_s = job.stamp_s();
   proto::Request request;
   auto* ingest = request.mutable_ingest_frame();
-  *ingest = service::make_ingest_frame(frame);
+  *ingest = std::move(*message);
   ingest->set_live(true);
   const auto encoded = Clock::now();
   auto id = client.start(std::move(request));
@@ -162,7 +163,7 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
   stats_.sample_ms("daemon.request_to_reply", ms_between(sent, replied));
   if (auto st = service::status_of(*reply); !st) {
     const auto n = stats_.count("refused");
-    if (worth_logging(n)) out_.log("the daemon refused the frame of " + seconds(frame.stamp_s) + " s: " + st.error().message);
+    if (worth_logging(n)) out_.log("the daemon refused the frame of " + seconds(stamp_s) + " s: " + st.error().message);
     return true;
   }
   if (reply->ingest().skipped()) {
@@ -174,7 +175,7 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
   // The frame's camera's T_world_odom, as the daemon holds it after this frame (identity in
   // `given` mode: the given poses are world poses).
   if (out_.odom && reply->ingest().has_localization()) {
-    out_.odom(reply->ingest().localization().t_world_odom(), frame.stamp_s);
+    out_.odom(reply->ingest().localization().t_world_odom(), stamp_s);
     stats_.count("odom_sent");
   }
   proto::Request objects;
@@ -182,15 +183,15 @@ bool DaemonLink::send_frame(service::Client& client, const FrameJob& job) {
   auto answer = call(client, std::move(objects), "objects");
   if (!answer) return false;
   if (service::status_of(*answer)) {
-    out_.objects(answer->objects(), frame.stamp_s);
+    out_.objects(answer->objects(), stamp_s);
     stats_.sample_ms("out.reply_to_objects_written", ms_between(replied, Clock::now()));
-    if (out_.markers && !publish_markers(client, reply->ingest(), answer->objects(), frame.stamp_s)) return false;
+    if (out_.markers && !publish_markers(client, reply->ingest(), answer->objects(), stamp_s)) return false;
   }
-  if (out_.surprise && !publish_surprise(client, frame.stamp_s, config_.camera_frame.empty() ? job.frame_id() : config_.camera_frame))
+  if (out_.surprise && !publish_surprise(client, stamp_s, config_.camera_frame.empty() ? job.frame_id() : config_.camera_frame))
     return false;
-  map_stamp_s_ = frame.stamp_s;
+  map_stamp_s_ = stamp_s;
   map_dirty_ = true;
-  if (Clock::now() - map_published_ >= std::chrono::duration<double>(config_.map_period_s)) publish_map(client, frame.stamp_s);
+  if (Clock::now() - map_published_ >= std::chrono::duration<double>(config_.map_period_s)) publish_map(client, stamp_s);
   return true;
 }
 

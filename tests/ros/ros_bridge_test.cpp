@@ -726,6 +726,80 @@ TEST_F(RosBridgeTest, AnOrganizedPointCloud2IsAFrameAndSlowOrVanishingSubscriber
               100 * (events[0].second - where).norm(), stats.c_str());
 }
 
+/// A counter of the bridge's stats line ("name=N"), 0 when absent.
+std::size_t stat(const std::string& stats, const std::string& name) {
+  const auto at = stats.find(" " + name + "=");
+  return at == std::string::npos ? 0 : std::stoul(stats.substr(at + name.size() + 2));
+}
+
+// VGA, as a RealSense or Kinect driver sends it. First in lock step (the next frame once the
+// previous one's objects came back): the latency the bridge adds with the daemon idle. Then, with
+// a fresh bridge, a stream at 30 Hz: the bridge keeps up as far as the daemon does and accounts
+// for every depth image it took (sent, skipped by the daemon as stale, or dropped with a reason).
+// Prints the latencies and the frames per second that reached the model (figures for
+// docs/ros2.md, not asserted: timing is no test's business).
+TEST_F(RosBridgeTest, AtVgaTheBridgeAddsLittleAndAccountsForEveryFrameOfA30HzStream) {
+  const std::uint32_t domain = configure_loopback_dds();
+  ShippedScenario shipped = shipped_scenario("cup_added", 640, 480, 30);
+  ASSERT_TRUE(shipped.simulator);
+  std::vector<sim::SimFrame> rendered;
+  for (std::size_t phase = 0; phase < shipped.simulator->phase_count(); ++phase) {
+    for (int f = 0; f < shipped.simulator->frame_count(phase); ++f) rendered.push_back(shipped.simulator->render(phase, f));
+  }
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "segmentation:\n  up_vector: [0, 0, 1]\n"));
+  CameraPeer camera(domain);
+
+  // Lock step over the first 20 frames.
+  ASSERT_NO_FATAL_FAILURE(start_bridge());
+  ASSERT_TRUE(camera.connect(30.0)) << "the bridge's DDS participant was not discovered";
+  const std::size_t kLockStep = 20;
+  std::size_t answered = 0;
+  for (std::size_t i = 0; i < kLockStep; ++i) {
+    const double stamp = kStamp0 + static_cast<double>(i) / 30.0;
+    bool got = false;
+    for (int attempt = 0; attempt < 3 && !got; ++attempt) {
+      camera.publish(rendered[i], shipped.scenario.intrinsics, stamp);
+      got = camera.objects_of(stamp, kFrameWaitS / 3).has_value();
+    }
+    answered += got;
+  }
+  EXPECT_EQ(answered, kLockStep);
+  const auto [lock_code, lock_stats] = stop_bridge();
+  EXPECT_EQ(lock_code, std::optional<int>(0)) << bridge_->stderr_text();
+  EXPECT_EQ(stat(lock_stats, "frames_sent"), kLockStep) << lock_stats;
+  std::printf("VGA in lock step, %zu frames: %s\n", kLockStep, lock_stats.c_str());
+
+  // The rest at 30 Hz.
+  ASSERT_NO_FATAL_FAILURE(start_bridge());
+  ASSERT_TRUE(camera.connect(30.0)) << "the second bridge was not discovered";
+  const auto start = Clock::now();
+  double last_stamp = 0;
+  for (std::size_t i = kLockStep; i < rendered.size(); ++i) {
+    std::this_thread::sleep_until(start + std::chrono::microseconds(static_cast<long>((i - kLockStep) * 1e6 / 30)));
+    last_stamp = kStamp0 + static_cast<double>(i) / 30.0;
+    camera.publish(rendered[i], shipped.scenario.intrinsics, last_stamp);
+  }
+  const double published_s = ms_since(start) / 1000;
+  camera.objects_of(last_stamp, 10.0);  // the last frame's answer, if it was not dropped
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  const double elapsed_s = ms_since(start) / 1000;
+  const auto [code, stats] = stop_bridge();
+  EXPECT_EQ(code, std::optional<int>(0)) << bridge_->stderr_text();
+  const std::size_t streamed = rendered.size() - kLockStep;
+  const std::size_t taken = stat(stats, "depth_in"), sent = stat(stats, "frames_sent"), skipped = stat(stats, "skipped_by_daemon");
+  std::size_t dropped = 0;
+  for (std::size_t at = stats.find(" dropped."); at != std::string::npos; at = stats.find(" dropped.", at + 1)) {
+    dropped += std::stoul(stats.substr(stats.find('=', at) + 1));
+  }
+  EXPECT_GT(taken, streamed / 2) << "best effort on loopback lost most images; " << stats;
+  EXPECT_GT(sent, 0u) << stats;
+  EXPECT_EQ(taken, sent + skipped + dropped) << "a frame went missing without a count; " << stats;
+  std::printf("VGA at 30 Hz: %zu frames published in %.2f s; the bridge took %zu, sent %zu (%zu skipped by the daemon as stale, "
+              "%zu dropped); %.1f frames per second reached the model over %.2f s\n%s\n",
+              streamed, published_s, taken, sent, skipped, dropped, static_cast<double>(sent - skipped) / elapsed_s, elapsed_s,
+              stats.c_str());
+}
+
 // The daemon vanishes (killed) and comes back on the same port: the bridge keeps running,
 // reconnects with backoff and carries on. A frame whose TF never comes is dropped with its reason
 // counted, not sent. Run with --no-markers and --no-surprise, which must leave neither topic.

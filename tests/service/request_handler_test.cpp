@@ -211,6 +211,53 @@ TEST_F(RequestHandlerTest, IntrinsicsMustFitTheOrganizedCloud) {
   EXPECT_EQ(frames_processed(), 0u);
 }
 
+// IngestFrame.rgbd: the images as a camera gives them, back-projected by the daemon through the
+// frame's intrinsics; every inconsistency is refused with the field named, and nothing processed.
+TEST_F(RequestHandlerTest, RgbdImagesAreBackProjectedAndBadOnesRefused) {
+  RequestHandler handler(memory_, {});
+  DepthImage depth;
+  depth.width = 60;
+  depth.height = 50;
+  depth.depth_mm.assign(3000, 1000);
+  depth.depth_mm[7] = DepthImage::kInvalid;
+  ColorImage color;
+  color.width = 60;
+  color.height = 50;
+  color.rgb.assign(9000, 200);
+  Frame meta;
+  meta.intrinsics = Intrinsics{500, 500, 29.5, 24.5, 60, 50};
+  proto::IngestFrame good = make_ingest_frame(meta);
+  set_rgbd_images(depth, &color, &good);
+
+  proto::IngestFrame no_intrinsics = good;
+  no_intrinsics.clear_intrinsics();
+  proto::IngestFrame wrong_intrinsics = good;
+  wrong_intrinsics.mutable_intrinsics()->set_width(61);
+  proto::IngestFrame short_depth = good;
+  short_depth.mutable_rgbd()->mutable_depth_mm()->pop_back();
+  proto::IngestFrame bad_rgb = good;
+  bad_rgb.mutable_rgbd()->mutable_rgb()->resize(5);
+  proto::IngestFrame zero = good;
+  zero.mutable_rgbd()->set_width(0);
+  proto::IngestFrame both = good;
+  *both.mutable_cloud() = make_ingest_frame(grid_frame(4, 3)).cloud();
+  for (const auto& [msg, expected] : std::vector<std::pair<const proto::IngestFrame*, std::string>>{
+           {&no_intrinsics, "rgbd needs intrinsics"}, {&wrong_intrinsics, "intrinsics are for a 61 x 50"},
+           {&short_depth, "rgbd.depth_mm has 5999 bytes, expected 6000"}, {&bad_rgb, "rgbd.rgb has 5 bytes"},
+           {&zero, "rgbd images of 0 x 50"}, {&both, "both cloud and rgbd"}}) {
+    const auto response = ingest(handler, *msg);
+    EXPECT_EQ(response.status().code(), proto::Status::INVALID_ARGUMENT) << expected;
+    EXPECT_NE(response.status().message().find(expected), std::string::npos) << response.status().message();
+  }
+  EXPECT_EQ(frames_processed(), 0u);
+
+  const auto response = ingest(handler, good);
+  ASSERT_EQ(response.status().code(), proto::Status::OK) << response.status().message();
+  EXPECT_EQ(response.ingest().points(), 2999u) << "every pixel with depth is a point";
+  EXPECT_EQ(frames_processed(), 1u);
+  EXPECT_LT(good.ByteSizeLong(), 5 * 3000 + 100) << "5 bytes a pixel";
+}
+
 TEST_F(RequestHandlerTest, ValidFrameIsProcessed) {
   RequestHandler handler(memory_, {});
   Frame frame = grid_frame(60, 50);

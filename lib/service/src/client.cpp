@@ -301,6 +301,11 @@ proto::IngestFrame make_ingest_frame(const Frame& frame) {
   return msg;
 }
 
+void set_rgbd_images(const DepthImage& depth, const ColorImage* color, proto::IngestFrame* msg) {
+  msg->clear_cloud();
+  convert::encode_rgbd(depth, color, msg->mutable_rgbd());
+}
+
 proto::Event make_event_message(const Event& event) {
   proto::Event msg;
   convert::to_proto(event, &msg);

@@ -328,6 +328,53 @@ Result<DecodedCloud> decode_cloud(const proto::Cloud& msg) {
   return DecodedCloud{std::move(cloud), has_color};
 }
 
+void encode_rgbd(const DepthImage& depth, const ColorImage* color, proto::RgbdImages* out) {
+  out->set_width(static_cast<std::uint32_t>(depth.width));
+  out->set_height(static_cast<std::uint32_t>(depth.height));
+  std::string* bytes = out->mutable_depth_mm();
+  bytes->resize(2 * depth.depth_mm.size());
+  const std::uint16_t probe = 1;
+  if (*reinterpret_cast<const unsigned char*>(&probe) == 1) {  // a little-endian host: the bytes as they are
+    std::memcpy(bytes->data(), depth.depth_mm.data(), bytes->size());
+  } else {
+    for (std::size_t i = 0; i < depth.depth_mm.size(); ++i) {
+      (*bytes)[2 * i] = static_cast<char>(depth.depth_mm[i] & 0xff);
+      (*bytes)[2 * i + 1] = static_cast<char>(depth.depth_mm[i] >> 8);
+    }
+  }
+  if (color) out->mutable_rgb()->assign(reinterpret_cast<const char*>(color->rgb.data()), color->rgb.size());
+}
+
+Result<DecodedRgbd> decode_rgbd(const proto::RgbdImages& msg) {
+  const std::string dims = std::to_string(msg.width()) + " x " + std::to_string(msg.height());
+  if (msg.width() == 0 || msg.height() == 0 || msg.width() > 100000 || msg.height() > 100000) {
+    return invalid_argument("rgbd images of " + dims + " pixels (1 to 100000 on a side)");
+  }
+  const std::size_t n = std::size_t{msg.width()} * msg.height();
+  if (msg.depth_mm().size() != 2 * n) {
+    return invalid_argument("rgbd.depth_mm has " + std::to_string(msg.depth_mm().size()) + " bytes, expected " +
+                            std::to_string(2 * n) + " (2 bytes per pixel for " + dims + " pixels)");
+  }
+  const bool has_color = !msg.rgb().empty();
+  if (has_color && msg.rgb().size() != 3 * n) {
+    return invalid_argument("rgbd.rgb has " + std::to_string(msg.rgb().size()) + " bytes, expected 0 or " +
+                            std::to_string(3 * n) + " (3 bytes per pixel for " + dims + " pixels)");
+  }
+  DecodedRgbd out;
+  out.has_color = has_color;
+  out.depth.width = out.color.width = static_cast<int>(msg.width());
+  out.depth.height = out.color.height = static_cast<int>(msg.height());
+  out.depth.depth_mm.resize(n);
+  const auto* d = reinterpret_cast<const unsigned char*>(msg.depth_mm().data());
+  for (std::size_t i = 0; i < n; ++i) out.depth.depth_mm[i] = static_cast<std::uint16_t>(d[2 * i] | (d[2 * i + 1] << 8));
+  if (has_color) {
+    out.color.rgb.assign(msg.rgb().begin(), msg.rgb().end());
+  } else {
+    out.color.rgb.assign(3 * n, 128);
+  }
+  return out;
+}
+
 Result<Pose> decode_pose(const proto::Pose& msg, const std::string& field) {
   if (msg.matrix_size() != 16) {
     return invalid_argument(field + ".matrix must have 16 values (row-major 4x4), got " +

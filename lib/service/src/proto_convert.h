@@ -9,6 +9,7 @@
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/geometry.h"
+#include "scenewatch/core/image.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/core/scene.h"
 #include "scenewatch/localization/localizer.h"
@@ -48,6 +49,18 @@ struct DecodedCloud {
 };
 /// Checks sizes (xyz 12 bytes and rgb 3 bytes per point) and decodes. Errors name the field.
 Result<DecodedCloud> decode_cloud(const proto::Cloud& msg);
+
+/// A depth image and its colour image -> RgbdImages (depth_mm little-endian; rgb only with `color`).
+void encode_rgbd(const DepthImage& depth, const ColorImage* color, proto::RgbdImages* out);
+/// The images of an RgbdImages; grey (128) when it had no rgb.
+struct DecodedRgbd {
+  DepthImage depth;
+  ColorImage color;
+  bool has_color = false;
+};
+/// Checks sizes (depth_mm 2 bytes and rgb 0 or 3 bytes per pixel, at most 100000 on a side) and
+/// decodes. Errors name the field.
+Result<DecodedRgbd> decode_rgbd(const proto::RgbdImages& msg);
 
 /// 16 finite values forming a rigid transform. `field` names the field in messages.
 Result<Pose> decode_pose(const proto::Pose& msg, const std::string& field);

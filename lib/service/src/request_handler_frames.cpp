@@ -8,6 +8,7 @@
 #include "proto_convert.h"
 #include "request_handler_impl.h"
 #include "scenewatch/core/files.h"
+#include "scenewatch/io/rgbd.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/pipeline/working_memory.h"
 
@@ -24,13 +25,40 @@ bool is_within(const fs::path& path, const fs::path& root) {
 
 }  // namespace
 
-Result<Frame> RequestHandler::Impl::decode_frame(const proto::IngestFrame& msg) {
-  if (!msg.has_cloud()) return invalid_argument("cloud is missing");
-  auto cloud = convert::decode_cloud(msg.cloud());
+/// The points of an IngestFrame that carries images: back-projected through its intrinsics.
+Result<Frame> RequestHandler::Impl::decode_rgbd_frame(const proto::IngestFrame& msg) {
+  if (!msg.has_intrinsics()) return invalid_argument("rgbd needs intrinsics to back-project the depth image");
+  auto images = convert::decode_rgbd(msg.rgbd());
+  if (!images) return images.error();
+  auto k = convert::decode_intrinsics(msg.intrinsics(), "intrinsics");
+  if (!k) return k.error();
+  if (k->width != images->depth.width || k->height != images->depth.height) {
+    return invalid_argument("intrinsics are for a " + std::to_string(k->width) + " x " + std::to_string(k->height) +
+                            " image but the rgbd images are " + std::to_string(images->depth.width) + " x " +
+                            std::to_string(images->depth.height));
+  }
+  auto cloud = io::rgbd_to_cloud(images->color, images->depth, *k, io::kDepthMillimetres);
   if (!cloud) return cloud.error();
   Frame frame;
-  frame.cloud = cloud->cloud;
-  frame.has_color = cloud->has_color;
+  frame.cloud = *cloud;
+  frame.has_color = images->has_color;
+  return frame;
+}
+
+Result<Frame> RequestHandler::Impl::decode_frame(const proto::IngestFrame& msg) {
+  if (msg.has_cloud() && msg.has_rgbd()) return invalid_argument("both cloud and rgbd are set: send one");
+  if (!msg.has_cloud() && !msg.has_rgbd()) return invalid_argument("cloud is missing (or rgbd, the images, with intrinsics)");
+  Frame frame;
+  if (msg.has_rgbd()) {
+    auto images = decode_rgbd_frame(msg);
+    if (!images) return images.error();
+    frame = std::move(*images);
+  } else {
+    auto cloud = convert::decode_cloud(msg.cloud());
+    if (!cloud) return cloud.error();
+    frame.cloud = cloud->cloud;
+    frame.has_color = cloud->has_color;
+  }
   if (msg.has_pose()) {
     auto pose = convert::decode_pose(msg.pose(), "pose");
     if (!pose) return pose.error();

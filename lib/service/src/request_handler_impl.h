@@ -50,6 +50,7 @@ struct RequestHandler::Impl {
   // --- request_handler_frames.cpp
   /// The frame of an IngestFrame message, checked (cloud, pose, intrinsics, stamp, mode).
   static Result<Frame> decode_frame(const proto::IngestFrame& msg);
+  static Result<Frame> decode_rgbd_frame(const proto::IngestFrame& msg);
   Status ingest_frame(const proto::IngestFrame& msg, proto::Response& response);
   Status get_surprise_map(const proto::GetSurpriseMap& msg, proto::Response& response);
   /// Opens a client's absolute path beneath the data root it names.

@@ -167,13 +167,13 @@ Result<Intrinsics> to_intrinsics(const CameraInfoMessage& m) {
   return K;
 }
 
-Result<RgbdCloud> to_rgbd_cloud(const ImageMessage& depth_message, const ImageMessage* color_message, Intrinsics K,
-                                const std::string& info_name, bool* color_at_fault) {
+Result<RgbdImages> to_rgbd_images(const ImageMessage& depth_message, const ImageMessage* color_message, Intrinsics K,
+                                  const std::string& info_name, bool* color_at_fault) {
   *color_at_fault = false;
   auto depth = to_depth(depth_message);
   if (!depth) return depth.error();
-  RgbdCloud out;
-  ColorImage color;
+  RgbdImages out;
+  ColorImage& color = out.color;
   if (color_message) {
     auto decoded = to_color(*color_message);
     if (decoded && (decoded->width != depth->width || decoded->height != depth->height)) {
@@ -198,11 +198,18 @@ Result<RgbdCloud> to_rgbd_cloud(const ImageMessage& depth_message, const ImageMe
   }
   K.width = depth->width;
   K.height = depth->height;
-  auto cloud = rgbd_to_cloud(color, *depth, K, kDepthMillimetres);
-  if (!cloud) return cloud.error();
-  out.cloud = *cloud;
+  out.depth = std::move(*depth);
   out.intrinsics = K;
   return out;
+}
+
+Result<RgbdCloud> to_rgbd_cloud(const ImageMessage& depth_message, const ImageMessage* color_message, Intrinsics K,
+                                const std::string& info_name, bool* color_at_fault) {
+  auto images = to_rgbd_images(depth_message, color_message, K, info_name, color_at_fault);
+  if (!images) return images.error();
+  auto cloud = rgbd_to_cloud(images->color, images->depth, images->intrinsics, kDepthMillimetres);
+  if (!cloud) return cloud.error();
+  return RgbdCloud{*cloud, images->intrinsics, images->has_color};
 }
 
 }  // namespace scenewatch::io::bag

@@ -10,6 +10,7 @@
 #include "scenewatch.pb.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/frame.h"
+#include "scenewatch/core/image.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/service/frame_parser.h"
 #include "scenewatch/service/server_config.h"
@@ -88,6 +89,10 @@ std::string to_string(proto::Status::Code code);
 /// Builds the IngestFrame message of a frame: cloud (xyz, and rgb when it has colour), pose,
 /// intrinsics, stamp and source.
 proto::IngestFrame make_ingest_frame(const Frame& frame);
+/// Puts a depth image (millimetres) and its colour image (none: grey points) into `msg` in place
+/// of a cloud: the daemon back-projects them through msg's intrinsics, which must be set and of
+/// the same size. 5 bytes a pixel on the wire where a cloud takes 15.
+void set_rgbd_images(const DepthImage& depth, const ColorImage* color, proto::IngestFrame* msg);
 /// The wire form of an event (for printing library events the way the daemon's are printed).
 proto::Event make_event_message(const Event& event);
 /// Decodes a float32 map of a SurpriseMapReply, checking it holds `expected` values.

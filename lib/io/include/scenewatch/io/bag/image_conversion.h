@@ -22,15 +22,26 @@ Result<CloudPtr> to_cloud(const PointCloud2Message& m);
 /// The pinhole of a CameraInfo's K and size; error unless the focal lengths are positive and finite.
 Result<Intrinsics> to_intrinsics(const CameraInfoMessage& m);
 
+/// An RGB-D frame's images, checked against each other and the camera info.
+struct RgbdImages {
+  DepthImage depth;       ///< millimetres
+  ColorImage color;       ///< grey (128) without a colour image
+  Intrinsics intrinsics;  ///< K with the depth image's size
+  bool has_color = true;
+};
+/// A depth image (16UC1 mm or 32FC1 m) with an optional colour image registered to it (same size)
+/// and K, whose size, when set, must be the depth image's (`info_name` names it in that error). On
+/// error, *color_at_fault tells whether the colour image or the depth image was.
+Result<RgbdImages> to_rgbd_images(const ImageMessage& depth, const ImageMessage* color, Intrinsics K,
+                                  const std::string& info_name, bool* color_at_fault);
+
 /// An RGB-D frame's organized cloud in the camera frame.
 struct RgbdCloud {
   CloudPtr cloud;
   Intrinsics intrinsics;  ///< K with the depth image's size
   bool has_color = true;  ///< false without a colour image (the points are grey)
 };
-/// Back-projects a depth image (16UC1 mm or 32FC1 m) with an optional colour image registered to it
-/// (same size) through K, whose size, when set, must be the depth image's (`info_name` names it in
-/// that error). On error, *color_at_fault tells whether the colour image or the depth image was.
+/// Back-projects to_rgbd_images' images through K.
 Result<RgbdCloud> to_rgbd_cloud(const ImageMessage& depth, const ImageMessage* color, Intrinsics K,
                                 const std::string& info_name, bool* color_at_fault);
 
