@@ -35,7 +35,7 @@ constexpr const char* kDescription =
     "  objects         vision_msgs/msg/Detection3DArray    reliable, keep last 10 (after every frame)\n"
     "  octomap_binary  octomap_msgs/msg/Octomap            reliable, transient local (binary, id OcTree)\n"
     "  markers         visualization_msgs/msg/MarkerArray  reliable, keep last 10 (after every frame; for RViz:\n"
-    "                  a DELETEALL, then planes, objects, labels, hands, events; --no-markers)\n"
+    "                  a DELETEALL, then planes, objects, labels, hands, person, events; --no-markers)\n"
     "  surprise        sensor_msgs/msg/Image 32FC1         best effort, keep last 5 (after every frame the memory\n"
     "                  predicts: the image surprise in nats per pixel, NaN where unknown, in the camera's frame;\n"
     "                  --no-surprise)\n"

@@ -24,6 +24,7 @@ constexpr Color kPlaneColor{0.1f, 0.9f, 0.2f, 1.0f};
 constexpr Color kObjectColor{0.2f, 0.55f, 1.0f, 0.45f};
 constexpr Color kLabelColor{1.0f, 1.0f, 1.0f, 1.0f};
 constexpr Color kHandColor{1.0f, 0.55f, 0.1f, 0.5f};
+constexpr Color kPersonColor{0.6f, 0.6f, 0.6f, 0.3f};
 constexpr Color kEventColor{1.0f, 0.9f, 0.0f, 1.0f};
 
 /// Marker.id is int32; the daemon's ids count up from 1, so the low 31 bits keep them apart for
@@ -119,12 +120,19 @@ void add_objects(MarkerArrayBuilder& b, const proto::ObjectsReply& objects) {
   }
 }
 
+/// An axis-aligned box as a CUBE marker's pose and scale.
+void set_box(Marker& m, const proto::Box& box) {
+  m.pose.position = {0.5 * (box.min().x() + box.max().x()), 0.5 * (box.min().y() + box.max().y()), 0.5 * (box.min().z() + box.max().z())};
+  m.scale = {box.max().x() - box.min().x(), box.max().y() - box.min().y(), box.max().z() - box.min().z()};
+}
+
+/// Each hand (and forearm) as an orange box; the rest of the person, when seen, as a grey one.
 void add_hands(MarkerArrayBuilder& b, const proto::HandsReply& hands) {
   for (int i = 0; i < hands.hands_size(); ++i) {
-    const proto::Box& box = hands.hands(i).box_world();
-    Marker& m = b.add("hands", i, visualization_msgs_msg_dds__Marker_Constants_CUBE, kHandColor);
-    m.pose.position = {0.5 * (box.min().x() + box.max().x()), 0.5 * (box.min().y() + box.max().y()), 0.5 * (box.min().z() + box.max().z())};
-    m.scale = {box.max().x() - box.min().x(), box.max().y() - box.min().y(), box.max().z() - box.min().z()};
+    set_box(b.add("hands", i, visualization_msgs_msg_dds__Marker_Constants_CUBE, kHandColor), hands.hands(i).box_world());
+  }
+  if (hands.has_person_box_world()) {
+    set_box(b.add("person", 0, visualization_msgs_msg_dds__Marker_Constants_CUBE, kPersonColor), hands.person_box_world());
   }
 }
 

@@ -6,6 +6,7 @@
 ///   objects CUBE per tracked object: its oriented box, translucent blue; id = object id
 ///   labels  TEXT_VIEW_FACING per object above its box: "#<id>", then its class when known
 ///   hands   CUBE per hand (with forearm): its world box, translucent orange; id = index
+///   person  CUBE of the rest of the person (body, head) when seen: its world box, translucent grey
 ///   events  LINE_LIST per recent event: the 12 edges of its world box, yellow; id = event id
 /// Ids are the daemon's, truncated to int32 (Marker.id), so a marker keeps its id across frames.
 #include <dds/dds.h>

@@ -581,6 +581,53 @@ TEST_F(RosBridgeTest, CupAddedOverDdsGivesOneEventTheObjectsAndTheMap) {
   std::printf("publish -> Detection3DArray back, through DDS, the bridge and the daemon: median %.1f ms\n", median(round_trip_ms));
 }
 
+// A hand picks up the cup: the markers of every frame draw the hands (and the person's box) that
+// the daemon's GetHands reports for that frame, box for box.
+TEST_F(RosBridgeTest, HandMarkersAreTheDaemonsHandsOfEachFrame) {
+  const std::uint32_t domain = configure_loopback_dds();
+  ShippedScenario shipped = shipped_scenario("hand_picks_cup_upright", 320, 240);
+  ASSERT_TRUE(shipped.simulator);
+  auto& simulator = shipped.simulator;
+  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "segmentation:\n  up_vector: [0, 0, 1]\n"));
+  ASSERT_NO_FATAL_FAILURE(start_bridge());
+  CameraPeer camera(domain);
+  ASSERT_TRUE(camera.connect(30.0)) << "the bridge's DDS participant was not discovered";
+  service::Client client = daemon_.connect();
+
+  std::size_t frames = 0, frames_with_hands = 0, hand_boxes = 0, person_boxes = 0;
+  for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
+    for (int f = 0; f < simulator->frame_count(phase); ++f) {
+      const sim::SimFrame rendered = simulator->render(phase, f);
+      const double stamp = kStamp0 + static_cast<double>(frames++) / 30.0;
+      std::optional<std::vector<ReceivedMarker>> markers;
+      for (int attempt = 0; attempt < 3 && !markers; ++attempt) {
+        camera.publish(rendered, shipped.scenario.intrinsics, stamp);
+        markers = camera.markers_of(stamp, kFrameWaitS / 3);
+      }
+      ASSERT_TRUE(markers) << "no MarkerArray for frame " << frames;
+      // Lock step: the daemon's last frame is this one until the test publishes the next.
+      const auto hands = call(client, request([](proto::Request& r) { r.mutable_get_hands(); })).hands();
+      ASSERT_NEAR(hands.stamp_s(), stamp, 1e-6);
+      const auto drawn = markers_in(*markers, "hands", visualization_msgs_msg_dds__Marker_Constants_CUBE);
+      ASSERT_EQ(drawn.size(), static_cast<std::size_t>(hands.hands_size())) << "frame " << frames;
+      for (int i = 0; i < hands.hands_size(); ++i) {
+        const auto& box = hands.hands(i).box_world();
+        const Eigen::Vector3d lo(box.min().x(), box.min().y(), box.min().z()), hi(box.max().x(), box.max().y(), box.max().z());
+        EXPECT_LT((drawn[static_cast<std::size_t>(i)]->position - 0.5 * (lo + hi)).norm(), 1e-9);
+        EXPECT_LT((drawn[static_cast<std::size_t>(i)]->scale - (hi - lo)).norm(), 1e-9);
+      }
+      const auto person = markers_in(*markers, "person", visualization_msgs_msg_dds__Marker_Constants_CUBE);
+      EXPECT_EQ(person.size(), hands.has_person_box_world() ? 1u : 0u);
+      frames_with_hands += hands.hands_size() > 0;
+      hand_boxes += drawn.size();
+      person_boxes += person.size();
+    }
+  }
+  EXPECT_GT(frames_with_hands, 0u) << "the daemon saw no hand in " << frames << " frames of a hand picking up a cup";
+  std::printf("hands drawn in %zu of %zu frames (%zu boxes), the person's box in %zu\n", frames_with_hands, frames, hand_boxes,
+              person_boxes);
+}
+
 // --publish-odom-tf: the camera's poses come from the robot's odometry (odom -> rig -> camera),
 // the daemon refines them against its memory, and the bridge publishes its correction, world ->
 // odom, on /tf after each frame: the T_world_odom that GetLocalization reports, which undoes a
