@@ -2,6 +2,8 @@
 // that speaks ROS 2's conventions on one side, a client of the daemon's TCP API on the other.
 #include <CLI/CLI.hpp>
 
+#include <malloc.h>
+
 #include <csignal>
 #include <cstdlib>
 #include <iostream>
@@ -155,7 +157,20 @@ std::thread stats_printer(BridgeStats& stats, double period_s) {
 
 }  // namespace
 
+/// Every frame moves megabytes through buffers of the same few sizes (a VGA frame's images, the
+/// request). glibc gives blocks over its mmap threshold fresh pages each time and returns them on
+/// free, and the page faults of touching them cost more than the copies: measured at VGA, 9.4 ms
+/// to write a 1.5 MB request and 4.2 ms to build it, against 0.9 and 2.0 ms with the blocks kept
+/// in the heap (docs/ros2.md). So the blocks stay: up to 32 MiB from the heap, and up to 128 MiB of
+/// free heap kept rather than trimmed. An environment's own GLIBC_TUNABLES still win.
+void keep_large_blocks() {
+  if (std::getenv("GLIBC_TUNABLES") != nullptr) return;
+  mallopt(M_MMAP_THRESHOLD, 32 << 20);
+  mallopt(M_TRIM_THRESHOLD, 128 << 20);
+}
+
 int main(int argc, char** argv) {
+  keep_large_blocks();
   BridgeConfig config;
   if (const char* domain = std::getenv("ROS_DOMAIN_ID"); domain != nullptr && *domain != '\0') {
     config.domain_id = static_cast<std::uint32_t>(std::strtoul(domain, nullptr, 10));

@@ -156,14 +156,18 @@ Status Client::send_raw(std::string_view bytes) {
 }
 
 Status Client::send(const proto::Request& request) {
-  std::string payload;
-  if (!request.SerializeToString(&payload)) return invalid_argument("cannot serialize the request");
-  if (payload.empty()) {
+  // Serialized once, straight behind room for the frame header (a frame of megabytes is not
+  // copied again).
+  std::string frame(kFrameHeaderBytes, '\0');
+  if (!request.AppendToString(&frame)) return invalid_argument("cannot serialize the request");
+  const std::size_t n = frame.size() - kFrameHeaderBytes;
+  if (n == 0) {
     // An empty message serializes to nothing, but a frame must not be empty: spell the id out.
     return invalid_argument("cannot send an empty request (no id and no call)");
   }
-  if (payload.size() > kMaxEncodableFrameBytes) return invalid_argument("request too large for one frame");
-  return send_raw(encode_frame(payload));
+  if (n > kMaxEncodableFrameBytes) return invalid_argument("request too large for one frame");
+  for (std::size_t i = 0; i < kFrameHeaderBytes; ++i) frame[i] = static_cast<char>((n >> (8 * (kFrameHeaderBytes - 1 - i))) & 0xFF);
+  return send_raw(frame);
 }
 
 Result<std::string> Client::read_payload(double timeout_s) {
