@@ -222,6 +222,24 @@ class ClientTest(unittest.TestCase):
         depth = read_png(os.path.join(SAMPLE_DIR, "tabletop", "frame-000000.depth.png"))
         self.assertEqual((depth.width, depth.height, depth.channels, depth.bit_depth), (320, 240, 1, 16))
 
+    def test_images_sent_as_they_are_give_what_the_cloud_gives(self):
+        # The same frame as IngestFrame.rgbd: the daemon back-projects it into the same points.
+        cloud = Sequence(os.path.join(SAMPLE_DIR, "tabletop")).frame(0)
+        images = Sequence(os.path.join(SAMPLE_DIR, "tabletop"), send_images=True).frame(0)
+        self.assertTrue(images.HasField("rgbd") and not images.HasField("cloud"))
+        self.assertEqual(len(images.rgbd.depth_mm), 2 * 320 * 240)
+        self.assertLess(images.ByteSize(), cloud.ByteSize() / 2.5)
+        by_cloud = self.client.ingest_frame(cloud)
+        by_images = self.client.ingest_frame(images)
+        self.assertEqual(by_images.points, by_cloud.points)
+        self.assertEqual(len(by_images.clusters), len(by_cloud.clusters))
+        self.assertEqual(len(by_images.planes), len(by_cloud.planes))
+        # Without intrinsics the daemon cannot back-project: refused, naming them.
+        images.ClearField("intrinsics")
+        with self.assertRaises(scenewatch.StatusError) as caught:
+            self.client.ingest_frame(images)
+        self.assertIn("intrinsics", caught.exception.message)
+
     def test_a_refused_request_raises_the_daemons_status(self):
         # A cloud whose byte count disagrees with its size.
         bad = pb.IngestFrame(cloud=pb.Cloud(width=10, height=1, xyz=b"\0" * 12))
