@@ -166,7 +166,7 @@ Status Client::send(const proto::Request& request) {
     return invalid_argument("cannot send an empty request (no id and no call)");
   }
   if (n > kMaxEncodableFrameBytes) return invalid_argument("request too large for one frame");
-  for (std::size_t i = 0; i < kFrameHeaderBytes; ++i) frame[i] = static_cast<char>((n >> (8 * (kFrameHeaderBytes - 1 - i))) & 0xFF);
+  put_frame_header(static_cast<std::uint32_t>(n), frame.data());
   return send_raw(frame);
 }
 

@@ -10,15 +10,19 @@ namespace {
 constexpr std::size_t kInitialReserveBytes = 64 * 1024;
 }  // namespace
 
+void put_frame_header(std::uint32_t payload_bytes, char* out) {
+  out[0] = static_cast<char>((payload_bytes >> 24) & 0xFF);
+  out[1] = static_cast<char>((payload_bytes >> 16) & 0xFF);
+  out[2] = static_cast<char>((payload_bytes >> 8) & 0xFF);
+  out[3] = static_cast<char>(payload_bytes & 0xFF);
+}
+
 std::string encode_frame(std::string_view payload) {
   assert(!payload.empty() && payload.size() <= kMaxEncodableFrameBytes);
-  const auto n = static_cast<std::uint32_t>(payload.size());
   std::string out;
   out.reserve(kFrameHeaderBytes + payload.size());
-  out.push_back(static_cast<char>((n >> 24) & 0xFF));
-  out.push_back(static_cast<char>((n >> 16) & 0xFF));
-  out.push_back(static_cast<char>((n >> 8) & 0xFF));
-  out.push_back(static_cast<char>(n & 0xFF));
+  out.resize(kFrameHeaderBytes);
+  put_frame_header(static_cast<std::uint32_t>(payload.size()), out.data());
   out.append(payload);
   return out;
 }

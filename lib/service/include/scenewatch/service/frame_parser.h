@@ -22,6 +22,9 @@ inline constexpr std::size_t kFrameHeaderBytes = 4;
 /// The largest payload the 4-byte prefix can describe.
 inline constexpr std::uint64_t kMaxEncodableFrameBytes = 0xFFFFFFFFull;
 
+/// Writes the 4-byte big-endian length of a payload of `payload_bytes` at `out`.
+void put_frame_header(std::uint32_t payload_bytes, char* out);
+
 /// Prepends the 4-byte big-endian length to a payload. The payload must be 1..2^32-1 bytes.
 std::string encode_frame(std::string_view payload);
 
