@@ -23,25 +23,32 @@ bool is_within(const fs::path& path, const fs::path& root) {
   return root_it == root.end();
 }
 
+/// An error unless `k` is for a width x height image; `what` names the points ("the organized cloud").
+Status check_intrinsics_fit(const Intrinsics& k, std::uint32_t width, std::uint32_t height, const std::string& what) {
+  if (static_cast<std::uint32_t>(k.width) == width && static_cast<std::uint32_t>(k.height) == height) return {};
+  return invalid_argument("intrinsics are for a " + std::to_string(k.width) + " x " + std::to_string(k.height) + " image but " +
+                          what + " " + std::to_string(width) + " x " + std::to_string(height));
+}
+
 }  // namespace
 
-/// The points of an IngestFrame that carries images: back-projected through its intrinsics.
+/// The points of an IngestFrame that carries images: back-projected through its intrinsics, which
+/// the frame keeps.
 Result<Frame> RequestHandler::Impl::decode_rgbd_frame(const proto::IngestFrame& msg) {
   if (!msg.has_intrinsics()) return invalid_argument("rgbd needs intrinsics to back-project the depth image");
   auto images = convert::decode_rgbd(msg.rgbd());
   if (!images) return images.error();
   auto k = convert::decode_intrinsics(msg.intrinsics(), "intrinsics");
   if (!k) return k.error();
-  if (k->width != images->depth.width || k->height != images->depth.height) {
-    return invalid_argument("intrinsics are for a " + std::to_string(k->width) + " x " + std::to_string(k->height) +
-                            " image but the rgbd images are " + std::to_string(images->depth.width) + " x " +
-                            std::to_string(images->depth.height));
-  }
+  const Status fits = check_intrinsics_fit(*k, static_cast<std::uint32_t>(images->depth.width),
+                                           static_cast<std::uint32_t>(images->depth.height), "the rgbd images are");
+  if (!fits) return fits.error();
   auto cloud = io::rgbd_to_cloud(images->color, images->depth, *k, io::kDepthMillimetres);
   if (!cloud) return cloud.error();
   Frame frame;
   frame.cloud = *cloud;
   frame.has_color = images->has_color;
+  frame.intrinsics = *k;
   return frame;
 }
 
@@ -64,14 +71,12 @@ Result<Frame> RequestHandler::Impl::decode_frame(const proto::IngestFrame& msg) 
     if (!pose) return pose.error();
     frame.T_world_camera = *pose;
   }
-  if (msg.has_intrinsics()) {
+  if (msg.has_intrinsics() && !frame.intrinsics) {  // an rgbd frame's were decoded with its images
     auto k = convert::decode_intrinsics(msg.intrinsics(), "intrinsics");
     if (!k) return k.error();
-    if (frame.cloud->height > 1 && (static_cast<std::uint32_t>(k->width) != frame.cloud->width ||
-                                    static_cast<std::uint32_t>(k->height) != frame.cloud->height)) {
-      return invalid_argument("intrinsics are for a " + std::to_string(k->width) + " x " +
-                              std::to_string(k->height) + " image but the organized cloud is " +
-                              std::to_string(frame.cloud->width) + " x " + std::to_string(frame.cloud->height));
+    if (frame.cloud->height > 1) {
+      const Status fits = check_intrinsics_fit(*k, frame.cloud->width, frame.cloud->height, "the organized cloud is");
+      if (!fits) return fits.error();
     }
     frame.intrinsics = *k;
   }
