@@ -5,7 +5,6 @@
 #include <algorithm>
 
 #include "scenewatch/io/bag/image_conversion.h"
-#include "scenewatch/io/rgbd.h"
 #include "scenewatch/service/access_token.h"
 
 namespace scenewatch::ros {
@@ -24,15 +23,11 @@ Result<proto::IngestFrame> request_of(const FrameJob& job, const BridgeConfig& c
   if (!job.T_world_camera) frame.localization = LocalizationMode::kTrack;  // --without-tf track
   if (job.cloud) {
     reason = "bad_cloud";
-    const auto view = cloud_view(*job.cloud);
-    auto cloud = io::bag::to_cloud(view);
-    if (!cloud) return Error{cloud.error().code, config.cloud_topic + ": " + cloud.error().message};
-    frame.cloud = *cloud;
-    frame.has_color = std::any_of(view.fields.begin(), view.fields.end(), [](const auto& f) { return f.name == "rgb" || f.name == "rgba"; });
-    frame.intrinsics = job.intrinsics;
-    if (!frame.intrinsics) {
-      if (auto K = io::estimate_intrinsics(*frame.cloud)) frame.intrinsics = *K;
-    }
+    auto points = io::bag::to_cloud_frame(cloud_view(*job.cloud), job.intrinsics);
+    if (!points) return Error{points.error().code, config.cloud_topic + ": " + points.error().message};
+    frame.cloud = points->cloud;
+    frame.has_color = points->has_color;
+    frame.intrinsics = points->intrinsics;
     frame.source = config.cloud_topic;
     return service::make_ingest_frame(frame);
   }

@@ -284,15 +284,11 @@ Result<Frame> load_bag_frame(Recording& rec, std::size_t index) {
   if (!rec.cloud_topic.empty()) {
     auto msg = bag::decode_point_cloud2(*depth_bytes, c.topics()[dm.topic].format);
     if (!msg) return fail(f.depth_message, msg.error());
-    auto cloud = bag::to_cloud(*msg);
-    if (!cloud) return fail(f.depth_message, cloud.error());
-    frame.cloud = *cloud;
-    frame.has_color = std::any_of(msg->fields.begin(), msg->fields.end(), [](const auto& fd) { return fd.name == "rgb" || fd.name == "rgba"; });
-    if (rec.intrinsics) {
-      frame.intrinsics = rec.intrinsics;
-    } else if (auto K = estimate_intrinsics(**cloud)) {
-      frame.intrinsics = *K;
-    }
+    auto points = bag::to_cloud_frame(*msg, rec.intrinsics);
+    if (!points) return fail(f.depth_message, points.error());
+    frame.cloud = points->cloud;
+    frame.has_color = points->has_color;
+    frame.intrinsics = points->intrinsics;
     return frame;
   }
   auto msg = bag::decode_image(*depth_bytes, c.topics()[dm.topic].format);

@@ -153,6 +153,19 @@ Result<CloudPtr> to_cloud(const PointCloud2Message& m) {
   return cloud;
 }
 
+Result<CloudFrame> to_cloud_frame(const PointCloud2Message& m, const std::optional<Intrinsics>& info) {
+  auto cloud = to_cloud(m);
+  if (!cloud) return cloud.error();
+  CloudFrame out;
+  out.cloud = *cloud;
+  out.has_color = std::any_of(m.fields.begin(), m.fields.end(), [](const PointField& f) { return f.name == "rgb" || f.name == "rgba"; });
+  out.intrinsics = info;
+  if (!out.intrinsics) {
+    if (auto K = estimate_intrinsics(*out.cloud)) out.intrinsics = *K;
+  }
+  return out;
+}
+
 Result<Intrinsics> to_intrinsics(const CameraInfoMessage& m) {
   Intrinsics K;
   K.fx = m.K[0];

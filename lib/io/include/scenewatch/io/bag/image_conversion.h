@@ -3,6 +3,8 @@
 // 16UC1/mono16 in millimetres, 32FC1 in metres (rounded to millimetres, NaN and <= 0 = no depth);
 // organized PointCloud2 with FLOAT32 x, y, z and optional rgb/rgba. Row strides and big-endian
 // data are honoured; sizes that do not add up are errors.
+#include <optional>
+
 #include "scenewatch/io/bag/messages.h"
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/geometry.h"
@@ -18,6 +20,16 @@ Result<ColorImage> to_color(const ImageMessage& m);
 Result<DepthImage> to_depth(const ImageMessage& m);
 /// An organized cloud in the message's frame; error for an unorganized one (height 1).
 Result<CloudPtr> to_cloud(const PointCloud2Message& m);
+
+/// A PointCloud2 as a frame's points: to_cloud's cloud, whether the message has an rgb/rgba
+/// field, and the pinhole: `info` (a CameraInfo's) when given, else estimated from the points
+/// (io::estimate_intrinsics; none when that fails).
+struct CloudFrame {
+  CloudPtr cloud;
+  bool has_color = false;
+  std::optional<Intrinsics> intrinsics;
+};
+Result<CloudFrame> to_cloud_frame(const PointCloud2Message& m, const std::optional<Intrinsics>& info);
 
 /// The pinhole of a CameraInfo's K and size; error unless the focal lengths are positive and finite.
 Result<Intrinsics> to_intrinsics(const CameraInfoMessage& m);
