@@ -21,6 +21,9 @@ constexpr int kMaxNormalBaselinePx = 16;
 constexpr int kRounds = 3;
 // Correspondences found anew this many times (ICP's outer loop).
 constexpr int kIterations = 3;
+// A step that moves a point kFarM away by less than kConvergedFraction of a voxel has converged.
+constexpr double kFarM = 3.0;
+constexpr double kConvergedFraction = 0.01;
 
 struct Sample {
   Eigen::Vector3d world = Eigen::Vector3d::Zero();  // the observed point, placed with the given pose
@@ -66,38 +69,56 @@ bool surface_along(const background::DenseGrid& grid, const Eigen::Vector3d& ori
 
 
 
-// The samples of a frame placed with pose T: rays of trusted pixels that meet a map surface.
-std::vector<Sample> collect(const background::DenseGrid& grid, const Cloud& cloud, const Pose& T, const DepthValidity& trusted,
-                            double focal_px, const SensorModel& sensor, int step_px) {
-  const Eigen::Vector3d origin = T.translation();
-  const double quantization2 = grid.resolution * grid.resolution / 12.0;
-  std::vector<Sample> samples;
+// A trusted pixel with a normal of its own: what does not depend on the pose, found once.
+struct Pixel {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();  // the observed point, camera frame
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();  // its surface normal, camera frame, facing the camera
+  double sigma = 0.0;                           // its noise with the map's quantization, metres
+};
+
+std::vector<Pixel> pixels_of(const Cloud& cloud, const DepthValidity& trusted, double focal_px, const SensorModel& sensor,
+                             double resolution, int step_px) {
+  const double quantization2 = resolution * resolution / 12.0;
+  std::vector<Pixel> out;
   const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height);
   for (int v = step_px / 2; v < h; v += step_px)
     for (int u = step_px / 2; u < w; u += step_px) {
       if (!trusted.has(u, v)) continue;
-      Eigen::Vector3d n_camera;
-      if (!normal_at(cloud, u, v, trusted, focal_px, n_camera)) continue;
+      Pixel px;
+      if (!normal_at(cloud, u, v, trusted, focal_px, px.n)) continue;
       const PointT& p = cloud.points[static_cast<std::size_t>(v) * w + u];
-      const Eigen::Vector3d ray = T * p.getVector3fMap().cast<double>() - origin;
-      const double range = ray.norm();
-      if (!(range > kWindowM)) continue;
-      const Eigen::Vector3d dir = ray / range;
-      const Eigen::Vector3d n = T.linear() * n_camera;
-      if (-n.dot(dir) < kMinCosIncidence) continue;
-      double surface = 0;
-      if (!surface_along(grid, origin, dir, range, surface)) continue;
-      Sample s;
-      s.world = origin + ray;
-      // Point-to-plane: the observed point's offset from the map's surface point on its ray,
-      // along the normal. A camera motion (rotation w about its centre, translation t) moves the
-      // point by w x ray + t.
-      s.e = (range - surface) * n.dot(dir);
-      s.J.head<3>() = ray.cross(n);
-      s.J.tail<3>() = n;
-      s.sigma = std::sqrt(std::pow(sensor.sigma_z(p.z), 2) + quantization2);
-      samples.push_back(s);
+      px.p = p.getVector3fMap().cast<double>();
+      px.sigma = std::sqrt(std::pow(sensor.sigma_z(p.z), 2) + quantization2);
+      out.push_back(px);
     }
+  return out;
+}
+
+// The samples of a frame placed with pose T: rays of its pixels that meet a map surface.
+std::vector<Sample> collect(const background::DenseGrid& grid, const std::vector<Pixel>& pixels, const Pose& T) {
+  const Eigen::Vector3d origin = T.translation();
+  std::vector<Sample> samples;
+  samples.reserve(pixels.size());
+  for (const Pixel& px : pixels) {
+    const Eigen::Vector3d ray = T * px.p - origin;
+    const double range = ray.norm();
+    if (!(range > kWindowM)) continue;
+    const Eigen::Vector3d dir = ray / range;
+    const Eigen::Vector3d n = T.linear() * px.n;
+    if (-n.dot(dir) < kMinCosIncidence) continue;
+    double surface = 0;
+    if (!surface_along(grid, origin, dir, range, surface)) continue;
+    Sample s;
+    s.world = origin + ray;
+    // Point-to-plane: the observed point's offset from the map's surface point on its ray,
+    // along the normal. A camera motion (rotation w about its centre, translation t) moves the
+    // point by w x ray + t.
+    s.e = (range - surface) * n.dot(dir);
+    s.J.head<3>() = ray.cross(n);
+    s.J.tail<3>() = n;
+    s.sigma = px.sigma;
+    samples.push_back(s);
+  }
   return samples;
 }
 
@@ -140,8 +161,9 @@ PoseAgreement pose_agreement(const background::DenseGrid& grid, const Cloud& clo
   // ICP's outer loop: correspondences found again along the rays of the corrected pose.
   Pose corrected = T;
   std::vector<Sample> first;
+  const std::vector<Pixel> pixels = pixels_of(cloud, trusted, focal_px, sensor, grid.resolution, step_px);
   for (int iteration = 0; iteration < kIterations; ++iteration) {
-    std::vector<Sample> samples = collect(grid, cloud, corrected, trusted, focal_px, sensor, step_px);
+    std::vector<Sample> samples = collect(grid, pixels, corrected);
     if (iteration == 0) out.samples = samples.size();
     Eigen::Matrix<double, 6, 1> delta;
     double rms = 0;
@@ -160,6 +182,9 @@ PoseAgreement pose_agreement(const background::DenseGrid& grid, const Cloud& clo
     const Eigen::Vector3d origin = corrected.translation();
     motion.translation() = origin - motion.linear() * origin + delta.tail<3>();
     corrected = motion * corrected;
+    // Converged: this step moved the points it was fitted on by well under the map's resolution,
+    // so new correspondences along the corrected rays would be the same ones.
+    if (delta.tail<3>().norm() + delta.head<3>().norm() * kFarM < kConvergedFraction * grid.resolution) break;
   }
   // The misalignment: the motion that takes the frame from its given pose to the corrected one.
   out.correction = corrected * T.inverse();

@@ -18,9 +18,17 @@ void SurfaceWitness::witness(const Cloud& cloud, const Pose& T, std::uint32_t ca
   ++frame_;
   const std::uint64_t bit = std::uint64_t{1} << (camera % 64);
   const Eigen::Isometry3f Tf = T.cast<float>();
+  // Neighbouring pixels mostly fall in one voxel (a 2 cm voxel spans 5 pixels at 2 m): marking
+  // it again changes nothing, so runs of one key cost one lookup.
+  std::uint64_t last = 0;
+  bool any = false;
   auto add = [&](const PointT& p) {
     if (!is_valid(p)) return;
-    Entry& e = voxels_[key((Tf * p.getVector3fMap()).cast<double>())];
+    const std::uint64_t k = key((Tf * p.getVector3fMap()).cast<double>());
+    if (any && k == last) return;
+    any = true;
+    last = k;
+    Entry& e = voxels_[k];
     e.cameras |= bit;
     e.last_frame = frame_;
   };

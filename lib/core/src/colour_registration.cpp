@@ -215,21 +215,36 @@ ColourRemap::ColourRemap(int width, int height, const Intrinsics& K, const Colou
 }
 
 CloudPtr ColourRemap::apply(const Cloud& organized) const {
-  auto out = std::make_shared<Cloud>(organized);
-  if (!fits(organized) || tap_.empty()) return out;
+  auto out = std::make_shared<Cloud>();
+  apply(organized, *out);
+  return out;
+}
+
+void ColourRemap::apply(const Cloud& organized, Cloud& out) const {
+  out.header = organized.header;
+  out.width = organized.width;
+  out.height = organized.height;
+  out.is_dense = organized.is_dense;
+  out.sensor_origin_ = organized.sensor_origin_;
+  out.sensor_orientation_ = organized.sensor_orientation_;
+  if (!fits(organized) || tap_.empty()) {
+    out.points = organized.points;
+    return;
+  }
   const auto& in = organized.points;
+  out.points.resize(in.size());
   const std::size_t w = static_cast<std::size_t>(width_);
   for (std::size_t i = 0; i < tap_.size(); ++i) {
     const std::size_t t = tap_[i];
     const float a = ax_[i], b = ay_[i];
     const float w00 = (1 - a) * (1 - b), w10 = a * (1 - b), w01 = (1 - a) * b, w11 = a * b;
     const PointT &p00 = in[t], &p10 = in[t + 1], &p01 = in[t + w], &p11 = in[t + w + 1];
-    PointT& q = out->points[i];
+    PointT& q = out.points[i];
+    q = in[i];
     q.r = static_cast<std::uint8_t>(w00 * p00.r + w10 * p10.r + w01 * p01.r + w11 * p11.r + 0.5f);
     q.g = static_cast<std::uint8_t>(w00 * p00.g + w10 * p10.g + w01 * p01.g + w11 * p11.g + 0.5f);
     q.b = static_cast<std::uint8_t>(w00 * p00.b + w10 * p10.b + w01 * p01.b + w11 * p11.b + 0.5f);
   }
-  return out;
 }
 
 CloudPtr apply_colour_registration(const Cloud& organized, const Intrinsics& K, const ColourRegistration& r) {

@@ -5,9 +5,11 @@
 // surprise, the hand detector). A registration that moves no pixel by a whole pixel is left
 // alone: the frame goes on as it came, uncopied.
 // NOT thread safe: the working memory's writer owns it.
+#include <atomic>
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <vector>
 
 #include "scenewatch/core/colour_registration.h"
 #include "scenewatch/core/frame.h"
@@ -28,8 +30,10 @@ class ColourRegistrationStage {
     const double cx = K.fx > 0 ? K.cx : (w - 1) / 2.0, cy = K.fy > 0 ? K.cy : (h - 1) / 2.0;
     if (!r || r->max_displacement_px(w, h, cx, cy) < 1.0) return frame;
     if (!c.remap || !c.remap->fits(*frame.cloud)) c.remap = std::make_unique<ColourRemap>(w, h, K, *r);
+    CloudPtr registered = spare(c);
+    c.remap->apply(*frame.cloud, *registered);
     Frame out = frame;
-    out.cloud = c.remap->apply(*frame.cloud);
+    out.cloud = std::move(registered);
     return out;
   }
 
@@ -44,11 +48,28 @@ class ColourRegistrationStage {
   void reset() { cameras_.clear(); }
 
  private:
+  // Registered clouds are written into buffers nobody holds any more (a frame's cloud is let go
+  // once the frame is processed, unless a stage keeps it): a fresh 10 MB a frame cost a page fault
+  // per 4 kB, more than the remap itself.
+  static constexpr std::size_t kBuffers = 3;
+
   SensorModel sensor_;
   struct Camera {
     ColourRegistrationEstimate estimate;
     std::unique_ptr<ColourRemap> remap;  // laid out for the camera's image size at its first registered frame
+    std::vector<CloudPtr> buffers;       // held here alone when use_count() is 1: free to overwrite
   };
+  static CloudPtr spare(Camera& c) {
+    for (const CloudPtr& b : c.buffers)
+      if (b.use_count() == 1) {
+        // Whoever let go last is done reading it (its release of the count pairs with this).
+        std::atomic_thread_fence(std::memory_order_acquire);
+        return b;
+      }
+    auto b = std::make_shared<Cloud>();
+    if (c.buffers.size() < kBuffers) c.buffers.push_back(b);
+    return b;
+  }
   std::map<std::uint32_t, Camera> cameras_;
 };
 

@@ -62,6 +62,9 @@ class ColourRemap {
   /// A copy of the cloud whose colours are read, bilinearly, where the registration says each
   /// pixel's colour lies (clamped to the image). Points keep their coordinates. Needs fits().
   CloudPtr apply(const Cloud& organized) const;
+  /// The same, written into `out` in one pass (its storage is reused when it has the size
+  /// already: a camera's frames need no fresh 10 MB each). `out` must not be `organized`.
+  void apply(const Cloud& organized, Cloud& out) const;
 
  private:
   int width_ = 0, height_ = 0;
