@@ -124,5 +124,37 @@ TEST(SurfaceWitness, ACameraClaimsOnlyAgainstWhatItHasSeen) {
   EXPECT_EQ(small.seen(Eigen::Vector3d(0.001, 0, 1.0), 0), SurfaceWitness::Seen::kByNone);
 }
 
+// The map's surface lies within the noise of the nearest depth it was seen at: one point of the
+// world, seen from 3 m by one camera and from 1.2 m by another, keeps 1.2 m, whichever came first.
+TEST(SurfaceWitness, KeepsTheNearestDepthEachSurfaceWasSeenAt) {
+  SurfaceWitness witness(0.02);
+  const Eigen::Vector3d world(0.11, 0.01, 3.01);
+  auto seen_from = [&](double back_m) {
+    Cloud cloud;
+    PointT p;
+    p.x = static_cast<float>(world.x());
+    p.y = static_cast<float>(world.y());
+    p.z = static_cast<float>(world.z() - back_m);  // camera frame: the camera at z = back_m
+    cloud.push_back(p);
+    Pose T = Pose::Identity();
+    T.translation() = Eigen::Vector3d(0, 0, back_m);
+    return std::make_pair(cloud, T);
+  };
+  double depth = -1;
+  EXPECT_EQ(witness.seen(world, 0, &depth), SurfaceWitness::Seen::kByNone);
+  EXPECT_EQ(depth, 0.0) << "no depth for a surface nobody saw";
+  const auto [far, T_far] = seen_from(0.0);
+  witness.witness(far, T_far, 0);
+  witness.seen(world, 0, &depth);
+  EXPECT_NEAR(depth, 3.01, 1e-6);
+  const auto [near, T_near] = seen_from(1.81);
+  witness.witness(near, T_near, 1);
+  EXPECT_EQ(witness.seen(world, 0, &depth), SurfaceWitness::Seen::kBySelf);
+  EXPECT_NEAR(depth, 1.2, 1e-6);
+  witness.witness(far, T_far, 0);
+  witness.seen(world, 1, &depth);
+  EXPECT_NEAR(depth, 1.2, 1e-6) << "a farther sighting later does not widen it again";
+}
+
 }  // namespace
 }  // namespace scenewatch::change

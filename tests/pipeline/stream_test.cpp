@@ -241,14 +241,15 @@ TEST(Stream, RealKitchenRevisitedIsCalm) {
 
 TEST(Stream, RealKitchenStretchHeldOutFromTuningIsCalm) {
   // redkitchen_long's files 250-498, which no remedy of issue 28 was tuned on (files 0-248 were):
-  // 18 false events before the sensor model, 1 after (a seen-through sliver at 2.3 m, frame 105).
+  // 18 false events before the sensor model, 1 after (a sliver at 2.6 m seen through by 8 cm,
+  // frame 105), 0 since a gap counts the map surface's noise as well as the frame's.
   SCENEWATCH_REQUIRE_DATA("redkitchen_long/frame-000498.color.jpg");
   std::vector<std::size_t> order;
   for (std::size_t i = 125; i < 250; ++i) order.push_back(i);
   std::size_t with_hands = 0;
   const auto events = run_recording(test::data_dir() / "redkitchen_long", order, {}, &with_hands);
   std::printf("redkitchen_long files 250-498: %zu events in 125 frames, hands in %zu frames\n", events.size(), with_hands);
-  EXPECT_LE(events.size(), 1u);
+  EXPECT_TRUE(events.empty());
   // Nobody is in it either: 13 frames with "hands" when a hand's points had to fall in an occupied
   // voxel to count as furniture, 10 since they count within the sensor's axial tolerance along
   // their ray (a wooden cupboard side entering the view, files 410-442, blanked as an arm and so
@@ -278,8 +279,9 @@ TEST(Stream, TwoCamerasOnOneRoomInterleaved) {
   // a claim only as far behind as a displaced version of it could lie (so that a camera joining
   // after a change can tell an addition): an OBJECT_ADDED of 36 points at 2.2 m, 14-20 cm in front
   // of camera b's surface. Other interleavings, not tuned on: files 0-248 with 250-498 either way
-  // round, 2 events before and after; files 80-198 with 380-498, 0 before and after.
-  EXPECT_LE(events.size(), 2u);
+  // round, 2 events before and after; files 80-198 with 380-498, 0 before and after. 1 since a
+  // gap counts the map surface's noise as well as the frame's: the addition at 2.9 m remains.
+  EXPECT_LE(events.size(), 1u);
 }
 
 }  // namespace

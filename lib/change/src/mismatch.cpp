@@ -179,14 +179,19 @@ std::vector<MissingVoxel> missing_surfaces(const background::DenseGrid& grid, co
   for (const background::DenseGrid::Surface& surface : grid.occupied) {
     if (surface.probability < min_probability) continue;
     const Eigen::Vector3d c = grid.center(static_cast<long>(surface.index));
-    if (witness != nullptr && witness->seen(c, camera) == SurfaceWitness::Seen::kByOthersOnly) continue;
+    double seen_depth = 0.0;
+    if (witness != nullptr && witness->seen(c, camera, &seen_depth) == SurfaceWitness::Seen::kByOthersOnly) continue;
     const Eigen::Vector3d q = T_camera_world * c;
     if (q.z() <= res || q.z() > config.max_range_m) continue;
     const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
     const double shift = measured_pose.shift_at(c);
     const double half_px = K.fx * (kHalfDiagonal * res + config.sigma_factor * config.sensor.pose_sigma_at(q.z()) + shift) / q.z();
     if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) continue;
-    const double limit = q.z() + kHalfDiagonal * res + map_tolerance_m(config, q.z(), shift);
+    // A gap is measured between two noisy surfaces: the frame's at this depth, and the map's,
+    // which lies within the noise of the nearest depth it was seen at (when this session saw it).
+    const double frame_sigma = config.sensor.sigma_z(q.z());
+    const double sigma = seen_depth > 0 ? std::hypot(frame_sigma, config.sensor.sigma_z(seen_depth)) : frame_sigma;
+    const double limit = q.z() + kHalfDiagonal * res + map_tolerance_from_sigma(config, sigma, q.z(), shift);
     constexpr int kSteps = 3;  // (2 kSteps + 1)^2 samples over the footprint
     int with_depth = 0, total = 0;
     float nearest = std::numeric_limits<float>::infinity();

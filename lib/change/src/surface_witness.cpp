@@ -31,6 +31,7 @@ void SurfaceWitness::witness(const Cloud& cloud, const Pose& T, std::uint32_t ca
     Entry& e = voxels_[k];
     e.cameras |= bit;
     e.last_frame = frame_;
+    if (e.nearest_depth_m == 0.0f || p.z < e.nearest_depth_m) e.nearest_depth_m = p.z;
   };
   if (cloud.height > 1 && stride > 1) {
     for (std::uint32_t v = 0; v < cloud.height; v += static_cast<std::uint32_t>(stride))
@@ -41,8 +42,9 @@ void SurfaceWitness::witness(const Cloud& cloud, const Pose& T, std::uint32_t ca
   if (voxels_.size() > max_voxels_) prune();
 }
 
-SurfaceWitness::Seen SurfaceWitness::seen(const Eigen::Vector3d& p, std::uint32_t camera) const {
+SurfaceWitness::Seen SurfaceWitness::seen(const Eigen::Vector3d& p, std::uint32_t camera, double* nearest_depth_m) const {
   const auto it = voxels_.find(key(p));
+  if (nearest_depth_m != nullptr) *nearest_depth_m = it == voxels_.end() ? 0.0 : it->second.nearest_depth_m;
   if (it == voxels_.end()) return Seen::kByNone;
   return (it->second.cameras & (std::uint64_t{1} << (camera % 64))) != 0 ? Seen::kBySelf : Seen::kByOthersOnly;
 }

@@ -28,8 +28,10 @@ class SurfaceWitness {
   /// Records the surfaces of a frame (every `stride`-th pixel of every `stride`-th row of an
   /// organized cloud; every point of an unorganized one) as seen by `camera` (ids modulo 64).
   void witness(const Cloud& points_camera, const Pose& T_world_camera, std::uint32_t camera, int stride = 2);
-  /// Who has seen the surface in the voxel of p, as far as `camera` is concerned.
-  Seen seen(const Eigen::Vector3d& p_world, std::uint32_t camera) const;
+  /// Who has seen the surface in the voxel of p, as far as `camera` is concerned; with
+  /// `nearest_depth_m`, also the smallest depth any camera saw it at (0 when none did): the
+  /// sensor's noise at that depth bounds where the map's surface lies.
+  Seen seen(const Eigen::Vector3d& p_world, std::uint32_t camera, double* nearest_depth_m = nullptr) const;
   /// Surfaces written free or gone (a confirmed removal) are forgotten.
   void forget(const std::vector<Eigen::Vector3d>& points_world);
 
@@ -40,6 +42,7 @@ class SurfaceWitness {
   struct Entry {
     std::uint64_t cameras = 0;  ///< bit (camera id mod 64) per camera that saw it
     std::uint64_t last_frame = 0;
+    float nearest_depth_m = 0.0f;  ///< the smallest depth (camera z) it was seen at
   };
   std::uint64_t key(const Eigen::Vector3d& p) const;
   void prune();
