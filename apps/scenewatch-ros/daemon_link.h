@@ -99,7 +99,7 @@ class DaemonLink {
   std::optional<std::uint64_t> start(service::Client& client, proto::Request request, const char* what);
   std::optional<proto::Response> wait_for(service::Client& client, std::uint64_t id, const char* what);
   /// A transport error on `client`: logged, counted as connection_lost, the connection closed.
-  /// Returns false (send_frame's "the connection broke").
+  /// Returns false (finish_frame's "the connection broke").
   bool lose(service::Client& client, const char* what, const std::string& why);
   /// Waits up to seconds unless stopping; false when stopping.
   bool sleep_for(double seconds);

@@ -2,7 +2,7 @@
 /// The newest events the bridge has seen, for the marker array: the daemon reports an event both
 /// in the IngestReply of the frame that raised it and on the Subscribe connection, so both feed
 /// this store and it keeps each event once (by id). Thread safe: add() from the ingest and the
-/// subscribe threads, newest() from the ingest thread.
+/// subscribe threads, newest() from the publishing thread.
 #include <cstddef>
 #include <map>
 #include <mutex>
