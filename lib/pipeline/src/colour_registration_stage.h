@@ -49,8 +49,9 @@ class ColourRegistrationStage {
 
  private:
   // Registered clouds are written into buffers nobody holds any more (a frame's cloud is let go
-  // once the frame is processed, unless a stage keeps it): a fresh 10 MB a frame cost a page fault
-  // per 4 kB, more than the remap itself.
+  // once the frame is processed, unless a stage keeps it), rather than into a fresh 10 MB a frame
+  // faulted in page by page. On redkitchen_long two buffers take turns: 2 allocated, then 19 of
+  // 21 frames reused one.
   static constexpr std::size_t kBuffers = 3;
 
   SensorModel sensor_;
