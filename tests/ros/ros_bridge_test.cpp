@@ -800,18 +800,19 @@ TEST_F(RosBridgeTest, AStalledKeepAllSubscriberInAnotherProcessDoesNotStallTheBr
   // Lock step: each frame's answer (its Detection3DArray) timed from its publication.
   std::vector<double> answer_ms;
   std::size_t events = 0;
+  auto take_events = [&] {
+    DdsPeer::take<scenewatch_msgs_msg_dds__EventArray_>(camera.events_reader(),
+                                                         [&](const scenewatch_msgs_msg_dds__EventArray_& m) { events += m.events._length; });
+  };
   for (std::size_t i = 0; i < rendered.size(); ++i) {
     const double stamp = kStamp0 + static_cast<double>(i) / 30.0;
     const auto published = Clock::now();
     camera.publish(rendered[i], shipped.scenario.intrinsics, stamp);
     if (camera.objects_of(stamp, kFrameWaitS)) answer_ms.push_back(ms_since(published));
-    DdsPeer::take<scenewatch_msgs_msg_dds__EventArray_>(camera.events_reader(),
-                                                         [&](const scenewatch_msgs_msg_dds__EventArray_& m) { events += m.events._length; });
+    take_events();
   }
-  const auto waited = Clock::now();
-  while (events == 0 && ms_since(waited) < kFrameWaitS * 1000) {
-    DdsPeer::take<scenewatch_msgs_msg_dds__EventArray_>(camera.events_reader(),
-                                                         [&](const scenewatch_msgs_msg_dds__EventArray_& m) { events += m.events._length; });
+  for (const auto waited = Clock::now(); events == 0 && ms_since(waited) < kFrameWaitS * 1000;) {
+    take_events();
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   EXPECT_EQ(answer_ms.size(), rendered.size()) << "every frame gives its Detection3DArray";
