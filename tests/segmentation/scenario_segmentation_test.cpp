@@ -132,15 +132,15 @@ TEST(ScenarioSegmentation, Clutter) {
 // support all the same, and the boxes on both pieces are found (with the largest piece alone
 // as the support: 6 of 9, the box behind is lost).
 TEST(ScenarioSegmentation, TableSplitByAnOccluderIsOneSupport) {
-  Config bridged;
-  bridged.bridge_hidden_support = true;
-  const SceneRun run = run_scenario("hidden_table", 1, bridged);
+  const SceneRun run = run_scenario("hidden_table", 1, Config{});
   ASSERT_EQ(run.frames, 3u);
   std::printf("hidden table: matched %zu of %zu, correct %zu of %zu\n", run.matched, run.objects, run.correct, run.clusters);
   EXPECT_EQ(run.matched, run.objects);
   EXPECT_EQ(run.correct, run.clusters);
-  // Off (the default), the largest visible piece alone is the support: measured 6 of 9.
-  const SceneRun alone = run_scenario("hidden_table");
+  // Off, the largest visible piece alone is the support: measured 6 of 9.
+  Config largest_piece;
+  largest_piece.bridge_hidden_support = false;
+  const SceneRun alone = run_scenario("hidden_table", 1, largest_piece);
   EXPECT_LT(alone.matched, run.matched);
 }
 
@@ -151,10 +151,10 @@ TEST(ScenarioSegmentation, TableSplitByAnOccluderIsOneSupport) {
 TEST(ScenarioSegmentation, FloorNoiseFarFromTheSensorBridgesNoSupport) {
   auto file = io::read_cloud(test::source_dir() / "sample_clouds/tabletop.pcd");
   ASSERT_TRUE(file.ok()) << file.error().message;
-  Config bridged;
-  bridged.bridge_hidden_support = true;
-  const Segmentation plain = segment(*file->cloud, Config{}, file->sensor_origin);
-  const Segmentation seg = segment(*file->cloud, bridged, file->sensor_origin);
+  Config largest_piece;
+  largest_piece.bridge_hidden_support = false;
+  const Segmentation plain = segment(*file->cloud, largest_piece, file->sensor_origin);
+  const Segmentation seg = segment(*file->cloud, Config{}, file->sensor_origin);
   EXPECT_EQ(plain.objects.size(), 4u);
   ASSERT_EQ(seg.objects.size(), 4u);
   ASSERT_EQ(seg.planes.size(), plain.planes.size());

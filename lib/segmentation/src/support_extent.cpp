@@ -32,6 +32,13 @@ class CellGrid {
     return it->second;
   }
   std::size_t size() const { return coords_.size(); }
+  /// The diagonal of the cells' bounding box, one cell added each way.
+  double diagonal_m() const {
+    if (coords_.empty()) return 0.0;
+    long a0 = coords_[0].first, a1 = a0, b0 = coords_[0].second, b1 = b0;
+    for (const auto& [a, b] : coords_) a0 = std::min(a0, a), a1 = std::max(a1, a), b0 = std::min(b0, b), b1 = std::max(b1, b);
+    return std::hypot(static_cast<double>(a1 - a0 + 3), static_cast<double>(b1 - b0 + 3)) * plane_.cell_m;
+  }
   /// True when the cell of p or one of its 8 neighbours is in the grid.
   bool near(const Eigen::Vector3d& p) const {
     const long a = static_cast<long>(std::floor(p.dot(plane_.u) / plane_.cell_m));
@@ -73,22 +80,26 @@ class CellGrid {
   std::vector<std::pair<long, long>> coords_;
 };
 
-bool has_pieces(const CellGrid& grid) {
-  const std::vector<int> comp = grid.components();
-  return std::any_of(comp.begin(), comp.end(), [](int c) { return c > 0; });
-}
-
 }  // namespace
 
 std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
                                 const PlaneGrid& plane, const std::vector<int>& standing,
                                 const std::optional<Eigen::Vector3d>& sensor_origin, double min_height_m,
-                                double max_height_m, const std::function<double(double range_m)>& noise_floor_m) {
+                                double max_height_m, const std::function<double(double range_m)>& noise_floor_m,
+                                std::vector<int>* visible_piece) {
   CellGrid grid(plane);
   std::vector<int> voxel_cell(inliers.size());
   for (std::size_t i = 0; i < inliers.size(); ++i) voxel_cell[i] = grid.add(centroids[inliers[i]].cast<double>());
+  // The largest piece in sight, by inliers; one of its cells stands for it (cells added later
+  // keep the numbers of those before).
+  const std::vector<int> pieces = grid.components();
+  std::vector<std::size_t> piece_size(grid.size(), 0);
+  for (int c : voxel_cell) ++piece_size[pieces[c]];
+  const int largest = static_cast<int>(std::max_element(piece_size.begin(), piece_size.end()) - piece_size.begin());
+  const int largest_cell = static_cast<int>(std::find(pieces.begin(), pieces.end(), largest) - pieces.begin());
   // One piece in sight: nothing to bridge.
-  if (sensor_origin && has_pieces(grid)) {
+  const bool in_pieces = std::any_of(pieces.begin(), pieces.end(), [](int c) { return c > 0; });
+  if (sensor_origin && in_pieces) {
     const Eigen::Vector3d& o = *sensor_origin;
     const double o_height = plane.n.dot(o) + plane.d;
     // The highest voxel over each cell hides the most: its shadow covers those of the voxels
@@ -107,24 +118,32 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
       auto [it, inserted] = highest.try_emplace(key, h, w);
       if (!inserted && it->second.first < h) it.value() = {h, w};
     }
+    // A shadow longer than the visible plane's extent reaches past every visible cell: the part
+    // beyond joins nothing (near the sensor's height, shadows run on for kilometres).
+    const double reach_m = visible.diagonal_m();
     for (const auto& [key, top] : highest) {
       const Eigen::Vector3d q = centroids[top.second].cast<double>();
       const double h = top.first;
       // The ray o + t (q - o) meets the plane at t = o_height / (o_height - h) > 1: behind q.
       const Eigen::Vector3d foot = q - h * plane.n;
-      const Eigen::Vector3d shadow = o + (o_height / (o_height - h)) * (q - o);
+      Eigen::Vector3d shadow = o + (o_height / (o_height - h)) * (q - o);
+      if ((shadow - foot).norm() > reach_m) shadow = foot + (shadow - foot).normalized() * reach_m;
       const int steps = static_cast<int>(std::ceil((shadow - foot).norm() / plane.cell_m));
       for (int k = 0; k <= steps; ++k) grid.add(foot + (shadow - foot) * (steps ? static_cast<double>(k) / steps : 0.0));
     }
   }
-  const std::vector<int> comp = grid.components();
-  std::vector<std::size_t> size(grid.size(), 0);
-  for (int c : voxel_cell) ++size[comp[c]];
-  const int best = static_cast<int>(std::max_element(size.begin(), size.end()) - size.begin());
+  // The support is the largest visible piece and what the hidden cells join to it: bridging
+  // extends that piece and never trades it for other pieces joined among themselves. A piece of
+  // fewer voxels than plane.min_piece_voxels does not join.
+  const std::vector<int> comp = grid.size() == pieces.size() ? pieces : grid.components();
+  const int best = comp[largest_cell];
   std::vector<int> out;
-  out.reserve(size[best]);
+  if (visible_piece) visible_piece->clear();
   for (std::size_t i = 0; i < inliers.size(); ++i) {
-    if (comp[voxel_cell[i]] == best) out.push_back(inliers[i]);
+    const int piece = pieces[voxel_cell[i]];
+    if (comp[voxel_cell[i]] == best && (piece == largest || piece_size[piece] >= plane.min_piece_voxels))
+      out.push_back(inliers[i]);
+    if (visible_piece && piece == largest) visible_piece->push_back(inliers[i]);
   }
   return out;
 }

@@ -18,15 +18,21 @@ struct PlaneGrid {
   Eigen::Vector3d n, u, v;
   double d = 0.0;
   double cell_m = 0.05;  ///< gaps narrower than a cell do not split the plane
+  /// A visible piece other than the largest joins the support only with this many inlier voxels
+  /// (a cell's worth): a voxel or two in the plane's band is no piece of a table.
+  std::size_t min_piece_voxels = 1;
 };
 
-/// The largest 8-connected group of the inlier voxels (indices into `centroids`) on the plane's
-/// grid, with cells hidden from `sensor_origin` counted as connecting (not as inliers) when
-/// `sensor_origin` is given: hidden by the voxels `standing`, those at a height above the plane
-/// in (min_height_m, max_height_m] and above noise_floor_m(their range from the sensor).
+/// The largest 8-connected piece of the inlier voxels (indices into `centroids`) on the plane's
+/// grid, and the pieces that cells hidden from `sensor_origin` join to it, when `sensor_origin`
+/// is given: hidden by the voxels `standing`, those at a height above the plane in
+/// (min_height_m, max_height_m] and above noise_floor_m(their range from the sensor). Hidden
+/// cells connect; they are not inliers. `visible_piece`, when given, receives the largest piece
+/// alone.
 std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
                                 const PlaneGrid& plane, const std::vector<int>& standing,
                                 const std::optional<Eigen::Vector3d>& sensor_origin, double min_height_m,
-                                double max_height_m, const std::function<double(double range_m)>& noise_floor_m);
+                                double max_height_m, const std::function<double(double range_m)>& noise_floor_m,
+                                std::vector<int>* visible_piece = nullptr);
 
 }  // namespace scenewatch::segmentation
