@@ -39,6 +39,11 @@ class CellGrid {
     for (const auto& [a, b] : coords_) a0 = std::min(a0, a), a1 = std::max(a1, a), b0 = std::min(b0, b), b1 = std::max(b1, b);
     return std::hypot(static_cast<double>(a1 - a0 + 3), static_cast<double>(b1 - b0 + 3)) * plane_.cell_m;
   }
+  /// The cell with key k, -1 when there is none.
+  int find(std::uint64_t k) const {
+    auto it = cells_.find(k);
+    return it == cells_.end() ? -1 : it->second;
+  }
   /// True when the cell of p or one of its 8 neighbours is in the grid.
   bool near(const Eigen::Vector3d& p) const {
     const long a = static_cast<long>(std::floor(p.dot(plane_.u) / plane_.cell_m));
@@ -86,7 +91,7 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
                                 const PlaneGrid& plane, const std::vector<int>& standing,
                                 const std::optional<Eigen::Vector3d>& sensor_origin, double min_height_m,
                                 double max_height_m, const std::function<double(double range_m)>& noise_floor_m,
-                                std::vector<int>* visible_piece) {
+                                std::vector<int>* visible_piece, std::vector<Eigen::Vector3d>* hidden_feet) {
   CellGrid grid(plane);
   std::vector<int> voxel_cell(inliers.size());
   for (std::size_t i = 0; i < inliers.size(); ++i) voxel_cell[i] = grid.add(centroids[inliers[i]].cast<double>());
@@ -99,6 +104,8 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
   const int largest_cell = static_cast<int>(std::find(pieces.begin(), pieces.end(), largest) - pieces.begin());
   // One piece in sight: nothing to bridge.
   const bool in_pieces = std::any_of(pieces.begin(), pieces.end(), [](int c) { return c > 0; });
+  std::vector<Eigen::Vector3d> feet;      // of what stands where no visible cell is
+  std::vector<std::uint64_t> tall_cells;  // cells under something taller than an object
   if (sensor_origin && in_pieces) {
     const Eigen::Vector3d& o = *sensor_origin;
     const double o_height = plane.n.dot(o) + plane.d;
@@ -109,11 +116,16 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
     for (int w : standing) {
       const Eigen::Vector3d q = centroids[w].cast<double>();
       const double h = plane.n.dot(q) + plane.d;
+      if (h > max_height_m && h < o_height) tall_cells.push_back(grid.key(q));
       if (h <= min_height_m || h > max_height_m || h >= o_height) continue;
       // Within the sensor's noise of the plane (far floors), a voxel is the plane and hides nothing.
       if (h < noise_floor_m((q - o).norm())) continue;
-      // Only what stands on the visible support hides it: its foot is at a visible cell.
-      if (!visible.near(q - h * plane.n)) continue;
+      // Only what stands on the visible support hides it: its foot is at a visible cell. What
+      // stands elsewhere may rest on the support where it is hidden (see below).
+      if (!visible.near(q - h * plane.n)) {
+        feet.push_back(q - h * plane.n);
+        continue;
+      }
       const std::uint64_t key = grid.key(q);
       auto [it, inserted] = highest.try_emplace(key, h, w);
       if (!inserted && it->second.first < h) it.value() = {h, w};
@@ -137,6 +149,20 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
   // fewer voxels than plane.min_piece_voxels does not join.
   const std::vector<int> comp = grid.size() == pieces.size() ? pieces : grid.components();
   const int best = comp[largest_cell];
+  // What stands on a hidden cell of the support rests on it (a box behind a pile, books running
+  // out of the image): the support runs under it. Not on a cell that something taller than an
+  // object stands on too (a wall, a person).
+  if (hidden_feet) {
+    hidden_feet->clear();
+    std::sort(tall_cells.begin(), tall_cells.end());
+    for (const Eigen::Vector3d& f : feet) {
+      const std::uint64_t key = grid.key(f);
+      const int c = grid.find(key);
+      const bool hidden = c >= static_cast<int>(pieces.size());  // cells after the visible ones
+      if (!hidden || comp[c] != best || std::binary_search(tall_cells.begin(), tall_cells.end(), key)) continue;
+      hidden_feet->push_back(f);
+    }
+  }
   std::vector<int> out;
   if (visible_piece) visible_piece->clear();
   for (std::size_t i = 0; i < inliers.size(); ++i) {

@@ -4,7 +4,8 @@
 // visible table falls into pieces around the pile; the pieces are one support when the table
 // continues, hidden, between them. The hidden cells are those each object voxel covers: from its
 // foot on the plane to where the ray from the sensor through it meets the plane (its shadow).
-// A voxel within the sensor's noise of the plane is the plane itself and hides nothing.
+// A voxel within the sensor's noise of the plane is the plane itself and hides nothing. What
+// stands over a hidden cell rests on the support there: its foot widens the support's hull.
 #include <Eigen/Core>
 
 #include <functional>
@@ -28,11 +29,14 @@ struct PlaneGrid {
 /// is given: hidden by the voxels `standing`, those at a height above the plane in
 /// (min_height_m, max_height_m] and above noise_floor_m(their range from the sensor). Hidden
 /// cells connect; they are not inliers. `visible_piece`, when given, receives the largest piece
-/// alone.
+/// alone. `hidden_feet`, when given, receives the feet on the plane of the voxels `standing` (in
+/// the same height band) over hidden cells of the support, except cells that something taller
+/// than max_height_m stands on: what rests on the support where the sensor cannot see it.
 std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, const std::vector<int>& inliers,
                                 const PlaneGrid& plane, const std::vector<int>& standing,
                                 const std::optional<Eigen::Vector3d>& sensor_origin, double min_height_m,
                                 double max_height_m, const std::function<double(double range_m)>& noise_floor_m,
-                                std::vector<int>* visible_piece = nullptr);
+                                std::vector<int>* visible_piece = nullptr,
+                                std::vector<Eigen::Vector3d>* hidden_feet = nullptr);
 
 }  // namespace scenewatch::segmentation

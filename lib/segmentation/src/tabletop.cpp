@@ -4,7 +4,8 @@
 //     least squares; each plane keeps its largest connected part (a 2D grid on the plane bridges
 //     the shadows that objects cast on the table and, seen from one view, the table hidden
 //     behind a pile: support_extent.h);
-//  3. convex hull of each plane (Andrew's monotone chain in the plane's 2D basis);
+//  3. convex hull of each plane (Andrew's monotone chain in the plane's 2D basis), widened by
+//     the feet of what stands where the table is hidden (support_extent.h);
 //  4. voxels in the prism above a hull are clustered (Euclidean, union-find over grid
 //     neighbours), and every input point of a cluster voxel at object height joins the object.
 #include <algorithm>
@@ -117,6 +118,8 @@ struct PlaneFrame {
   PlaneModel model;
   Eigen::Vector3d u, v;
   std::vector<Vec2> hull2d;
+  std::vector<Vec2> own_hull2d;  ///< the hull before the feet below widen it
+  Vec2 at(const Eigen::Vector3d& q) const { return Vec2(q.dot(u), q.dot(v)); }
 };
 
 // Box with its z axis along the plane normal and the yaw of the minimum-area rectangle around
@@ -292,6 +295,29 @@ Plane make_plane(const Cloud& cloud, const VoxelIndex& grid, const std::vector<c
   return plane;
 }
 
+// What stands where a support is hidden rests on it, and its feet widen the support's hull
+// (support_extent.h), unless they are in the prism of another support (a writing tablet on a
+// floor): that one holds them.
+void widen_by_resting_feet(std::vector<PlaneFrame>& frames, std::vector<Plane>& planes,
+                           const std::vector<std::vector<Eigen::Vector3d>>& feet) {
+  for (std::size_t i = 0; i < frames.size(); ++i) {
+    PlaneFrame& f = frames[i];
+    std::vector<Vec2> pts2 = f.own_hull2d;
+    for (const Eigen::Vector3d& q : feet[i]) {
+      bool elsewhere = false;
+      for (std::size_t j = 0; j < frames.size() && !elsewhere; ++j)
+        elsewhere = j != i && inside_convex(frames[j].own_hull2d, frames[j].at(q));
+      if (!elsewhere) pts2.push_back(f.at(q));
+    }
+    if (pts2.size() == f.own_hull2d.size()) continue;
+    f.hull2d = convex_hull(std::move(pts2));
+    const Eigen::Vector3d origin_on_plane = -f.model.d * f.model.n;
+    planes[i].hull.clear();
+    for (const Vec2& h : f.hull2d) planes[i].hull.push_back(origin_on_plane + h.x() * f.u + h.y() * f.v);
+    planes[i].area_m2 = polygon_area(f.hull2d);
+  }
+}
+
 // Supporting planes, largest first: RANSAC on the voxel centroids, least-squares refinement,
 // the largest connected part, its hull; object faces inside an earlier support's prism are
 // skipped. Marks each plane's voxels in `in_plane` (plane id + 1) and appends to `planes`.
@@ -305,6 +331,7 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
   std::mt19937 rng(cfg.seed);
   in_plane.assign(nvox, 0);
   std::vector<PlaneFrame> frames;
+  std::vector<std::vector<Eigen::Vector3d>> feet_of;  // per frame: support_extent's hidden feet
   std::vector<int> remaining(nvox);
   std::iota(remaining.begin(), remaining.end(), 0);
   for (int p = 0; p < cfg.max_planes; ++p) {
@@ -338,9 +365,10 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
     const PlaneGrid plane_grid{model.n, frame.u, frame.v, model.d, cfg.plane_connectivity_m,
                                static_cast<std::size_t>(std::ceil(cell_voxels * cell_voxels))};
     std::vector<int> visible;
+    std::vector<Eigen::Vector3d> feet;
     const std::vector<int> part =
         support_extent(centroids, inliers, plane_grid, remaining, viewpoint, cfg.plane_distance_m, cfg.max_object_height_m,
-                       [&cfg](double range_m) { return object_height_threshold(cfg, range_m); }, &visible);
+                       [&cfg](double range_m) { return object_height_threshold(cfg, range_m); }, &visible, &feet);
     const auto hull_of = [&](const std::vector<int>& voxels) {
       std::vector<Vec2> pts2;
       pts2.reserve(voxels.size());
@@ -369,6 +397,8 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
     // floor that took in its other pieces left a YCB frame's writing tablet to a RANSAC draw
     // tilted by 7 degrees, and the tuna can on it was fitted off its axis).
     if (part.size() != visible.size()) frame.hull2d = hull_of(part);
+    frame.own_hull2d = frame.hull2d;
+    feet_of.push_back(std::move(feet));
     const double area = polygon_area(frame.hull2d);
 
     const char mark = static_cast<char>(1 + planes.size());
@@ -384,6 +414,7 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
     }
     remaining.swap(next);
   }
+  widen_by_resting_feet(frames, planes, feet_of);
   return frames;
 }
 
@@ -404,7 +435,7 @@ std::vector<Piece> euclidean_clusters(const Cloud& cloud, const VoxelIndex& grid
       const double h = frames[p].model.distance(centroids[v]);
       if (h < min_h || h > cfg.max_object_height_m || h >= best_h) continue;
       const Eigen::Vector3d q = centroids[v].cast<double>();
-      if (!inside_convex(frames[p].hull2d, Vec2(q.dot(frames[p].u), q.dot(frames[p].v)))) continue;
+      if (!inside_convex(frames[p].hull2d, frames[p].at(q))) continue;
       best_h = h;
       owner[v] = static_cast<int>(p);
     }
