@@ -30,11 +30,12 @@ function(scenewatch_add_module name)
   scenewatch_target_properties(scenewatch_${name})
 endfunction()
 
-# scenewatch_add_test(NAME SOURCES ... DEPS ...): one GoogleTest executable per module.
+# scenewatch_add_test(NAME SOURCES ... DEPS ... [PROPERTIES ...]): one GoogleTest executable per
+# module; PROPERTIES go to each of its tests (a RESOURCE_LOCK, say).
 function(scenewatch_add_test name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS" ${ARGN})
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PROPERTIES" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_DEPS} scenewatch_test_support GTest::gtest_main)
   scenewatch_target_properties(${name})
-  gtest_discover_tests(${name} TEST_PREFIX "${name}." DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600)
+  gtest_discover_tests(${name} TEST_PREFIX "${name}." DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600 ${ARG_PROPERTIES})
 endfunction()
