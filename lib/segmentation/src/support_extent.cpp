@@ -104,15 +104,17 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
   const int largest_cell = static_cast<int>(std::find(pieces.begin(), pieces.end(), largest) - pieces.begin());
   // One piece in sight: nothing to bridge.
   const bool in_pieces = std::any_of(pieces.begin(), pieces.end(), [](int c) { return c > 0; });
-  std::vector<Eigen::Vector3d> feet;      // of what stands where no visible cell is
+  std::vector<Eigen::Vector3d> feet;      // of what stands on hidden cells
   std::vector<std::uint64_t> tall_cells;  // cells under something taller than an object
   if (sensor_origin && in_pieces) {
     const Eigen::Vector3d& o = *sensor_origin;
     const double o_height = plane.n.dot(o) + plane.d;
-    // The highest voxel over each cell hides the most: its shadow covers those of the voxels
-    // under it (same foot, shorter shadow the same way).
-    tsl::robin_map<std::uint64_t, std::pair<double, int>, MixHash64> highest;
-    const CellGrid visible = grid;
+    struct Standing {
+      int voxel;
+      double h;
+      Eigen::Vector3d foot;
+    };
+    std::vector<Standing> pending;
     for (int w : standing) {
       const Eigen::Vector3d q = centroids[w].cast<double>();
       const double h = plane.n.dot(q) + plane.d;
@@ -120,28 +122,42 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
       if (h <= min_height_m || h > max_height_m || h >= o_height) continue;
       // Within the sensor's noise of the plane (far floors), a voxel is the plane and hides nothing.
       if (h < noise_floor_m((q - o).norm())) continue;
-      // Only what stands on the visible support hides it: its foot is at a visible cell. What
-      // stands elsewhere may rest on the support where it is hidden (see below).
-      if (!visible.near(q - h * plane.n)) {
-        feet.push_back(q - h * plane.n);
-        continue;
-      }
-      const std::uint64_t key = grid.key(q);
-      auto [it, inserted] = highest.try_emplace(key, h, w);
-      if (!inserted && it->second.first < h) it.value() = {h, w};
+      pending.push_back({w, h, q - h * plane.n});
     }
+    std::sort(tall_cells.begin(), tall_cells.end());
+    const auto tall = [&](std::uint64_t key) { return std::binary_search(tall_cells.begin(), tall_cells.end(), key); };
     // A shadow longer than the visible plane's extent reaches past every visible cell: the part
     // beyond joins nothing (near the sensor's height, shadows run on for kilometres).
-    const double reach_m = visible.diagonal_m();
-    for (const auto& [key, top] : highest) {
-      const Eigen::Vector3d q = centroids[top.second].cast<double>();
-      const double h = top.first;
-      // The ray o + t (q - o) meets the plane at t = o_height / (o_height - h) > 1: behind q.
-      const Eigen::Vector3d foot = q - h * plane.n;
-      Eigen::Vector3d shadow = o + (o_height / (o_height - h)) * (q - o);
-      if ((shadow - foot).norm() > reach_m) shadow = foot + (shadow - foot).normalized() * reach_m;
-      const int steps = static_cast<int>(std::ceil((shadow - foot).norm() / plane.cell_m));
-      for (int k = 0; k <= steps; ++k) grid.add(foot + (shadow - foot) * (steps ? static_cast<double>(k) / steps : 0.0));
+    const double reach_m = grid.diagonal_m();
+    // What stands on the visible support hides it: first what stands at a visible cell, then, round
+    // by round, what stands on the cells hidden so far (a box behind a box behind a pile), except
+    // on a cell that something taller than an object stands on (a wall, a person).
+    for (bool first = true; !pending.empty(); first = false) {
+      // The highest voxel over each cell hides the most: its shadow covers those of the voxels
+      // under it (same foot, shorter shadow the same way).
+      tsl::robin_map<std::uint64_t, std::pair<double, int>, MixHash64> highest;
+      std::vector<Standing> rest;
+      for (const Standing& s : pending) {
+        if (!grid.near(s.foot) || (!first && tall(grid.key(s.foot)))) {
+          rest.push_back(s);
+          continue;
+        }
+        if (!first) feet.push_back(s.foot);
+        auto [it, inserted] = highest.try_emplace(grid.key(s.foot), s.h, s.voxel);
+        if (!inserted && it->second.first < s.h) it.value() = {s.h, s.voxel};
+      }
+      if (highest.empty()) break;
+      for (const auto& [key, top] : highest) {
+        const Eigen::Vector3d q = centroids[top.second].cast<double>();
+        const double h = top.first;
+        // The ray o + t (q - o) meets the plane at t = o_height / (o_height - h) > 1: behind q.
+        const Eigen::Vector3d foot = q - h * plane.n;
+        Eigen::Vector3d shadow = o + (o_height / (o_height - h)) * (q - o);
+        if ((shadow - foot).norm() > reach_m) shadow = foot + (shadow - foot).normalized() * reach_m;
+        const int steps = static_cast<int>(std::ceil((shadow - foot).norm() / plane.cell_m));
+        for (int k = 0; k <= steps; ++k) grid.add(foot + (shadow - foot) * (steps ? static_cast<double>(k) / steps : 0.0));
+      }
+      pending.swap(rest);
     }
   }
   // The support is the largest visible piece and what the hidden cells join to it: bridging
@@ -150,17 +166,13 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
   const std::vector<int> comp = grid.size() == pieces.size() ? pieces : grid.components();
   const int best = comp[largest_cell];
   // What stands on a hidden cell of the support rests on it (a box behind a pile, books running
-  // out of the image): the support runs under it. Not on a cell that something taller than an
-  // object stands on too (a wall, a person).
+  // out of the image): the support runs under it.
   if (hidden_feet) {
     hidden_feet->clear();
-    std::sort(tall_cells.begin(), tall_cells.end());
     for (const Eigen::Vector3d& f : feet) {
-      const std::uint64_t key = grid.key(f);
-      const int c = grid.find(key);
+      const int c = grid.find(grid.key(f));
       const bool hidden = c >= static_cast<int>(pieces.size());  // cells after the visible ones
-      if (!hidden || comp[c] != best || std::binary_search(tall_cells.begin(), tall_cells.end(), key)) continue;
-      hidden_feet->push_back(f);
+      if (hidden && comp[c] == best) hidden_feet->push_back(f);
     }
   }
   std::vector<int> out;

@@ -296,17 +296,18 @@ Plane make_plane(const Cloud& cloud, const VoxelIndex& grid, const std::vector<c
 }
 
 // What stands where a support is hidden rests on it, and its feet widen the support's hull
-// (support_extent.h), unless they are in the prism of another support (a writing tablet on a
-// floor): that one holds them.
+// (support_extent.h), unless they are on another support, in its band and its hull (a writing
+// tablet on a floor): that one holds them.
 void widen_by_resting_feet(std::vector<PlaneFrame>& frames, std::vector<Plane>& planes,
-                           const std::vector<std::vector<Eigen::Vector3d>>& feet) {
+                           const std::vector<std::vector<Eigen::Vector3d>>& feet, double band_m) {
   for (std::size_t i = 0; i < frames.size(); ++i) {
     PlaneFrame& f = frames[i];
     std::vector<Vec2> pts2 = f.own_hull2d;
     for (const Eigen::Vector3d& q : feet[i]) {
       bool elsewhere = false;
       for (std::size_t j = 0; j < frames.size() && !elsewhere; ++j)
-        elsewhere = j != i && inside_convex(frames[j].own_hull2d, frames[j].at(q));
+        elsewhere = j != i && std::abs(frames[j].model.distance(q.cast<float>())) <= band_m &&
+                    inside_convex(frames[j].own_hull2d, frames[j].at(q));
       if (!elsewhere) pts2.push_back(f.at(q));
     }
     if (pts2.size() == f.own_hull2d.size()) continue;
@@ -414,7 +415,7 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
     }
     remaining.swap(next);
   }
-  widen_by_resting_feet(frames, planes, feet_of);
+  widen_by_resting_feet(frames, planes, feet_of, cfg.plane_distance_m);
   return frames;
 }
 

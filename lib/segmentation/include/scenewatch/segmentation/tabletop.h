@@ -61,7 +61,7 @@ struct Config {
   /// A pile cuts the visible table into pieces; bridge them through the cells the objects standing
   /// on it hide from the sensor, so everything on the table is on one support (one view only),
   /// and what stands on those hidden cells rests on it (its feet widen the hull).
-  /// On mOSD's piles it finds 35 of 44 objects instead of 22 (tuning scenes) and 20 of 32 instead
+  /// On mOSD's piles it finds 35 of 44 objects instead of 22 (tuning scenes) and 21 of 32 instead
   /// of 15 (held out). Only the first support and planes parallel to it are bridged, and only
   /// their hulls widen; pieces smaller than a cell do not join, and voxels within the sensor's
   /// noise of the plane hide nothing. A floor that is the largest plane is bridged too: YCB's
