@@ -5,7 +5,8 @@
 // continues, hidden, between them. The hidden cells are those each object voxel covers: from its
 // foot on the plane to where the ray from the sensor through it meets the plane (its shadow).
 // A voxel within the sensor's noise of the plane is the plane itself and hides nothing. What
-// stands over a hidden cell rests on the support there: its foot widens the support's hull.
+// stands over a hidden cell rests on the support there: its foot widens the support's hull, and
+// it hides the support behind it in turn (a box behind a box behind a pile).
 #include <Eigen/Core>
 
 #include <functional>
