@@ -104,15 +104,16 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
   const int largest_cell = static_cast<int>(std::find(pieces.begin(), pieces.end(), largest) - pieces.begin());
   // One piece in sight: nothing to bridge.
   const bool in_pieces = std::any_of(pieces.begin(), pieces.end(), [](int c) { return c > 0; });
-  std::vector<Eigen::Vector3d> feet;      // of what stands on hidden cells
-  std::vector<std::uint64_t> tall_cells;  // cells under something taller than an object
+  std::vector<Eigen::Vector3d> feet;  // of what stands on hidden cells
   if (sensor_origin && in_pieces) {
     const Eigen::Vector3d& o = *sensor_origin;
     const double o_height = plane.n.dot(o) + plane.d;
+    std::vector<std::uint64_t> tall_cells;  // cells under something taller than an object
     struct Standing {
       int voxel;
       double h;
       Eigen::Vector3d foot;
+      bool on_tall_cell = false;  // something taller than an object stands on its cell too
     };
     std::vector<Standing> pending;
     for (int w : standing) {
@@ -125,7 +126,7 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
       pending.push_back({w, h, q - h * plane.n});
     }
     std::sort(tall_cells.begin(), tall_cells.end());
-    const auto tall = [&](std::uint64_t key) { return std::binary_search(tall_cells.begin(), tall_cells.end(), key); };
+    for (Standing& s : pending) s.on_tall_cell = std::binary_search(tall_cells.begin(), tall_cells.end(), grid.key(s.foot));
     // A shadow longer than the visible plane's extent reaches past every visible cell: the part
     // beyond joins nothing (near the sensor's height, shadows run on for kilometres).
     const double reach_m = grid.diagonal_m();
@@ -138,7 +139,7 @@ std::vector<int> support_extent(const std::vector<Eigen::Vector3f>& centroids, c
       tsl::robin_map<std::uint64_t, std::pair<double, int>, MixHash64> highest;
       std::vector<Standing> rest;
       for (const Standing& s : pending) {
-        if (!grid.near(s.foot) || (!first && tall(grid.key(s.foot)))) {
+        if (!grid.near(s.foot) || (!first && s.on_tall_cell)) {
           rest.push_back(s);
           continue;
         }

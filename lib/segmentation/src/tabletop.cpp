@@ -120,6 +120,14 @@ struct PlaneFrame {
   std::vector<Vec2> hull2d;
   std::vector<Vec2> own_hull2d;  ///< the hull before the feet below widen it
   Vec2 at(const Eigen::Vector3d& q) const { return Vec2(q.dot(u), q.dot(v)); }
+  Eigen::Vector3d origin_on_plane() const { return -model.d * model.n; }
+  /// hull2d back in 3D, on the plane.
+  std::vector<Eigen::Vector3d> hull_3d() const {
+    std::vector<Eigen::Vector3d> out;
+    out.reserve(hull2d.size());
+    for (const Vec2& h : hull2d) out.push_back(origin_on_plane() + h.x() * u + h.y() * v);
+    return out;
+  }
 };
 
 // Box with its z axis along the plane normal and the yaw of the minimum-area rectangle around
@@ -182,7 +190,7 @@ bool on_objects_of(const std::vector<Eigen::Vector3f>& centroids, const std::vec
     for (const PlaneFrame& f : supports) {
       const double h = f.model.distance(centroids[v]);
       if (h >= object_height_threshold(cfg, (q - sensor_origin).norm()) && h <= cfg.max_object_height_m &&
-          inside_convex(f.hull2d, Vec2(q.dot(f.u), q.dot(f.v)))) {
+          inside_convex(f.hull2d, f.at(q))) {
         ++above;
         break;
       }
@@ -277,8 +285,7 @@ Plane make_plane(const Cloud& cloud, const VoxelIndex& grid, const std::vector<c
   plane.normal = model.n;
   plane.d = model.d;
   plane.area_m2 = area;
-  const Eigen::Vector3d origin_on_plane = -model.d * model.n;
-  for (const Vec2& h : frame.hull2d) plane.hull.push_back(origin_on_plane + h.x() * frame.u + h.y() * frame.v);
+  plane.hull = frame.hull_3d();
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const int v = grid.point_voxel[i];
@@ -291,7 +298,7 @@ Plane make_plane(const Cloud& cloud, const VoxelIndex& grid, const std::vector<c
     }
   }
   plane.inlier_count = plane.indices.size();
-  plane.centroid = plane.inlier_count > 0 ? Eigen::Vector3d(sum / static_cast<double>(plane.inlier_count)) : origin_on_plane;
+  plane.centroid = plane.inlier_count > 0 ? Eigen::Vector3d(sum / static_cast<double>(plane.inlier_count)) : frame.origin_on_plane();
   return plane;
 }
 
@@ -312,9 +319,7 @@ void widen_by_resting_feet(std::vector<PlaneFrame>& frames, std::vector<Plane>& 
     }
     if (pts2.size() == f.own_hull2d.size()) continue;
     f.hull2d = convex_hull(std::move(pts2));
-    const Eigen::Vector3d origin_on_plane = -f.model.d * f.model.n;
-    planes[i].hull.clear();
-    for (const Vec2& h : f.hull2d) planes[i].hull.push_back(origin_on_plane + h.x() * f.u + h.y() * f.v);
+    planes[i].hull = f.hull_3d();
     planes[i].area_m2 = polygon_area(f.hull2d);
   }
 }
@@ -373,10 +378,7 @@ std::vector<PlaneFrame> find_supports(const Cloud& cloud, const VoxelIndex& grid
     const auto hull_of = [&](const std::vector<int>& voxels) {
       std::vector<Vec2> pts2;
       pts2.reserve(voxels.size());
-      for (int v : voxels) {
-        const Eigen::Vector3d q = centroids[v].cast<double>();
-        pts2.emplace_back(q.dot(frame.u), q.dot(frame.v));
-      }
+      for (int v : voxels) pts2.push_back(frame.at(centroids[v].cast<double>()));
       return convex_hull(std::move(pts2));
     };
     // The largest remaining plane is too small: no further supporting plane can be found. Judged
