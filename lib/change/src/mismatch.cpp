@@ -162,6 +162,24 @@ DepthView depth_view(const Cloud& cloud, const Intrinsics& K) {
 }
 
 namespace {
+// Whether every sample of a voxel's footprint (centre uc, vc; half-width half_px) has trusted
+// depth beyond `limit`; `nearest` is then the nearest of those depths.
+template <typename TrustedAt>
+bool footprint_behind(const DepthView& depth, const TrustedAt& trusted_at, double uc, double vc, double half_px, double limit,
+                      float& nearest) {
+  constexpr int kSteps = 3;  // (2 kSteps + 1)^2 samples over the footprint
+  nearest = std::numeric_limits<float>::infinity();
+  for (int a = -kSteps; a <= kSteps; ++a)
+    for (int b = -kSteps; b <= kSteps; ++b) {
+      const int u = static_cast<int>(std::lround(uc + half_px * a / kSteps));
+      const int v = static_cast<int>(std::lround(vc + half_px * b / kSteps));
+      const float z = depth.at(u, v);
+      if (!(z > 0) || !trusted_at(u, v) || z <= limit) return false;
+      nearest = std::min(nearest, z);
+    }
+  return true;
+}
+
 // Removed: occupied voxels whose whole projected footprint shows depth behind them by more than the
 // tolerance. A footprint pixel at or in front of the voxel (the surface is still there, or
 // something occludes it) vetoes; so does one without depth (a hole at a grazing edge may be the
@@ -179,8 +197,6 @@ std::vector<MissingVoxel> missing_surfaces(const background::DenseGrid& grid, co
   for (const background::DenseGrid::Surface& surface : grid.occupied) {
     if (surface.probability < min_probability) continue;
     const Eigen::Vector3d c = grid.center(static_cast<long>(surface.index));
-    double seen_depth = 0.0;
-    if (witness != nullptr && witness->seen(c, camera, &seen_depth) == SurfaceWitness::Seen::kByOthersOnly) continue;
     const Eigen::Vector3d q = T_camera_world * c;
     if (q.z() <= res || q.z() > config.max_range_m) continue;
     const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
@@ -189,28 +205,19 @@ std::vector<MissingVoxel> missing_surfaces(const background::DenseGrid& grid, co
     if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) continue;
     // A gap is measured between two noisy surfaces: the frame's at this depth, and the map's,
     // which lies within the noise of the nearest depth it was seen at (when this session saw it).
+    // Most surfaces in view are still there and the frame's noise alone vetoes them; the witness
+    // (a hash lookup) is asked only about the rest, whose limit its depth can only widen.
     const double frame_sigma = config.sensor.sigma_z(q.z());
-    const double sigma = seen_depth > 0 ? std::hypot(frame_sigma, config.sensor.sigma_z(seen_depth)) : frame_sigma;
-    const double limit = q.z() + kHalfDiagonal * res + map_tolerance_from_sigma(config, sigma, q.z(), shift);
-    constexpr int kSteps = 3;  // (2 kSteps + 1)^2 samples over the footprint
-    int with_depth = 0, total = 0;
-    float nearest = std::numeric_limits<float>::infinity();
-    bool veto = false;
-    for (int a = -kSteps; a <= kSteps && !veto; ++a)
-      for (int b = -kSteps; b <= kSteps; ++b) {
-        const int u = static_cast<int>(std::lround(uc + half_px * a / kSteps));
-        const int v = static_cast<int>(std::lround(vc + half_px * b / kSteps));
-        ++total;
-        const float z = depth.at(u, v);
-        if (!(z > 0) || !trusted_at(u, v)) continue;
-        ++with_depth;
-        if (z <= limit) {
-          veto = true;
-          break;
-        }
-        nearest = std::min(nearest, z);
-      }
-    if (veto || with_depth < total) continue;
+    auto limit_for = [&](double sigma) { return q.z() + kHalfDiagonal * res + map_tolerance_from_sigma(config, sigma, q.z(), shift); };
+    float nearest = 0.0f;
+    if (!footprint_behind(depth, trusted_at, uc, vc, half_px, limit_for(frame_sigma), nearest)) continue;
+    if (witness != nullptr) {
+      double seen_depth = 0.0;
+      if (witness->seen(c, camera, &seen_depth) == SurfaceWitness::Seen::kByOthersOnly) continue;
+      if (seen_depth > 0 &&
+          !footprint_behind(depth, trusted_at, uc, vc, half_px, limit_for(std::hypot(frame_sigma, config.sensor.sigma_z(seen_depth))), nearest))
+        continue;
+    }
     MissingVoxel m;
     m.center_world = c;
     m.rgb = surface.rgb;
@@ -289,11 +296,11 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     const PointT& p = cloud.points[i];
     if (!is_valid(p) || p.z > config.max_range_m) continue;
+    const auto [u, v] = pixel_of(i, p);
+    if (!trusted_at(u, v)) continue;
     const Eigen::Vector3d w = (Tf * p.getVector3fMap()).cast<double>();
     const long idx = grid.index_of(w);
     if (grid.at(idx) != background::Occupancy::kFree) continue;
-    const auto [u, v] = pixel_of(i, p);
-    if (!trusted_at(u, v)) continue;
     const double shift = measured_pose.shift_at(w);
     const double gap = kHalfDiagonal * res + map_tolerance_m(config, p.z, shift);
     if (surface_within(grid, idx, w, gap, kHeadOnRing)) continue;

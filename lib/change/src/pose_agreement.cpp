@@ -53,9 +53,18 @@ bool normal_at(const Cloud& cloud, int u, int v, const DepthValidity& trusted, d
 bool surface_along(const background::DenseGrid& grid, const Eigen::Vector3d& origin, const Eigen::Vector3d& dir,
                    double range, double& surface) {
   const double step = 0.5 * grid.resolution;
+  // Walked in voxel units: a step adds half a voxel along the ray, with no division per sample.
+  const Eigen::Vector3d q0 = (origin + (range - kWindowM) * dir - grid.origin) / grid.resolution;
+  const Eigen::Vector3d dq = 0.5 * dir;
+  const int steps = static_cast<int>(std::floor(2 * kWindowM / step + 1e-9));
   double entry = -1, exit = -1;
-  for (double s = range - kWindowM; s <= range + kWindowM; s += step) {
-    if (grid.at(grid.index_of(origin + s * dir)) == background::Occupancy::kOccupied) {
+  for (int n = 0; n <= steps; ++n) {
+    const Eigen::Vector3d q = q0 + n * dq;
+    const long i = static_cast<long>(std::floor(q.x())), j = static_cast<long>(std::floor(q.y())),
+               k = static_cast<long>(std::floor(q.z()));
+    const bool inside = i >= 0 && j >= 0 && k >= 0 && i < grid.nx && j < grid.ny && k < grid.nz;
+    const double s = range - kWindowM + n * step;
+    if (inside && grid.at((k * grid.ny + j) * grid.nx + i) == background::Occupancy::kOccupied) {
       if (entry < 0) entry = s;
       exit = s;
     } else if (entry >= 0) {
@@ -66,8 +75,6 @@ bool surface_along(const background::DenseGrid& grid, const Eigen::Vector3d& ori
   surface = 0.5 * (entry + exit);
   return true;
 }
-
-
 
 // A trusted pixel with a normal of its own: what does not depend on the pose, found once.
 struct Pixel {

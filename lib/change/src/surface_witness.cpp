@@ -6,11 +6,11 @@
 
 namespace scenewatch::change {
 
-SurfaceWitness::SurfaceWitness(double voxel_m, std::size_t max_voxels) : voxel_m_(voxel_m), max_voxels_(max_voxels) {}
+SurfaceWitness::SurfaceWitness(double voxel_m, std::size_t max_voxels) : per_m_(1.0 / voxel_m), max_voxels_(max_voxels) {}
 
 std::uint64_t SurfaceWitness::key(const Eigen::Vector3d& p) const {
   // 21 bits per axis around the origin: +-20 km at 2 cm.
-  auto c = [&](double x) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x / voxel_m_)) + (1 << 20)) & 0x1fffff; };
+  auto c = [&](double x) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x * per_m_)) + (1 << 20)) & 0x1fffff; };
   return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
 }
 
@@ -18,16 +18,17 @@ void SurfaceWitness::witness(const Cloud& cloud, const Pose& T, std::uint32_t ca
   ++frame_;
   const std::uint64_t bit = std::uint64_t{1} << (camera % 64);
   const Eigen::Isometry3f Tf = T.cast<float>();
-  // Neighbouring pixels mostly fall in one voxel (a 2 cm voxel spans 5 pixels at 2 m): marking
-  // it again changes nothing, so runs of one key cost one lookup.
-  std::uint64_t last = 0;
-  bool any = false;
+  // Neighbouring pixels mostly fall in one voxel (a 2 cm voxel spans 5 pixels at 2 m), in this
+  // row and in the rows above: marking it again, at no smaller depth, changes nothing. A small
+  // table of the voxels marked in this frame (direct-mapped by key, with the depth marked) spares
+  // most of the lookups in the map.
+  if (recent_.empty()) recent_.resize(kRecent);
   auto add = [&](const PointT& p) {
     if (!is_valid(p)) return;
     const std::uint64_t k = key((Tf * p.getVector3fMap()).cast<double>());
-    if (any && k == last) return;
-    any = true;
-    last = k;
+    Recent& r = recent_[(k ^ (k >> 19) ^ (k >> 40)) & (kRecent - 1)];  // the low bits of each axis
+    if (r.frame == frame_ && r.key == k && p.z >= r.depth_m) return;
+    r = {k, frame_, p.z};
     Entry& e = voxels_[k];
     e.cameras |= bit;
     e.last_frame = frame_;

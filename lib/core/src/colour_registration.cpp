@@ -196,21 +196,17 @@ ColourRemap::ColourRemap(int width, int height, const Intrinsics& K, const Colou
   if (width < 2 || height < 2) return;
   const Eigen::Vector2d c = principal_point(K, width, height);
   const double cx = c.x(), cy = c.y();
-  const std::size_t n = static_cast<std::size_t>(width) * height;
-  tap_.resize(n);
-  ax_.resize(n);
-  ay_.resize(n);
+  columns_.resize(static_cast<std::size_t>(width));
+  rows_.resize(static_cast<std::size_t>(height));
   for (int v = 0; v < height; ++v) {
     const double y = std::clamp(cy + r.scale * (v - cy) + r.shift_y_px, 0.0, height - 1.0);
     const int v0 = std::min(static_cast<int>(y), height - 2);
-    for (int u = 0; u < width; ++u) {
-      const double x = std::clamp(cx + r.scale * (u - cx) + r.shift_x_px, 0.0, width - 1.0);
-      const int u0 = std::min(static_cast<int>(x), width - 2);
-      const std::size_t i = static_cast<std::size_t>(v) * width + u;
-      tap_[i] = static_cast<std::uint32_t>(static_cast<std::size_t>(v0) * width + u0);
-      ax_[i] = static_cast<float>(x - u0);
-      ay_[i] = static_cast<float>(y - v0);
-    }
+    rows_[static_cast<std::size_t>(v)] = {v0, static_cast<float>(y - v0)};
+  }
+  for (int u = 0; u < width; ++u) {
+    const double x = std::clamp(cx + r.scale * (u - cx) + r.shift_x_px, 0.0, width - 1.0);
+    const int u0 = std::min(static_cast<int>(x), width - 2);
+    columns_[static_cast<std::size_t>(u)] = {u0, static_cast<float>(x - u0)};
   }
 }
 
@@ -227,23 +223,29 @@ void ColourRemap::apply(const Cloud& organized, Cloud& out) const {
   out.is_dense = organized.is_dense;
   out.sensor_origin_ = organized.sensor_origin_;
   out.sensor_orientation_ = organized.sensor_orientation_;
-  if (!fits(organized) || tap_.empty()) {
+  if (!fits(organized) || rows_.empty()) {
     out.points = organized.points;
     return;
   }
   const auto& in = organized.points;
   out.points.resize(in.size());
   const std::size_t w = static_cast<std::size_t>(width_);
-  for (std::size_t i = 0; i < tap_.size(); ++i) {
-    const std::size_t t = tap_[i];
-    const float a = ax_[i], b = ay_[i];
-    const float w00 = (1 - a) * (1 - b), w10 = a * (1 - b), w01 = (1 - a) * b, w11 = a * b;
-    const PointT &p00 = in[t], &p10 = in[t + 1], &p01 = in[t + w], &p11 = in[t + w + 1];
-    PointT& q = out.points[i];
-    q = in[i];
-    q.r = static_cast<std::uint8_t>(w00 * p00.r + w10 * p10.r + w01 * p01.r + w11 * p11.r + 0.5f);
-    q.g = static_cast<std::uint8_t>(w00 * p00.g + w10 * p10.g + w01 * p01.g + w11 * p11.g + 0.5f);
-    q.b = static_cast<std::uint8_t>(w00 * p00.b + w10 * p10.b + w01 * p01.b + w11 * p11.b + 0.5f);
+  for (std::size_t v = 0; v < rows_.size(); ++v) {
+    const float b = rows_[v].weight;
+    const PointT* top = &in[static_cast<std::size_t>(rows_[v].first) * w];
+    const PointT* bottom = top + w;
+    for (std::size_t u = 0; u < w; ++u) {
+      const std::size_t t = static_cast<std::size_t>(columns_[u].first);
+      const float a = columns_[u].weight;
+      const float w00 = (1 - a) * (1 - b), w10 = a * (1 - b), w01 = (1 - a) * b, w11 = a * b;
+      const PointT &p00 = top[t], &p10 = top[t + 1], &p01 = bottom[t], &p11 = bottom[t + 1];
+      const std::size_t i = v * w + u;
+      PointT& q = out.points[i];
+      q = in[i];
+      q.r = static_cast<std::uint8_t>(w00 * p00.r + w10 * p10.r + w01 * p01.r + w11 * p11.r + 0.5f);
+      q.g = static_cast<std::uint8_t>(w00 * p00.g + w10 * p10.g + w01 * p01.g + w11 * p11.g + 0.5f);
+      q.b = static_cast<std::uint8_t>(w00 * p00.b + w10 * p10.b + w01 * p01.b + w11 * p11.b + 0.5f);
+    }
   }
 }
 

@@ -86,7 +86,7 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
   const int stride = sample_stride(frame, K, b.resolution_m, b.max_range_m, b.insert_stride_px);
   std::unique_lock<std::shared_mutex> write(mutex_);
   result.insert_stats = map_.insert(*to_insert, T, stride);
-  witness_.witness(*to_insert, T, camera, stride);
+  if (config.change.witness_per_camera) witness_.witness(*to_insert, T, camera, stride);
   for (const auto& c : changed.confirmed) {
     if (c.before) {
       map_.set_voxels(c.before->points_world, background::Occupancy::kFree);

@@ -8,6 +8,7 @@
 /// another camera alone has seen waits for a camera that saw it. One camera: every surface is its
 /// own, nothing changes. NOT thread safe: the working memory's writer owns it.
 #include <cstdint>
+#include <vector>
 
 #include <tsl/robin_map.h>
 
@@ -46,7 +47,15 @@ class SurfaceWitness {
   };
   std::uint64_t key(const Eigen::Vector3d& p) const;
   void prune();
-  double voxel_m_;
+  // The voxels the current frame has marked, by a hash of their key (surface_witness.cpp).
+  struct Recent {
+    std::uint64_t key = 0;
+    std::uint64_t frame = 0;  ///< frames count from 1: 0 marks nothing
+    float depth_m = 0.0f;
+  };
+  static constexpr std::size_t kRecent = 4096;
+  std::vector<Recent> recent_;
+  double per_m_;  ///< voxels per metre
   std::size_t max_voxels_;
   std::uint64_t frame_ = 0;
   tsl::robin_map<std::uint64_t, Entry, MixHash64> voxels_;

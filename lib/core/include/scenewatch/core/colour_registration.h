@@ -68,8 +68,13 @@ class ColourRemap {
 
  private:
   int width_ = 0, height_ = 0;
-  std::vector<std::uint32_t> tap_;  ///< top-left tap per pixel
-  std::vector<float> ax_, ay_;      ///< weights of the right and lower taps
+  // The registration scales and shifts each axis on its own, so a pixel's taps are its column's
+  // and its row's: 1,120 entries rather than a table per pixel to stream through every frame.
+  struct Tap {
+    int first = 0;          ///< the left (top) tap's column (row)
+    float weight = 0.0f;    ///< the right (lower) tap's weight
+  };
+  std::vector<Tap> columns_, rows_;
 };
 
 /// ColourRemap(...).apply(organized), once.
