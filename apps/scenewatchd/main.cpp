@@ -255,6 +255,7 @@ bool listen_live_view(const scenewatch::service::ServerConfig& server_config, sc
   scenewatch::service::LiveViewConfig view_config;
   view_config.three_js = server_config.http_three_js;
   view_config.classes = server_config.classes;
+  view_config.suggested_views = server_config.suggested_views;
   live.view = std::make_unique<scenewatch::service::LiveView>(memory, view_config);
   if (auto s = live.view->check_three_js(); !s) log(LogLevel::kWarning, "live view: " + s.error().message);
   server.set_frame_observer([view = live.view.get()](const scenewatch::Frame& frame,

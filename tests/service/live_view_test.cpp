@@ -2,7 +2,8 @@
 // scenewatchd's HTTP port against raw sockets (bad requests neither stop it nor its TCP API), both
 // servers refusing a bad address or a taken port, and headless Chromium on the page after a
 // simulated cup was put on the table: the event and the object with its class are in the page's
-// DOM, and the object's box is drawn in the 3D view of the screenshot.
+// DOM, the object's box is drawn in the 3D view of the screenshot, and so are the views the last
+// NextBestView suggested, as camera frusta.
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
@@ -15,11 +16,15 @@
 
 #include <filesystem>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <future>
 #include <memory>
 #include <mutex>
 #include <thread>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "daemon_harness.h"
 #include "scenewatch.pb.h"
@@ -453,7 +458,28 @@ CommandResult run_chromium(const fs::path& work_dir, const std::string& url, con
                      work_dir, 240.0);
 }
 
-TEST_F(LiveViewTest, ChromiumShowsTheObjectAndTheEventAfterACupIsPutOnTheTable) {
+// The views the last NextBestView suggested are in the state (both polls), as the API gave them,
+// and stay there when a later request fails.
+void expect_suggested_views_in_state(std::uint16_t http_port, const proto::NextBestViewReply& reply, std::uint64_t answer) {
+  for (const char* target : {"/api/state", "/api/state?voxels=0"}) {
+    SCOPED_TRACE(target);
+    const nlohmann::json views = nlohmann::json::parse(body_of(get(http_port, target))).at("views");
+    EXPECT_EQ(views.at("answer").get<std::uint64_t>(), answer);
+    EXPECT_EQ(views.at("measure").get<std::string>(), reply.measure());
+    // The planner's default camera: 640 x 480 at 525 px.
+    EXPECT_NEAR(views.at("horizontal_fov_deg").get<double>(), 2 * std::atan(320.0 / 525.0) * 180 / M_PI, 1e-9);
+    ASSERT_EQ(views.at("views").size(), static_cast<std::size_t>(reply.views_size()));
+    for (int k = 0; k < reply.views_size(); ++k) {
+      const auto& pose = views.at("views")[k].at("pose");
+      ASSERT_EQ(pose.size(), 16u);
+      // Within 1e-9: the pose went through the API's decoding, which checks it is rigid.
+      for (int i = 0; i < 16; ++i) EXPECT_NEAR(pose[i].get<double>(), reply.views(k).pose().matrix(i), 1e-9) << "view " << k;
+      EXPECT_DOUBLE_EQ(views.at("views")[k].at("score").get<double>(), reply.views(k).score());
+    }
+  }
+}
+
+TEST_F(LiveViewTest, ChromiumShowsTheObjectTheEventAndTheSuggestedViewsAfterACupIsPutOnTheTable) {
   ASSERT_NO_FATAL_FAILURE(start());
   // A stream opened before the frames hears the event as it is emitted.
   auto stream = std::async(std::launch::async, [port = http_port_] {
@@ -479,6 +505,19 @@ TEST_F(LiveViewTest, ChromiumShowsTheObjectAndTheEventAfterACupIsPutOnTheTable) 
   const std::string frame = get(http_port_, "/api/frame.png");
   ASSERT_EQ(status_of(frame), 200);
   EXPECT_EQ(body_of(frame).substr(1, 3), "PNG");
+  // Where to look at the workspace next: three views, drawn as frusta.
+  EXPECT_EQ(nlohmann::json::parse(body_of(get(http_port_, "/api/state?voxels=0"))).at("views").at("answer"), 0) << "none yet";
+  service::Client client = daemon_.connect();
+  const auto nbv = call(client, request([](proto::Request& r) {
+    r.mutable_next_best_view()->set_workspace(true);
+    r.mutable_next_best_view()->set_n(3);
+  }));
+  ASSERT_EQ(nbv.status().code(), proto::Status::OK) << nbv.status().message();
+  ASSERT_EQ(nbv.next_best_view().views_size(), 3);
+  expect_suggested_views_in_state(http_port_, nbv.next_best_view(), 1);
+  const auto unknown = call(client, request([](proto::Request& r) { r.mutable_next_best_view()->set_object_id(999999); }));
+  EXPECT_EQ(unknown.status().code(), proto::Status::NOT_FOUND);
+  expect_suggested_views_in_state(http_port_, nbv.next_best_view(), 1);
 
   if (!fs::exists(kChromium)) {
     GTEST_SKIP() << "headless Chromium is not installed (" << kChromium
@@ -508,6 +547,16 @@ TEST_F(LiveViewTest, ChromiumShowsTheObjectAndTheEventAfterACupIsPutOnTheTable) 
       magenta += bgr[2] > 230 && bgr[0] > 230 && bgr[1] < 40;
     }
   EXPECT_GT(magenta, 1000) << "the object's box is not drawn in the 3D view: " << shot;
+  // The suggested views' frusta are drawn in cyan (#00e5ff, the best view; #00a0b4 the others),
+  // a colour nothing else on the page has either (the voxels' lit blue-grey keeps some red).
+  int cyan = 0;
+  for (int y = 0; y < view.rows; ++y)
+    for (int x = 0; x < view.cols; ++x) {
+      const cv::Vec3b bgr = view.at<cv::Vec3b>(y, x);
+      cyan += bgr[2] < 50 && bgr[1] > 140 && bgr[0] > 160;
+    }
+  EXPECT_GT(cyan, 200) << "the suggested views are not drawn in the 3D view: " << shot;
+  std::printf("3D view: %d magenta pixels (the objects), %d cyan (the suggested views)\n", magenta, cyan);
   if (const char* keep = std::getenv("SCENEWATCH_LIVE_VIEW_SCREENSHOT")) fs::copy_file(shot, keep, fs::copy_options::overwrite_existing);
   ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
 }

@@ -96,6 +96,27 @@ struct LiveView::Impl {
 
   /// With `with_voxels` false, the "voxels" key is left out: the page polls that way and asks
   /// for them only when a frame was processed.
+  // The last NextBestView answer's views: T_world_camera row-major (as the API's Pose), the
+  // score, and the field of view to draw each camera's frustum with.
+  json suggested_views_json() const {
+    json out = {{"answer", 0}, {"views", json::array()}};
+    if (!config.suggested_views) return out;
+    const SuggestedViewSet set = config.suggested_views->last();
+    out["answer"] = set.answer;
+    out["measure"] = set.measure;
+    out["horizontal_fov_deg"] = set.horizontal_fov_deg;
+    out["vertical_fov_deg"] = set.vertical_fov_deg;
+    out["target"] = {{"min", {mm(set.target.min.x()), mm(set.target.min.y()), mm(set.target.min.z())}},
+                     {"max", {mm(set.target.max.x()), mm(set.target.max.y()), mm(set.target.max.z())}}};
+    for (const SuggestedView& v : set.views) {
+      json pose = json::array();
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) pose.push_back(v.T_world_camera.matrix()(r, c));
+      out["views"].push_back({{"pose", pose}, {"score", v.score}});
+    }
+    return out;
+  }
+
   HttpResponse state(bool with_voxels) const {
     const auto snapshot = memory.snapshot();
     const pipeline::Stats stats = memory.stats();
@@ -122,7 +143,8 @@ struct LiveView::Impl {
                     {"map_resolution_m", stats.map_resolution_m}, {"last_frame_ms", stats.last_frame_ms},
                     {"mean_frame_ms", stats.mean_frame_ms}, {"keyframes", stats.keyframes}}},
                   {"planes", planes},
-                  {"objects", objects}};
+                  {"objects", objects},
+                  {"views", suggested_views_json()}};
     if (with_voxels) {
       const pipeline::OccupiedVoxels voxels = memory.occupied_voxels(config.max_voxels);
       std::vector<double> centers;

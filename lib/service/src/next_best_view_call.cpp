@@ -1,5 +1,7 @@
 #include "next_best_view_call.h"
 
+#include <cmath>
+
 #include "proto_convert.h"
 #include "scenewatch/pipeline/covariance_view_request.h"
 #include "scenewatch/planning/covariance_view.h"
@@ -118,9 +120,25 @@ Status covariance_view(const pipeline::WorkingMemory& memory, const proto::NextB
   return {};
 }
 
-}  // namespace
+// The answer's views as the live view draws them: poses, scores, the target, the camera's field of view.
+SuggestedViewSet suggested_set(const proto::NextBestView& msg, const proto::NextBestViewReply& reply) {
+  SuggestedViewSet set;
+  set.measure = reply.measure();
+  if (auto box = convert::decode_box(reply.target(), "target")) set.target = *box;
+  Intrinsics K = planning::NextBestViewRequest{}.intrinsics;
+  if (msg.has_intrinsics()) {
+    if (auto given = convert::decode_intrinsics(msg.intrinsics(), "intrinsics")) K = *given;
+  }
+  set.horizontal_fov_deg = 2.0 * std::atan(0.5 * K.width / K.fx) * 180.0 / M_PI;
+  set.vertical_fov_deg = 2.0 * std::atan(0.5 * K.height / K.fy) * 180.0 / M_PI;
+  for (const auto& v : reply.views()) {
+    if (auto pose = convert::decode_pose(v.pose(), "pose")) set.views.push_back({*pose, v.score()});
+  }
+  return set;
+}
 
-Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, proto::NextBestViewReply* out) {
+Status answer_next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg,
+                             proto::NextBestViewReply* out) {
   if (const auto rule = planning::parse_covariance_measure(msg.measure())) return covariance_view(memory, msg, *rule, out);
   auto request = to_request(memory, msg);
   if (!request) return request.error();
@@ -147,6 +165,15 @@ Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBe
     o->set_why(convert::valid_utf8(v.why));
   }
   return {};
+}
+
+}  // namespace
+
+Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, proto::NextBestViewReply* out,
+                      SuggestedViews* suggested) {
+  Status status = answer_next_best_view(memory, msg, out);
+  if (status && suggested != nullptr) suggested->record(suggested_set(msg, *out));
+  return status;
 }
 
 }  // namespace scenewatch::service

@@ -4,11 +4,14 @@
 #include "scenewatch.pb.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/pipeline/working_memory.h"
+#include "scenewatch/service/suggested_views.h"
 
 namespace scenewatch::service {
 
 /// Answers one NextBestView from the memory's map. Bad requests (unknown object or event, bad
 /// numbers) are errors naming the field. Thread safe as the memory's queries are.
-Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, proto::NextBestViewReply* out);
+/// A successful answer's views are recorded in `suggested` (the live view draws them), when given.
+Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, proto::NextBestViewReply* out,
+                      SuggestedViews* suggested = nullptr);
 
 }  // namespace scenewatch::service

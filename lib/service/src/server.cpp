@@ -55,7 +55,7 @@ struct Server::Impl {
         memory(m),
         log(std::move(l)),
         handler(m, HandlerConfig{config.data_roots, config.model_dir, config.max_file_bytes, config.keep_snapshots,
-                                    config.access_token, config.classes},
+                                    config.access_token, config.classes, config.suggested_views},
                 [this](std::function<void()> task) { asio::post(model_strand, std::move(task)); },
                 [this](std::function<void()> task) { asio::post(workers, std::move(task)); }) {
     handler.set_connection_counter([this] { return registry.size(); });

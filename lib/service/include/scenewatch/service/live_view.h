@@ -5,7 +5,8 @@
 ///   GET /                  the page (embedded in the binary)
 ///   GET /three.min.js      three.js, read from Debian's libjs-three (LiveViewConfig::three_js)
 ///   GET /api/state         frames, stats, planes (hulls), objects (boxes, and their class when
-///                          LiveViewConfig::classes is set), occupied voxels (JSON);
+///                          LiveViewConfig::classes is set), the last NextBestView's suggested
+///                          views (LiveViewConfig::suggested_views), occupied voxels (JSON);
 ///                          (?voxels=0: without the voxels and the classes: the page's cheap poll)
 ///   GET /api/frame.png     the last colour frame with the surprise heatmap laid over it
 ///   GET /api/events        the events as they are emitted (Server-Sent Events)
@@ -17,6 +18,7 @@
 #include "scenewatch/core/frame.h"
 #include "scenewatch/core/result.h"
 #include "scenewatch/service/http_server.h"
+#include "scenewatch/service/suggested_views.h"
 
 namespace scenewatch::ontology {
 class ClassCatalog;
@@ -39,6 +41,8 @@ struct LiveViewConfig {
   /// The classes the objects are described by in /api/state (each new description is recorded
   /// in the catalog, as GetObjects records it); null: the objects carry no class.
   std::shared_ptr<ontology::ClassCatalog> classes;
+  /// The views the last NextBestView answer suggested, drawn as camera frusta; null: none.
+  std::shared_ptr<SuggestedViews> suggested_views;
 };
 
 /// Thread safe. `memory` must outlive it; it subscribes to the memory's events and unsubscribes

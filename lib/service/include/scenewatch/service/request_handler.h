@@ -25,6 +25,8 @@ class ClassCatalog;
 
 namespace scenewatch::service {
 
+class SuggestedViews;
+
 /// What the handler may touch on the server's file system.
 struct HandlerConfig {
   std::vector<std::filesystem::path> data_roots;  ///< IngestFile reads only below these
@@ -36,6 +38,8 @@ struct HandlerConfig {
   std::string token;
   /// The object classes (DefineClass, ListClasses); null: those calls answer FAILED_PRECONDITION.
   std::shared_ptr<ontology::ClassCatalog> classes;
+  /// Where NextBestView answers are recorded for the live view; null: nowhere.
+  std::shared_ptr<SuggestedViews> suggested_views;
 };
 
 /// The answer to one request.

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "scenewatch/core/result.h"
+#include "scenewatch/service/suggested_views.h"
 
 namespace scenewatch::ontology {
 class ClassCatalog;
@@ -50,6 +51,8 @@ struct ServerConfig {
   std::string access_token;
   /// Not read from YAML: the object classes the daemon serves (DefineClass, ListClasses); null: none.
   std::shared_ptr<ontology::ClassCatalog> classes;
+  /// Not read from YAML: where NextBestView answers are kept for the live view (both get this one).
+  std::shared_ptr<SuggestedViews> suggested_views = std::make_shared<SuggestedViews>();
 };
 
 /// Checks ranges; the message names the key ("server.read_timeout_s: must be > 0, got 0").
