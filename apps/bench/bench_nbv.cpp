@@ -12,6 +12,7 @@
 
 #include "bench.h"
 #include "closed_loop.h"
+#include "nbv_plot.h"
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/planning/covariance_planner.h"
 #include "scenewatch/planning/next_best_view.h"
@@ -155,6 +156,15 @@ void run_reproduction() {
     for (const auto& row : rows) csv << "," << row.trace[s] << "," << row.norm[s];
     csv << "\n";
   }
+  // The seed's Figs. 3.12 and 3.13 in one: the first 15 steps and the last 21 (180-200 in the seed).
+  const int late_first = std::max(1, setup.steps - 20);
+  std::vector<StepCurve> curves;
+  for (const auto& row : rows) curves.push_back({row.name, row.trace});
+  char title[160];
+  std::snprintf(title, sizeof title, "Seed's experiment (Figs. 3.12, 3.13): covariance trace, %d points, mean of %d runs", setup.points, runs);
+  const std::filesystem::path png = "nbv_reproduction.png";
+  const bool plotted = write_step_plot(png, title, "trace, sum over the points (m^2)", curves,
+                                       {{1, 15}, {late_first, setup.steps}});
   std::printf("\n== nbv: the seed's experiment (%d points in a %.1f m cube, cameras on a %.1f m sphere, f %.0f px, %.0f px noise, "
               "10 runs; CSV nbv_reproduction.csv) ==\n",
               setup.points, setup.cube_side_m, setup.sphere_radius_m, setup.focal_px, setup.sigma_px);
@@ -166,6 +176,12 @@ void run_reproduction() {
   for (int s = 0; s < 15; ++s) print_step(s);
   std::printf("  ...\n");
   for (int s = 179; s < setup.steps; ++s) print_step(s);
+  if (plotted) {
+    std::printf("plot of the trace (steps 1-15 and %d-%d): %s\n", late_first, setup.steps,
+                std::filesystem::absolute(png).c_str());
+  } else {
+    std::fprintf(stderr, "nbv: could not write %s\n", png.c_str());
+  }
 }
 
 int run_closed_loops(const sim::Scenario& scenario) {
