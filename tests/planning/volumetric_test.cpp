@@ -2,6 +2,8 @@
 // measures on a grid with a known front and an unknown back.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <random>
 #include <set>
 
@@ -101,6 +103,55 @@ TEST(ViewScorer, RearSideMeasuresSeeTheBackFromBehindOnly) {
   EXPECT_EQ(again.gain, b.gain);
 }
 
+// A free voxel seen free too few times to be settled carries its entropy, and may hide what lies
+// behind it; a settled one carries none. The object box of front_seen_object() seen from +x, its
+// two layers nearest the camera free (the rest stays as it was: unknown inside, an occupied -x face).
+TEST(ViewScorer, UncertainFreeVoxelsCarryTheirEntropyAndDimWhatIsBehind) {
+  DenseGrid settled = front_seen_object();
+  for (std::size_t i = 0; i < settled.size(); ++i) {
+    const Eigen::Vector3d c = settled.center(static_cast<long>(i));
+    if ((c.array().abs() < 0.1).all() && c.x() > 0.06) settled.state[i] = static_cast<std::uint8_t>(Occupancy::kFree);
+  }
+  DenseGrid uncertain = settled;
+  constexpr std::uint8_t kP = 102;  // p = 0.4: seen free once (OctoMap's miss, log-odds -0.4)
+  std::size_t listed = 0;
+  for (std::size_t i = 0; i < uncertain.size(); ++i) {
+    const Eigen::Vector3d c = uncertain.center(static_cast<long>(i));
+    if ((c.array().abs() < 0.1).all() && c.x() > 0.06) {
+      uncertain.uncertain_free.push_back({i, 0, kP});
+      ++listed;
+    }
+  }
+  ASSERT_EQ(listed, 200u);
+  const Pose back = look_at(Eigen::Vector3d(0.6, 0.0, 0.0), Eigen::Vector3d::Zero());
+  ViewScorer settled_scorer(settled, kObject), uncertain_scorer(uncertain, kObject);
+  const ViewGain s = settled_scorer.score(back, kIntrinsics, Measure::kOcclusionAware);
+  const ViewGain u = uncertain_scorer.score(back, kIntrinsics, Measure::kOcclusionAware);
+  // The same voxels reached and counted as unknown: an uncertain voxel is free.
+  EXPECT_EQ(u.unknown_reached, s.unknown_reached);
+  EXPECT_EQ(u.target_reached, s.target_reached);
+  EXPECT_GT(s.unknown_reached, 100u);
+  // Settled free voxels carry no entropy: only the unknown ones, one bit each, and the occupied
+  // face's voxels reached through them from behind, H(240/255) each.
+  const double q = 240.0 / 255.0, h_face = -(q * std::log2(q) + (1 - q) * std::log2(1 - q));
+  const double faces = (s.entropy_bits - static_cast<double>(s.unknown_reached)) / h_face;
+  EXPECT_NEAR(faces, std::round(faces), 1e-6);
+  EXPECT_LE(faces, 100.0 + 1e-6);
+  // Each uncertain voxel reached adds H(0.4) = 0.971 bits; most of the 200 are reached.
+  const double p = kP / 255.0, h = -(p * std::log2(p) + (1 - p) * std::log2(1 - p));
+  const double uncertain_reached = (u.entropy_bits - s.entropy_bits) / h;
+  EXPECT_NEAR(uncertain_reached, std::round(uncertain_reached), 1e-6);
+  EXPECT_GT(uncertain_reached, 150.0);
+  EXPECT_LE(uncertain_reached, 200.0 + 1e-6);
+  // Every ray enters the box through the two uncertain layers (or three, slanting): the unknown
+  // inside weighs at most 0.6^2 = 0.36 of what it weighs behind settled free space, and at least
+  // 0.6^3; the uncertain voxels add at most their own entropy each.
+  EXPECT_LE(u.gain, uncertain_reached * h + 0.36 * s.gain + 1e-9);
+  EXPECT_GE(u.gain, 0.216 * s.gain);
+  std::printf("from behind: %zu unknown voxels, %.0f uncertain free; occlusion-aware %.1f settled, %.1f uncertain\n",
+              s.unknown_reached, uncertain_reached, s.gain, u.gain);
+}
+
 // The 2 cm map of the simulator's clutter table from two 640x480 frames (scenewatch-bench's speed
 // case), over the planning region of a request for the whole table.
 DenseGrid clutter_table_grid(NextBestViewRequest& r) {
@@ -121,7 +172,8 @@ DenseGrid clutter_table_grid(NextBestViewRequest& r) {
   r.constraint.radius_max_m = 0.9;
   r.intrinsics = vga.intrinsics;
   DenseGrid g;
-  EXPECT_TRUE(map.fill_dense_grid(*planning_region(r), g));
+  EXPECT_TRUE(map.fill_dense_grid(*planning_region(r), g, std::size_t{1} << 26, /*with_uncertain_free=*/true));
+  EXPECT_GT(g.uncertain_free.size(), 1000u) << "two frames leave much of the space they freed unsettled";
   return g;
 }
 

@@ -262,6 +262,7 @@ struct GridFill {
   OcTreeKey lo, hi;
   unsigned depth;
   DenseGrid& grid;
+  bool uncertain_free = false;  // list the free voxels not yet at the lower clamp
 
   void visit(const octomap::ColorOcTreeNode* node, unsigned level, const std::array<unsigned, 3>& base) {
     const unsigned span = 1u << (depth - level);
@@ -289,20 +290,24 @@ struct GridFill {
     }
     const bool occupied = tree.isNodeOccupied(node);
     const auto s = static_cast<std::uint8_t>(occupied ? Occupancy::kOccupied : Occupancy::kFree);
+    // OctoMap clamps a belief exactly at the bound (and set_voxels writes the bound itself).
+    std::vector<DenseGrid::Surface>* listed =
+        occupied ? &grid.occupied
+                 : (uncertain_free && node.getLogOdds() > tree.getClampingThresMinLog() ? &grid.uncertain_free : nullptr);
     DenseGrid::Surface surface;
+    if (listed != nullptr) surface.probability = static_cast<std::uint8_t>(std::lround(255.0 * node.getOccupancy()));
     if (occupied) {
       const octomap::ColorOcTreeNode::Color col = node.getColor();
       surface.rgb = (std::uint32_t{col.r} << 16) | (std::uint32_t{col.g} << 8) | col.b;
-      surface.probability = static_cast<std::uint8_t>(std::lround(255.0 * node.getOccupancy()));
     }
     for (long z = first[2]; z <= last[2]; ++z)
       for (long y = first[1]; y <= last[1]; ++y) {
         const std::size_t row = (static_cast<std::size_t>(z) * grid.ny + y) * grid.nx;
         std::fill(grid.state.begin() + row + first[0], grid.state.begin() + row + last[0] + 1, s);
-        if (!occupied) continue;
+        if (listed == nullptr) continue;
         for (long x = first[0]; x <= last[0]; ++x) {
           surface.index = row + x;
-          grid.occupied.push_back(surface);
+          listed->push_back(surface);
         }
       }
   }
@@ -312,11 +317,11 @@ struct GridFill {
 
 Result<DenseGrid> OccupancyMap::dense_grid(const Aabb& box, std::size_t max_voxels) const {
   DenseGrid grid;
-  if (auto st = fill_dense_grid(box, grid, max_voxels); !st) return st.error();
+  if (auto st = fill_dense_grid(box, grid, max_voxels, /*with_uncertain_free=*/true); !st) return st.error();
   return grid;
 }
 
-Status OccupancyMap::fill_dense_grid(const Aabb& box, DenseGrid& grid, std::size_t max_voxels) const {
+Status OccupancyMap::fill_dense_grid(const Aabb& box, DenseGrid& grid, std::size_t max_voxels, bool with_uncertain_free) const {
   const auto& tree = impl_->tree;
   OcTreeKey lo, hi;
   if (!box.valid()) return invalid_argument("dense grid: the box is empty or not finite");
@@ -336,12 +341,14 @@ Status OccupancyMap::fill_dense_grid(const Aabb& box, DenseGrid& grid, std::size
   // assign() and clear() keep the buffers of a grid filled before: no fresh pages per frame.
   grid.state.assign(n, static_cast<std::uint8_t>(Occupancy::kUnknown));
   grid.occupied.clear();
+  grid.uncertain_free.clear();
   if (tree.getRoot() != nullptr) {
-    GridFill fill{tree, lo, hi, tree.getTreeDepth(), grid};
+    GridFill fill{tree, lo, hi, tree.getTreeDepth(), grid, with_uncertain_free};
     fill.visit(tree.getRoot(), 0, {0u, 0u, 0u});
   }
-  std::sort(grid.occupied.begin(), grid.occupied.end(),
-            [](const DenseGrid::Surface& a, const DenseGrid::Surface& b) { return a.index < b.index; });
+  const auto by_index = [](const DenseGrid::Surface& a, const DenseGrid::Surface& b) { return a.index < b.index; };
+  std::sort(grid.occupied.begin(), grid.occupied.end(), by_index);
+  std::sort(grid.uncertain_free.begin(), grid.uncertain_free.end(), by_index);
   return {};
 }
 

@@ -164,7 +164,7 @@ Result<ClosedLoopCurve> run_closed_loop(const sim::Scenario& scenario_in, const 
     if (setup.random) {
       current = (*candidates)[std::uniform_int_distribution<std::size_t>(0, candidates->size() - 1)(choice_rng)];
     } else {
-      if (auto st = map.fill_dense_grid(*region, grid); !st) return st.error();
+      if (auto st = map.fill_dense_grid(*region, grid, std::size_t{1} << 26, /*with_uncertain_free=*/true); !st) return st.error();
       request.current_T_world_camera = current;
       auto answer = next_best_views(grid, request);
       if (!answer) return answer.error();

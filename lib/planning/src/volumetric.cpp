@@ -101,6 +101,14 @@ double ViewScorer::occupied_probability(long index) const {
   return it->probability / 255.0;
 }
 
+double ViewScorer::uncertain_free_probability(long index) const {
+  const auto& listed = grid_.uncertain_free;
+  const auto it = std::lower_bound(listed.begin(), listed.end(), static_cast<std::size_t>(index),
+                                   [](const DenseGrid::Surface& s, std::size_t i) { return s.index < i; });
+  if (it == listed.end() || it->index != static_cast<std::size_t>(index)) return 0.0;
+  return it->probability / 255.0;
+}
+
 void ViewScorer::count_surface(long index, double visibility, RaySums& sums) const {
   const double h = binary_entropy(occupied_probability(index));
   sums.known_entropy += h;
@@ -128,8 +136,20 @@ bool ViewScorer::visit_target_voxel(long index, long mark, std::uint32_t stamp, 
     }
     ray.previous_unknown_target = mark;
     ray.visibility *= 0.5;  // an unknown voxel is occupied with probability 0.5
-  } else {
-    ray.previous_unknown_target = -1;
+    return false;
+  }
+  ray.previous_unknown_target = -1;
+  // A free voxel seen free too few times to be settled (below OctoMap's clamp) is still
+  // uncertain: its entropy counts, and it may hide what lies behind it.
+  if (!grid_.uncertain_free.empty()) {
+    if (const double p = uncertain_free_probability(index); p > 0.0) {
+      if (first) {
+        const double h = binary_entropy(p);
+        sums.known_entropy += h;
+        sums.occlusion_aware += ray.visibility * h;
+      }
+      ray.visibility *= 1.0 - p;
+    }
   }
   return false;
 }

@@ -61,6 +61,11 @@ struct DenseGrid {
     std::uint8_t probability = 0;  ///< occupancy probability times 255
   };
   std::vector<Surface> occupied;  ///< every occupied voxel of the grid, by index
+  /// Free voxels whose belief has not reached OctoMap's lower clamp yet (seen free a few times:
+  /// not isNodeAtThreshold), by index, with their occupancy probability; no colour. Filled only
+  /// on request (dense_grid() does; fill_dense_grid() when asked): the view planner counts their
+  /// entropy, a settled free voxel carries none.
+  std::vector<Surface> uncertain_free;
   std::size_t size() const { return state.size(); }
   /// Index of the voxel holding p, or -1 outside the grid.
   long index_of(const Eigen::Vector3d& p_world) const {
@@ -107,12 +112,13 @@ class OccupancyMap {
   std::size_t clear_box(const Aabb& box_world);
   void reset();
 
-  /// The voxels overlapping a box as a dense grid. Error when the box is invalid, outside the
-  /// map's extent, or holds more than max_voxels voxels.
+  /// The voxels overlapping a box as a dense grid, with its uncertain free voxels. Error when the
+  /// box is invalid, outside the map's extent, or holds more than max_voxels voxels.
   Result<DenseGrid> dense_grid(const Aabb& box_world, std::size_t max_voxels = std::size_t{1} << 26) const;
   /// The same into `grid`, whose buffers are kept (a caller that fills one grid per frame
-  /// allocates once). On error `grid` is unspecified.
-  Status fill_dense_grid(const Aabb& box_world, DenseGrid& grid, std::size_t max_voxels = std::size_t{1} << 26) const;
+  /// allocates once); the uncertain free voxels only when asked. On error `grid` is unspecified.
+  Status fill_dense_grid(const Aabb& box_world, DenseGrid& grid, std::size_t max_voxels = std::size_t{1} << 26,
+                         bool with_uncertain_free = false) const;
   /// Sets the voxels holding the given points to the clamped free or occupied belief (a confirmed
   /// change written into the model at once instead of over several frames). kUnknown deletes
   /// them. Returns the number of distinct voxels set.

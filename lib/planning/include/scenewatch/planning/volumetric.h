@@ -88,6 +88,9 @@ class ViewScorer {
   /// The mark slot of target voxel (i, j, k): reached_ and rear_ cover the target box only.
   long mark_of(const long ijk[3]) const { return ((ijk[2] - lo_[2]) * span_[1] + (ijk[1] - lo_[1])) * span_[0] + ijk[0] - lo_[0]; }
   double occupied_probability(long index) const;
+  /// A free voxel's occupancy probability while its belief is not settled (the grid's
+  /// uncertain_free); 0 for a settled one.
+  double uncertain_free_probability(long index) const;
   /// An occupied target voxel reached for the first time in this call: its entropy into the sums.
   void count_surface(long index, double visibility, RaySums& sums) const;
   /// One ray's running state: the visibility (prod of 1 - p so far) and the mark slot of the
