@@ -290,6 +290,14 @@ struct GridFill {
     }
     const bool occupied = tree.isNodeOccupied(node);
     const auto s = static_cast<std::uint8_t>(occupied ? Occupancy::kOccupied : Occupancy::kFree);
+    if (!occupied && !uncertain_free) {  // the common case, free space: rows of state only
+      for (long z = first[2]; z <= last[2]; ++z)
+        for (long y = first[1]; y <= last[1]; ++y) {
+          const std::size_t row = (static_cast<std::size_t>(z) * grid.ny + y) * grid.nx;
+          std::fill(grid.state.begin() + row + first[0], grid.state.begin() + row + last[0] + 1, s);
+        }
+      return;
+    }
     // OctoMap clamps a belief exactly at the bound (and set_voxels writes the bound itself).
     std::vector<DenseGrid::Surface>* listed =
         occupied ? &grid.occupied
