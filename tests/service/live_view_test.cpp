@@ -530,6 +530,7 @@ TEST_F(LiveViewTest, ChromiumShowsTheObjectTheEventAndTheSuggestedViewsAfterACup
   EXPECT_NE(dom.out.find("class=\"object\">object "), std::string::npos) << dom.out;
   EXPECT_NE(dom.out.find(" (cup, score "), std::string::npos) << "the object's class is listed:\n" << dom.out;
   EXPECT_NE(dom.out.find("id=\"three-error\" hidden"), std::string::npos) << "three.js or WebGL missing:\n" << dom.out;
+  EXPECT_NE(dom.out.find("3 suggested views (" + nbv.next_best_view().measure() + "), best first"), std::string::npos) << dom.out;
 
   const fs::path shot = tmp_ / "live-view.png";
   const CommandResult screenshot = run_chromium(tmp_, url, "--screenshot=" + shot.string());
