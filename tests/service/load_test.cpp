@@ -177,11 +177,14 @@ TEST(DaemonLoadTest, NoRequestLostUnderLoadWithHostileConnectionsHeld) {
 // Per round, the daemon's VmRSS before, at the peak and after: the peak within the unfinished
 // frames' budget (server.max_buffered_bytes, 256 MiB) plus an allowance for what else a burst costs
 // (sessions and their read buffers, the allocator's rounding), and after each round back within a
-// smaller allowance of where the run started: no round leaves memory behind for the next.
+// smaller allowance of where the run started: no round leaves memory behind for the next. The
+// closed sessions' read buffers are given back (session.cpp): 2-7 MiB stay after a round, measured;
+// 25-32 MiB stayed before that, which the earlier allowance of 32 MiB hid until a loaded CI run
+// went past it.
 constexpr int kRounds = 4;
 constexpr double kBurstBudgetMiB = 256;
 constexpr double kBurstPeakAllowanceMiB = 64;
-constexpr double kBurstAfterAllowanceMiB = 32;
+constexpr double kBurstAfterAllowanceMiB = 16;
 
 TEST(DaemonLoadTest, RoundsOfConnectionAndHalfFrameBurstsKeepMemoryBounded) {
   const fs::path tmp = make_temp_dir("load-bursts");
