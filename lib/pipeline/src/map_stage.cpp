@@ -1,6 +1,7 @@
 // The background map's part of a frame: change detection, then insertion (map_stage.h).
 #include "map_stage.h"
 
+#include <future>
 #include <limits>
 
 #include "frame_sampling.h"
@@ -85,8 +86,14 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
   const background::Config& b = config.background;
   const int stride = sample_stride(frame, K, b.resolution_m, b.max_range_m, b.insert_stride_px);
   std::unique_lock<std::shared_mutex> write(mutex_);
+  // The witness and the octree are apart: the frame's surfaces are witnessed on a thread of their
+  // own while the insertion runs (the map's part is the frame's longest; the other core has room).
+  std::future<void> witnessed;
+  if (config.change.witness_per_camera) {
+    witnessed = std::async(std::launch::async, [&] { witness_.witness(*to_insert, T, camera, stride); });
+  }
   result.insert_stats = map_.insert(*to_insert, T, stride);
-  if (config.change.witness_per_camera) witness_.witness(*to_insert, T, camera, stride);
+  if (witnessed.valid()) witnessed.get();
   for (const auto& c : changed.confirmed) {
     if (c.before) {
       map_.set_voxels(c.before->points_world, background::Occupancy::kFree);
