@@ -94,8 +94,6 @@ struct LiveView::Impl {
     return r;
   }
 
-  /// With `with_voxels` false, the "voxels" key is left out: the page polls that way and asks
-  /// for them only when a frame was processed.
   // The last NextBestView answer's views: T_world_camera row-major (as the API's Pose), the
   // score, and the field of view to draw each camera's frustum with.
   json suggested_views_json() const {
@@ -117,6 +115,8 @@ struct LiveView::Impl {
     return out;
   }
 
+  /// With `with_voxels` false, the "voxels" key is left out: the page polls that way and asks
+  /// for them only when a frame was processed.
   HttpResponse state(bool with_voxels) const {
     const auto snapshot = memory.snapshot();
     const pipeline::Stats stats = memory.stats();

@@ -67,10 +67,10 @@ Session::Session(tcp::socket socket, const SessionOptions& options, RequestHandl
 
 Session::~Session() {
   handler_.unsubscribe(context_);
-  if (gone_session_bytes.fetch_add(sizeof(Session)) + sizeof(Session) >= kGoneSessionBytesToGiveBack) {
-    gone_session_bytes = 0;
-    give_back_free_memory();
-  }
+  std::size_t gone = gone_session_bytes.fetch_add(sizeof(Session)) + sizeof(Session);
+  // One of the sessions going together resets the count and gives back (the others' bytes are
+  // then counted towards the next time).
+  if (gone >= kGoneSessionBytesToGiveBack && gone_session_bytes.compare_exchange_strong(gone, 0)) give_back_free_memory();
 }
 
 void Session::log(LogLevel level, const std::string& message) const {
