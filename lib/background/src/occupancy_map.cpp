@@ -290,12 +290,17 @@ struct GridFill {
     }
     const bool occupied = tree.isNodeOccupied(node);
     const auto s = static_cast<std::uint8_t>(occupied ? Occupancy::kOccupied : Occupancy::kFree);
-    if (!occupied && !uncertain_free) {  // the common case, free space: rows of state only
+    // Each row of the leaf's voxels in the box gets the state, then `also(row)`.
+    const auto rows = [&](const auto& also) {
       for (long z = first[2]; z <= last[2]; ++z)
         for (long y = first[1]; y <= last[1]; ++y) {
           const std::size_t row = (static_cast<std::size_t>(z) * grid.ny + y) * grid.nx;
           std::fill(grid.state.begin() + row + first[0], grid.state.begin() + row + last[0] + 1, s);
+          also(row);
         }
+    };
+    if (!occupied && !uncertain_free) {  // the common case, free space: the state alone
+      rows([](std::size_t) {});
       return;
     }
     // OctoMap clamps a belief exactly at the bound (and set_voxels writes the bound itself).
@@ -308,16 +313,13 @@ struct GridFill {
       const octomap::ColorOcTreeNode::Color col = node.getColor();
       surface.rgb = (std::uint32_t{col.r} << 16) | (std::uint32_t{col.g} << 8) | col.b;
     }
-    for (long z = first[2]; z <= last[2]; ++z)
-      for (long y = first[1]; y <= last[1]; ++y) {
-        const std::size_t row = (static_cast<std::size_t>(z) * grid.ny + y) * grid.nx;
-        std::fill(grid.state.begin() + row + first[0], grid.state.begin() + row + last[0] + 1, s);
-        if (listed == nullptr) continue;
-        for (long x = first[0]; x <= last[0]; ++x) {
-          surface.index = row + x;
-          listed->push_back(surface);
-        }
+    rows([&](std::size_t row) {
+      if (listed == nullptr) return;
+      for (long x = first[0]; x <= last[0]; ++x) {
+        surface.index = row + x;
+        listed->push_back(surface);
       }
+    });
   }
 };
 

@@ -214,9 +214,8 @@ std::vector<MissingVoxel> missing_surfaces(const background::DenseGrid& grid, co
     if (witness != nullptr) {
       double seen_depth = 0.0;
       if (witness->seen(c, camera, &seen_depth) == SurfaceWitness::Seen::kByOthersOnly) continue;
-      if (seen_depth > 0 &&
-          !footprint_behind(depth, trusted_at, uc, vc, half_px, limit_for(std::hypot(frame_sigma, config.sensor.sigma_z(seen_depth))), nearest))
-        continue;
+      // The whole footprint lies behind the frame's limit; the wider one holds when its nearest does.
+      if (seen_depth > 0 && !(nearest > limit_for(std::hypot(frame_sigma, config.sensor.sigma_z(seen_depth))))) continue;
     }
     MissingVoxel m;
     m.center_world = c;

@@ -25,6 +25,14 @@ double binary_entropy(double p) {
   return -(p * std::log2(p) + (1.0 - p) * std::log2(1.0 - p));
 }
 
+// The probability a grid's list (sorted by index) holds for voxel `index`, `absent` when it is not listed.
+double listed_probability(const std::vector<DenseGrid::Surface>& listed, long index, double absent) {
+  const auto it = std::lower_bound(listed.begin(), listed.end(), static_cast<std::size_t>(index),
+                                   [](const DenseGrid::Surface& s, std::size_t i) { return s.index < i; });
+  if (it == listed.end() || it->index != static_cast<std::size_t>(index)) return absent;
+  return it->probability / 255.0;
+}
+
 }  // namespace
 
 const char* to_string(Measure measure) {
@@ -94,20 +102,9 @@ ViewScorer::ViewScorer(const DenseGrid& grid, const Aabb& target, VolumetricConf
       }
 }
 
-double ViewScorer::occupied_probability(long index) const {
-  const auto it = std::lower_bound(grid_.occupied.begin(), grid_.occupied.end(), static_cast<std::size_t>(index),
-                                   [](const DenseGrid::Surface& s, std::size_t i) { return s.index < i; });
-  if (it == grid_.occupied.end() || it->index != static_cast<std::size_t>(index)) return 1.0;
-  return it->probability / 255.0;
-}
+double ViewScorer::occupied_probability(long index) const { return listed_probability(grid_.occupied, index, 1.0); }
 
-double ViewScorer::uncertain_free_probability(long index) const {
-  const auto& listed = grid_.uncertain_free;
-  const auto it = std::lower_bound(listed.begin(), listed.end(), static_cast<std::size_t>(index),
-                                   [](const DenseGrid::Surface& s, std::size_t i) { return s.index < i; });
-  if (it == listed.end() || it->index != static_cast<std::size_t>(index)) return 0.0;
-  return it->probability / 255.0;
-}
+double ViewScorer::uncertain_free_probability(long index) const { return listed_probability(grid_.uncertain_free, index, 0.0); }
 
 void ViewScorer::count_surface(long index, double visibility, RaySums& sums) const {
   const double h = binary_entropy(occupied_probability(index));
