@@ -23,11 +23,45 @@ double huber_weight(double e) {
   return a <= kHuber ? 1.0 : kHuber / a;
 }
 
-// Adds w * J^T J and w * J^T r.
-void accumulate(Mat6& H, Vec6& b, const Vec6& J, double r, double w) {
-  const Vec6 wJ = w * J;
-  H.noalias() += wJ * J.transpose();
-  b.noalias() += r * wJ;
+// The normal equations of a least-squares pass: the upper triangle of H = sum w J J^T, row by
+// row, and b = sum w r J. A pass adds one term per pixel, so the 21 distinct entries of the
+// symmetric H are summed rather than all 36 of an Eigen outer product.
+struct NormalEquations {
+  double h[21] = {};
+  double b[6] = {};
+  void add(const double (&J)[6], double r, double w) {
+    int k = 0;
+    for (int i = 0; i < 6; ++i) {
+      const double wi = w * J[i];
+      b[i] += r * wi;
+      for (int j = i; j < 6; ++j) h[k++] += wi * J[j];
+    }
+  }
+  void add_information(const double (&J)[6], double w) {
+    int k = 0;
+    for (int i = 0; i < 6; ++i) {
+      const double wi = w * J[i];
+      for (int j = i; j < 6; ++j) h[k++] += wi * J[j];
+    }
+  }
+  Mat6 H() const {
+    Mat6 m;
+    int k = 0;
+    for (int i = 0; i < 6; ++i)
+      for (int j = i; j < 6; ++j) m(i, j) = m(j, i) = h[k++];
+    return m;
+  }
+  Vec6 rhs() const { return Vec6(b[0], b[1], b[2], b[3], b[4], b[5]); }
+};
+
+// J = (n, q x n) for a point q and a direction n: the derivative of n . q under a twist.
+void point_jacobian(const Eigen::Vector3d& q, const Eigen::Vector3d& n, double (&J)[6]) {
+  J[0] = n.x();
+  J[1] = n.y();
+  J[2] = n.z();
+  J[3] = q.y() * n.z() - q.z() * n.y();
+  J[4] = q.z() * n.x() - q.x() * n.z();
+  J[5] = q.x() * n.y() - q.y() * n.x();
 }
 
 float bilinear(const std::vector<float>& img, int width, float x, float y) {
@@ -38,9 +72,8 @@ float bilinear(const std::vector<float>& img, int width, float x, float y) {
 }
 
 struct Pass {
-  Mat6 H = Mat6::Zero();      // geometric and photometric
-  Vec6 b = Vec6::Zero();
-  Mat6 H_geometric = Mat6::Zero();  // unweighted by Huber, 1 / sigma^2: the information
+  NormalEquations system;       // geometric and photometric
+  NormalEquations information;  // geometric inliers, unweighted by Huber, 1 / sigma^2
   std::size_t valid = 0, correspondences = 0, inliers = 0;
   double inlier_sq = 0.0, depth_sum = 0.0;
   std::vector<float> photometric_abs;  // |r| of the photometric terms, for their robust spread
@@ -54,8 +87,10 @@ struct LevelInput {
 };
 
 // One pass over the current level's pixels at the pose T_rc.
-Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor, const AlignmentConfig& config) {
+Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor, const AlignmentConfig& config,
+               bool keep_information = false) {
   Pass p;
+  if (config.photometric_weight > 0) p.photometric_abs.reserve(in.cur.pixels() / 2);
   const RgbdLevel& ref = in.ref;
   const RgbdLevel& cur = in.cur;
   const Eigen::Matrix3f R = T_rc.linear().cast<float>();
@@ -81,20 +116,21 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
       const float zr = ref.depth_m[ir];
       if (zr > 0 && std::isfinite(ref.normals[ir].x())) {
         const Eigen::Vector3f d = q - ref.point(iu, iv, zr);
-        const double sigma = std::hypot(sensor.sigma_z(zc), sensor.sigma_z(zr));
+        const double sz_c = sensor.sigma_z(zc), sz_r = sensor.sigma_z(zr);
+        const double sigma2 = sz_c * sz_c + sz_r * sz_r, sigma = std::sqrt(sigma2);
         if (d.norm() <= std::max(in.gate_m, kGateSigmas * sigma)) {
           const Eigen::Vector3d n = ref.normals[ir].cast<double>();
           const double r = n.dot(d.cast<double>());
-          Vec6 J;
-          J << n, qd.cross(n);
-          const double info = 1.0 / (sigma * sigma);
-          accumulate(p.H, p.b, J, r, info * huber_weight(r / sigma));
+          double J[6];
+          point_jacobian(qd, n, J);
+          const double info = 1.0 / sigma2;
+          p.system.add(J, r, info * huber_weight(r / sigma));
           ++p.correspondences;
           p.depth_sum += zr;
           if (std::abs(r) <= kInlierSigmas * sigma) {
             ++p.inliers;
             p.inlier_sq += r * r;
-            p.H_geometric.noalias() += (info * J) * J.transpose();
+            if (keep_information) p.information.add_information(J, info);
           }
         }
       }
@@ -107,10 +143,10 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
       const double iz = 1.0 / qd.z();
       // Gradient through the projection: a = dpi/dq^T grad.
       const Eigen::Vector3d a(bgx * fx * iz, bgy * fy * iz, -(bgx * fx * qd.x() + bgy * fy * qd.y()) * iz * iz);
-      Vec6 J;
-      J << a, qd.cross(a);
+      double J[6];
+      point_jacobian(qd, a, J);
       const double s = in.photometric_sigma;
-      accumulate(p.H, p.b, J, r, wphoto * huber_weight(r / s) / (s * s));
+      p.system.add(J, r, wphoto * huber_weight(r / s) / (s * s));
       p.photometric_abs.push_back(static_cast<float>(std::abs(r)));
     }
   }
@@ -124,8 +160,6 @@ double robust_spread(std::vector<float>& abs_residuals, double fallback) {
   // 1.4826 x MAD; at least one grey level of an 8-bit image.
   return std::max(1.4826 * *mid, 1.0 / 255.0);
 }
-
-Mat6 full(const Mat6& m) { return 0.5 * (m + m.transpose()); }
 
 }  // namespace
 
@@ -192,8 +226,7 @@ Alignment align(const RgbdPyramid& reference, const RgbdPyramid& current, const 
       ++out.iterations;
       in.photometric_sigma = robust_spread(pass.photometric_abs, in.photometric_sigma);
       if (pass.correspondences < 60) break;
-      const Mat6 H = full(pass.H);
-      const Vec6 delta = H.ldlt().solve(-pass.b);
+      const Vec6 delta = pass.system.H().ldlt().solve(-pass.system.rhs());
       if (!delta.allFinite()) break;
       T = twist_exp(delta) * T;
       if (delta.head<3>().norm() < config.converged_m && delta.tail<3>().norm() < converged_rad) break;
@@ -203,14 +236,14 @@ Alignment align(const RgbdPyramid& reference, const RgbdPyramid& current, const 
   LevelInput fine{reference.levels[0], current.levels[0], config.max_correspondence_m * std::pow(0.5, levels - 1), 0.1};
   AlignmentConfig geometric = config;
   geometric.photometric_weight = 0;
-  const Pass last = linearise(fine, T, sensor, geometric);
+  const Pass last = linearise(fine, T, sensor, geometric, true);
   out.T_reference_current = T;
   out.valid_pixels = last.valid;
   out.inliers = last.inliers;
   out.inlier_fraction = last.valid ? static_cast<double>(last.inliers) / last.valid : 0.0;
   out.residual_m = last.inliers ? std::sqrt(last.inlier_sq / last.inliers) : 0.0;
   if (last.inliers >= 6) {
-    const Mat6 info = full(last.H_geometric);
+    const Mat6 info = last.information.H();
     // Information per motion, rotation scaled by the mean depth so both are metres.
     const double depth = last.correspondences ? last.depth_sum / last.correspondences : 1.0;
     out.mean_depth_m = depth;
