@@ -64,12 +64,21 @@ void point_jacobian(const Eigen::Vector3d& q, const Eigen::Vector3d& n, double (
   J[5] = q.x() * n.y() - q.y() * n.x();
 }
 
-float bilinear(const std::vector<float>& img, int width, float x, float y) {
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const float ax = x - x0, ay = y - y0;
-  const std::size_t i = static_cast<std::size_t>(y0) * width + x0;
-  return (1 - ay) * ((1 - ax) * img[i] + ax * img[i + 1]) + ay * ((1 - ax) * img[i + width] + ax * img[i + width + 1]);
-}
+// Where a point falls between four pixels, for sampling several images there.
+struct Bilinear {
+  std::size_t i;  ///< the top-left pixel
+  std::size_t width;
+  float ax, ay;
+  Bilinear(int width_px, float x, float y) : width(static_cast<std::size_t>(width_px)) {
+    const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+    ax = x - x0;
+    ay = y - y0;
+    i = static_cast<std::size_t>(y0) * width + x0;
+  }
+  float operator()(const std::vector<float>& img) const {
+    return (1 - ay) * ((1 - ax) * img[i] + ax * img[i + 1]) + ay * ((1 - ax) * img[i + width] + ax * img[i + width + 1]);
+  }
+};
 
 struct Pass {
   NormalEquations system;       // geometric and photometric
@@ -138,8 +147,9 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
       if (wphoto <= 0) continue;
       const float gx = ref.grad_x[ir], gy = ref.grad_y[ir];
       if (std::abs(gx) < min_grad && std::abs(gy) < min_grad) continue;
-      const double r = bilinear(ref.intensity, ref.width, x, y) - cur.intensity[ic];
-      const double bgx = bilinear(ref.grad_x, ref.width, x, y), bgy = bilinear(ref.grad_y, ref.width, x, y);
+      const Bilinear at(ref.width, x, y);
+      const double r = at(ref.intensity) - cur.intensity[ic];
+      const double bgx = at(ref.grad_x), bgy = at(ref.grad_y);
       const double iz = 1.0 / qd.z();
       // Gradient through the projection: a = dpi/dq^T grad.
       const Eigen::Vector3d a(bgx * fx * iz, bgy * fy * iz, -(bgx * fx * qd.x() + bgy * fy * qd.y()) * iz * iz);
