@@ -6,7 +6,6 @@
 #include <filesystem>
 #include <functional>
 #include <optional>
-#include <random>
 
 #include <pcl/filters/voxel_grid.h>
 #include <pcl/registration/gicp.h>
@@ -19,6 +18,7 @@
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/localization/localizer.h"
+#include "scenewatch/localization/pose_error.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"
 
@@ -36,19 +36,6 @@ void add_error(Errors& e, const Pose& estimate, const Pose& truth) {
   e.deg.push_back(d.rotation_deg);
 }
 
-// Odometry as a robot has it: the recording's relative motions, each with a random error
-// (translation N(0, s_t^2 / 3) per axis, so a step's RMS error is s_t; rotation likewise), integrated.
-std::vector<Pose> with_drift(const std::vector<Pose>& truth, double step_m, double step_deg, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> t(0.0, step_m / std::sqrt(3.0)), r(0.0, step_deg * M_PI / 180.0 / std::sqrt(3.0));
-  std::vector<Pose> out{truth.front()};
-  for (std::size_t i = 1; i < truth.size(); ++i) {
-    Eigen::Matrix<double, 6, 1> xi;
-    xi << t(rng), t(rng), t(rng), r(rng), r(rng), r(rng);
-    out.push_back(Pose(out.back() * truth[i - 1].inverse() * truth[i] * localization::twist_exp(xi)));
-  }
-  return out;
-}
 
 struct Trajectory {
   std::vector<Pose> used;
@@ -111,19 +98,6 @@ Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& 
   return run([&](std::size_t i) { return io::load_sequence_frame(seq, i); }, given, mode, std::move(lc));
 }
 
-// The given poses with noise independent per frame (translation N(0, s_t^2 / 3) per axis, so its
-// RMS is s_t; rotation likewise), as a motion-capture marker's jitter or a pose estimate's scatter.
-std::vector<Pose> with_noise(const std::vector<Pose>& truth, double sigma_m, double sigma_deg, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> t(0.0, sigma_m / std::sqrt(3.0)), r(0.0, sigma_deg * M_PI / 180.0 / std::sqrt(3.0));
-  std::vector<Pose> out;
-  for (const Pose& p : truth) {
-    Eigen::Matrix<double, 6, 1> xi;
-    xi << t(rng), t(rng), t(rng), r(rng), r(rng), r(rng);
-    out.push_back(Pose(p * localization::twist_exp(xi)));
-  }
-  return out;
-}
 
 // The simulator, whose truth is exact (unlike a reconstruction's poses): the `clutter` table seen
 // by a camera moving on half a circle, 90 frames at 640x480.
@@ -157,14 +131,14 @@ int run_simulated() {
   told_noise.noise_m = 0.005;
   told_noise.noise_deg = 0.25;
   for (unsigned seed : {1u, 2u, 3u}) {
-    const auto noisy = with_noise(truth, 0.005, 0.25, seed);
+    const auto noisy = localization::with_noise(truth, 0.005, 0.25, seed);
     const std::string label = "noise 5 mm + 0.25 deg per frame, seed " + std::to_string(seed);
     score(("given: " + label).c_str(), noisy, std::nullopt);
     score(("refine, default: " + label).c_str(), noisy, localization::Config{});
     score(("refine, noise configured: " + label).c_str(), noisy, told_noise);
   }
   for (unsigned seed : {1u, 2u, 3u}) {
-    const auto drifted = with_drift(truth, 0.001, 0.05, seed);
+    const auto drifted = localization::with_drift(truth, 0.001, 0.05, seed);
     const std::string label = "drift 1 mm + 0.05 deg/frame, seed " + std::to_string(seed);
     score(("given: " + label).c_str(), drifted, std::nullopt);
     score(("refine, default: " + label).c_str(), drifted, localization::Config{});
@@ -182,7 +156,7 @@ int run_trajectories(const io::Sequence& seq, const std::vector<Pose>& truth) {
     print_errors("refine, the recording's own poses (correction)", e, t);
   }
   for (unsigned seed : {1u, 2u, 3u}) {
-    const auto drifted = with_drift(truth, 0.003, 0.15, seed);
+    const auto drifted = localization::with_drift(truth, 0.003, 0.15, seed);
     std::vector<std::optional<Pose>> given(drifted.begin(), drifted.end());
     Errors before;
     for (std::size_t i = 0; i < truth.size(); ++i) add_error(before, drifted[i], truth[i]);
