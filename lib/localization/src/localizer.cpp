@@ -352,9 +352,14 @@ std::optional<Localization> Localizer::step_from_previous(Attempt& at, const Loc
   // From the last motion, and from standing still: a wrong rotation in the last motion (0.6-0.9
   // degrees a frame on redkitchen_long) can lead the alignment into a false minimum where fewer
   // pixels agree. The one more of the frame agrees with wins.
-  Alignment a = align(*track.previous, current, track.motion, sensor_, config_.alignment);
-  Alignment still = align(*track.previous, current, Pose::Identity(), sensor_, config_.alignment);
-  if (still.inlier_fraction > a.inlier_fraction) a = std::move(still);
+  // The two priors are told apart on the coarsest level, where an alignment costs a fifth of a
+  // full one; only the winner goes on to the finer levels.
+  AlignmentConfig coarse = config_.alignment;
+  std::fill(coarse.iterations.begin() + 1, coarse.iterations.end(), 0);
+  const Alignment moving = align(*track.previous, current, track.motion, sensor_, coarse);
+  const Alignment still = align(*track.previous, current, Pose::Identity(), sensor_, coarse);
+  const Pose& start = still.inlier_fraction > moving.inlier_fraction ? still.T_reference_current : moving.T_reference_current;
+  Alignment a = align(*track.previous, current, start, sensor_, config_.alignment);
   Localization r = out;
   if (!accept(r, a, track.last, "the previous frame")) return std::nullopt;
   return r;
