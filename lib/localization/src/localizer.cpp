@@ -351,9 +351,10 @@ std::optional<Localization> Localizer::step_from_previous(Attempt& at, const Loc
   const RgbdPyramid& current = frame_pyramid(at.current, at.frame, sensor_, config_.pyramid, true);
   // From the last motion, and from standing still: a wrong rotation in the last motion (0.6-0.9
   // degrees a frame on redkitchen_long) can lead the alignment into a false minimum where fewer
-  // pixels agree. The one more of the frame agrees with wins.
-  // The two priors are told apart on the coarsest level, where an alignment costs a fifth of a
-  // full one; only the winner goes on to the finer levels.
+  // pixels agree. The one more of the frame agrees with wins. They are told apart after the
+  // coarsest level alone (about a quarter of a full alignment, with the agreement measured on
+  // the finest), and only the winner goes on through the finer levels: on redkitchen_long the
+  // same trajectory as two full alignments, to 0.01 mm RMSE.
   AlignmentConfig coarse = config_.alignment;
   std::fill(coarse.iterations.begin() + 1, coarse.iterations.end(), 0);
   const Alignment moving = align(*track.previous, current, track.motion, sensor_, coarse);
