@@ -25,6 +25,7 @@ TEST(ObjectTracker, JoinsAfterConfirmFramesAndNoiseNeverJoins) {
   TrackingConfig config;
   config.confirm_frames = 3;
   ObjectTracker tracker(config);
+  tracker.update({}, 0, kOccluded);  // the first frame lists at first sight: this one saw nothing
   tracker.update({seen_at(0, 0), seen_at(0.5, 0.5)}, 1, kOccluded);
   tracker.update({seen_at(0.005, 0)}, 2, kOccluded);  // the noise cluster at (0.5, 0.5) is gone
   EXPECT_TRUE(tracker.objects().empty()) << "two sightings are not enough";
@@ -36,12 +37,36 @@ TEST(ObjectTracker, JoinsAfterConfirmFramesAndNoiseNeverJoins) {
   EXPECT_EQ(tracker.tentative(), 0u) << "and was forgotten";
 }
 
+// A single cloud sent once lists its objects; in a stream, a cluster seen in one frame is not an
+// object (a fragment, a piece of an arm, noise) until it is seen again.
+TEST(ObjectTracker, TheFirstFrameListsAtFirstSightLaterFramesNeedConfirming) {
+  ObjectTracker tracker(TrackingConfig{});  // confirm_frames 2
+  tracker.update({seen_at(0, 0)}, 1, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 1u) << "the first frame: listed at first sight";
+  tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, 2, kOccluded);
+  EXPECT_EQ(tracker.objects().size(), 1u) << "a new cluster in the second frame waits";
+  tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, 3, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 2u) << "seen twice: listed";
+  tracker.update({seen_at(0, 0), seen_at(0.3, 0), seen_at(0.6, 0)}, 4, kOccluded);  // a fragment, once
+  for (int i = 5; i < 8; ++i) tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, i, kOccluded);
+  EXPECT_EQ(tracker.objects().size(), 2u) << "the fragment seen once never joined";
+  EXPECT_EQ(tracker.tentative(), 0u) << "and was forgotten";
+  tracker.reset();
+  tracker.update({seen_at(0.6, 0)}, 8, kOccluded);
+  EXPECT_EQ(tracker.objects().size(), 1u) << "after a reset the first frame lists again";
+  const auto saved = tracker.objects();
+  ObjectTracker restored(TrackingConfig{});
+  restored.restore(saved, {}, tracker.next_id());
+  restored.update({seen_at(0.6, 0), seen_at(0, 0)}, 9, kOccluded);
+  EXPECT_EQ(restored.objects().size(), 1u) << "a restored list goes on: the new cluster waits";
+}
+
 TEST(ObjectTracker, LeavesOnlyWhenItsSpaceIsSeenFreeInGoneFrames) {
   TrackingConfig config;
   config.gone_frames = 2;
   ObjectTracker tracker(config);
   tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, 1, kOccluded);
-  ASSERT_EQ(tracker.objects().size(), 2u) << "confirm_frames 1: listed at first sight";
+  ASSERT_EQ(tracker.objects().size(), 2u) << "the first frame: listed at first sight";
   for (int i = 2; i < 10; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded);
   EXPECT_EQ(tracker.objects().size(), 2u) << "unseen but occluded: it keeps its place";
   tracker.update({seen_at(0.3, 0)}, 10, kSeenFree);
@@ -61,6 +86,7 @@ TEST(ObjectTracker, FarClustersAreNotObjectsAndIdsSurviveARestore) {
   ASSERT_EQ(restored.objects().size(), 1u);
   EXPECT_EQ(restored.objects()[0].id, saved[0].id);
   restored.update({seen_at(0, 0), seen_at(0.4, 0)}, 2, kOccluded);
+  restored.update({seen_at(0, 0), seen_at(0.4, 0)}, 3, kOccluded);  // the new one confirmed
   ASSERT_EQ(restored.objects().size(), 2u);
   EXPECT_EQ(restored.objects()[0].id, saved[0].id) << "matched, same id";
   EXPECT_GT(restored.objects()[1].id, saved[0].id) << "a new id, never one given before";
@@ -95,14 +121,15 @@ TEST(ObjectTracker, SeenInPlaceWithoutAClusterLeavesAfterHalfItsSightings) {
   const ObjectTracker::SeenFraction hidden = [](const std::vector<Eigen::Vector3d>&) { return 0.0; };
   ObjectTracker tracker(config);
   for (int i = 0; i < 10; ++i) tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, i, kOccluded, seen);
-  tracker.update({seen_at(0.3, 0), seen_at(0.6, 0)}, 10, kOccluded, seen);  // a fragment at 0.6, once
+  tracker.update({seen_at(0.3, 0), seen_at(0.6, 0)}, 10, kOccluded, seen);  // a fragment at 0.6, twice
+  tracker.update({seen_at(0.3, 0), seen_at(0.6, 0)}, 11, kOccluded, hidden);
   ASSERT_EQ(tracker.objects().size(), 3u);
-  for (int i = 11; i < 30; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded, hidden);
+  for (int i = 12; i < 30; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded, hidden);
   EXPECT_EQ(tracker.objects().size(), 3u) << "hidden: nothing leaves";
   tracker.update({seen_at(0.3, 0)}, 30, kOccluded, seen);
   EXPECT_EQ(tracker.objects().size(), 3u) << "one frame is not enough";
   tracker.update({seen_at(0.3, 0)}, 31, kOccluded, seen);
-  ASSERT_EQ(tracker.objects().size(), 2u) << "the fragment seen once leaves after gone_frames";
+  ASSERT_EQ(tracker.objects().size(), 2u) << "the fragment seen twice leaves after gone_frames";
   for (int i = 32; i < 34; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded, seen);
   EXPECT_EQ(tracker.objects().size(), 2u) << "the object seen 10 times stays for 5 frames";
   tracker.update({seen_at(0.3, 0)}, 34, kOccluded, seen);
@@ -121,6 +148,7 @@ TEST(ObjectTracker, PiecesOfAPersonStartNoTrack) {
   ASSERT_EQ(tracker.objects().size(), 1u) << "the finger is not listed";
   EXPECT_EQ(tracker.objects()[0].observations, 2) << "the object in reach keeps its track";
   tracker.update({seen_at(0.4, 0)}, 3, kOccluded);
+  tracker.update({seen_at(0.4, 0)}, 4, kOccluded);
   EXPECT_EQ(tracker.objects().size(), 2u) << "seen apart from the hand, it is listed";
 }
 

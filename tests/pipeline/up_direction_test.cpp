@@ -17,7 +17,8 @@ namespace {
 
 // Also the object list: what stands on the wall (the relief of a whiteboard, posters) is not an
 // object. Two objects stand on the table (a bin and a toy). The most listed in any frame from the
-// fifth on, measured: pick_toy_1 7, pick_toy_2 10 (at the end 18 and 25-26 before strips narrower
+// fifth on, measured: pick_toy_1 6, pick_toy_2 8 (7 and 10 while a cluster seen in one frame was
+// listed, tracking.confirm_frames 1; at the end 18 and 25-26 before strips narrower
 // than the sensor resolves, pieces seen in place without a cluster of their own and pieces of
 // hands were dropped; 41 and 60 when the wall's pieces were listed). What remains: two pieces of
 // the chair beside the table, inside the table's hull (bands of the wall and the chair's back at
@@ -68,12 +69,12 @@ void expect_table_up_on_every_frame(const std::string& name, std::size_t max_obj
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy1AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_1");
-  expect_table_up_on_every_frame("pick_toy_1", 7);
+  expect_table_up_on_every_frame("pick_toy_1", 6);
 }
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy2AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_2");
-  expect_table_up_on_every_frame("pick_toy_2", 10);
+  expect_table_up_on_every_frame("pick_toy_2", 8);
 }
 
 }  // namespace

@@ -33,6 +33,9 @@ std::vector<int> match(const std::vector<TrackerObservation>& obs, const std::ve
 
 void ObjectTracker::update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction,
                            const SeenFraction& seen_fraction) {
+  ++frames_;
+  // The first frame lists what it sees (a single cloud sent once); later ones need confirming.
+  const int confirm = frames_ == 1 ? 1 : config_.confirm_frames;
   for (auto& o : observations) o.cluster.indices.clear();  // indices belong to this frame only
   // What each observation stands on, by the centroid of the supporting observation (the indices
   // of supported_by are this frame's and do not survive matching).
@@ -111,7 +114,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     Track& t = tentative_[i];
     const bool seen_now = n_confirmed + i < hit.size() ? hit[n_confirmed + i] != 0 : true;  // new ones are seen now
     if (!seen_now) ++t.misses;
-    if (t.object.observations >= config_.confirm_frames) {
+    if (t.object.observations >= confirm) {
       t.object.id = next_id_++;
       t.misses = 0;
       kept.push_back(std::move(t));
@@ -160,6 +163,7 @@ void ObjectTracker::restore(std::vector<TrackedObject> objects, std::map<std::ui
     tracks_.push_back(std::move(t));
   }
   next_id_ = next_id;
+  frames_ = 1;  // a restored list goes on: the next frame's new clusters need confirming
   for (const auto& t : tracks_) objects_.push_back(t.object);
 }
 
@@ -173,6 +177,7 @@ void ObjectTracker::reset() {
   tracks_.clear();
   tentative_.clear();
   objects_.clear();
+  frames_ = 0;
 }
 
 }  // namespace scenewatch::pipeline

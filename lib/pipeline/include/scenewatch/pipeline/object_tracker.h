@@ -1,8 +1,10 @@
 #pragma once
 /// The object list of the working memory: clusters of each frame matched to remembered objects,
 /// with hysteresis both ways. A listed object must be an object, by evidence noise cannot give:
-///  - it was seen in `confirm_frames` frames (1 by default: a single cloud sent once lists its
-///    objects; more keep a noise cluster that comes and goes out of the list);
+///  - it was seen in `confirm_frames` frames (2 by default: a fragment, a piece of an arm or a
+///    noise cluster seen in one frame of a stream is not listed), except in the first frame the
+///    tracker gets (after a start or a reset), whose objects are listed at first sight: a single
+///    cloud sent once lists its objects;
 ///  - it is as wide as the sensor can resolve at its range: both horizontal extents span at least
 ///    `min_extent_cells` cells of max(segmentation voxel, 2 sigma_z(range)) (a strip one voxel
 ///    wide along a rim or an edge is a fragment: its width was never measured, only quantized);
@@ -32,7 +34,9 @@ struct TrackingConfig {
   /// An unmatched object's frame counts as "seen free" when this share of its sample points lies
   /// in space the frame saw through (or that the map holds free).
   double gone_free_fraction = 0.6;
-  int confirm_frames = 1;    ///< sightings before a cluster joins the object list (1: at first sight)
+  /// Sightings before a cluster joins the object list (1: at first sight); the first frame's
+  /// clusters join at first sight whatever this is.
+  int confirm_frames = 2;
   /// Cells of the resolution (see above) each horizontal extent must span; 0: no size check.
   double min_extent_cells = 2.0;
   int gone_frames = 2;       ///< frames of seen-free space before an object leaves the list
@@ -109,6 +113,7 @@ class ObjectTracker {
   std::vector<Track> tentative_;       ///< seen, not yet confirmed
   std::vector<TrackedObject> objects_;  ///< the confirmed objects, as published
   std::uint64_t next_id_ = 1;
+  std::uint64_t frames_ = 0;  ///< frames since the start, a reset or a restore (which counts as one)
 };
 
 }  // namespace scenewatch::pipeline
