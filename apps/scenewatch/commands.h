@@ -71,10 +71,13 @@ int run_classes(const RemoteOptions& options);
 int run_define_class(const RemoteOptions& options, const std::string& yaml_file);
 int run_events(const RemoteOptions& options, std::uint64_t since, std::uint32_t max_count);
 int run_watch(const RemoteOptions& options);
+/// The changes seen but not yet confirmed (GetPendingChanges).
+int run_pending(const RemoteOptions& options);
 
-/// Where to look next (NextBestView): exactly one target of object, event, box or workspace.
+/// Where to look next (NextBestView): exactly one target of object, event, pending change, box or
+/// workspace.
 struct NextViewOptions {
-  std::optional<std::uint64_t> object_id, event_id;
+  std::optional<std::uint64_t> object_id, event_id, pending_id;
   std::vector<double> box;  ///< MINX MINY MINZ MAXX MAXY MAXZ, or empty
   bool workspace = false;
   std::string measure;      ///< empty: the daemon's default for the target

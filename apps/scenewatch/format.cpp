@@ -112,7 +112,19 @@ nlohmann::json to_json(const proto::Event& event) {
     j["indices_before"] = std::vector<int>(event.indices_before().begin(), event.indices_before().end());
   if (event.indices_after_size() > 0)
     j["indices_after"] = std::vector<int>(event.indices_after().begin(), event.indices_after().end());
+  if (event.pending_ids_size() > 0)
+    j["pending_ids"] = std::vector<std::uint64_t>(event.pending_ids().begin(), event.pending_ids().end());
   return j;
+}
+
+nlohmann::json to_json(const proto::PendingChange& change) {
+  return {{"id", change.id()},
+          {"kind", proto::PendingChange::Kind_Name(change.kind())},
+          {"box_world", to_json(change.box_world())},
+          {"centroid_world", to_json(change.centroid_world())},
+          {"hits", change.hits()},
+          {"hits_needed", change.hits_needed()},
+          {"camera", change.camera()}};
 }
 
 nlohmann::json to_json(const proto::HealthReply& health) {
@@ -268,6 +280,15 @@ std::string text(const proto::Event& event) {
   if (event.has_object_id()) os << " object " << event.object_id();
   os << " at " << text(event.centroid_world()) << ", t " << fixed(event.stamp_s(), 2) << " s";
   if (!event.detail().empty()) os << ": " << event.detail();
+  return os.str();
+}
+
+std::string text(const proto::PendingChange& change) {
+  std::ostringstream os;
+  os << "  pending " << change.id() << " " << proto::PendingChange::Kind_Name(change.kind()) << " at "
+     << text(change.centroid_world()) << ", box " << text(change.box_world().min()) << " .. " << text(change.box_world().max())
+     << ", seen in " << change.hits() << " of " << change.hits_needed() << " frames, camera "
+     << (change.camera().empty() ? "(default)" : "'" + change.camera() + "'");
   return os.str();
 }
 

@@ -18,6 +18,7 @@ nlohmann::json to_json(const proto::Plane& plane);
 nlohmann::json to_json(const proto::Cluster& cluster);
 nlohmann::json to_json(const proto::Object& object);
 nlohmann::json to_json(const proto::Event& event);
+nlohmann::json to_json(const proto::PendingChange& change);
 nlohmann::json to_json(const proto::HealthReply& health);
 nlohmann::json to_json(const proto::StatsReply& stats);
 nlohmann::json to_json(const proto::LocalizationResult& localization);
@@ -34,6 +35,7 @@ std::string text(const proto::Plane& plane);
 std::string text(const proto::Object& object);
 std::string text(const proto::Cluster& cluster);
 std::string text(const proto::Event& event);
+std::string text(const proto::PendingChange& change);
 /// A camera's localization (GetLocalization), a few lines.
 std::string text(const proto::LocalizationResult& localization);
 

@@ -24,6 +24,7 @@ int main(int argc, char** argv) {
   add_class_commands(app, remote, action);   // classes, define-class
   add_model_commands(app, remote, action);   // reset, save, load
   add_event_commands(app, remote, action);   // events, watch
+  add_pending_command(app, remote, action);
   add_next_view_command(app, remote, action);
   add_segment_command(app, action);
   add_fit_command(app, action);

@@ -25,15 +25,8 @@ int run_events(const RemoteOptions& options, std::uint64_t since, std::uint32_t 
   request.mutable_get_events()->set_since(since);
   request.mutable_get_events()->set_max_count(max_count);
   return simple_call(options, request, [&](const proto::Response& r) {
-    if (options.json) {
-      json list = json::array();
-      for (const auto& e : r.events().events()) list.push_back(to_json(e));
-      return print_json({{"events", std::move(list)}});
-    }
-    std::cout << plural(r.events().events_size(), "event") << (since > 0 ? " after " + std::to_string(since) : "")
-              << "\n";
-    for (const auto& e : r.events().events()) std::cout << text(e) << "\n";
-    std::cout << std::flush;
+    print_list(options.json, json::object(), "events", r.events().events(),
+               plural(r.events().events_size(), "event") + (since > 0 ? " after " + std::to_string(since) : ""));
   });
 }
 

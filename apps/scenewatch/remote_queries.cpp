@@ -62,17 +62,10 @@ int run_planes(const RemoteOptions& options) {
   request.mutable_get_planes();
   return simple_call(options, request, [&](const proto::Response& r) {
     const auto& planes = r.planes();
-    if (options.json) {
-      json list = json::array();
-      for (const auto& p : planes.planes()) list.push_back(to_json(p));
-      return print_json({{"frames_processed", planes.frames_processed()},
-                         {"last_stamp_s", planes.last_stamp_s()},
-                         {"planes", std::move(list)}});
-    }
-    std::cout << plural(planes.planes_size(), "plane") << " in the last frame (" << planes.frames_processed()
-              << " processed)\n";
-    for (const auto& p : planes.planes()) std::cout << text(p) << "\n";
-    std::cout << std::flush;
+    print_list(options.json, {{"frames_processed", planes.frames_processed()}, {"last_stamp_s", planes.last_stamp_s()}},
+               "planes", planes.planes(),
+               plural(planes.planes_size(), "plane") + " in the last frame (" + std::to_string(planes.frames_processed()) +
+                   " processed)");
   });
 }
 
@@ -81,14 +74,8 @@ int run_objects(const RemoteOptions& options, bool describe) {
   request.mutable_get_objects()->set_describe(describe);
   return simple_call(options, request, [&](const proto::Response& r) {
     const auto& objects = r.objects();
-    if (options.json) {
-      json list = json::array();
-      for (const auto& o : objects.objects()) list.push_back(to_json(o));
-      return print_json({{"frames_processed", objects.frames_processed()}, {"objects", std::move(list)}});
-    }
-    std::cout << plural(objects.objects_size(), "tracked object") << "\n";
-    for (const auto& o : objects.objects()) std::cout << text(o) << "\n";
-    std::cout << std::flush;
+    print_list(options.json, {{"frames_processed", objects.frames_processed()}}, "objects", objects.objects(),
+               plural(objects.objects_size(), "tracked object"));
   });
 }
 

@@ -44,6 +44,8 @@ void add_class_commands(CLI::App& app, RemoteOptions& remote, Action& action);
 void add_model_commands(CLI::App& app, RemoteOptions& remote, Action& action);
 /// events, watch (remote_events.cpp).
 void add_event_commands(CLI::App& app, RemoteOptions& remote, Action& action);
+/// pending (remote_pending.cpp).
+void add_pending_command(CLI::App& app, RemoteOptions& remote, Action& action);
 /// next-view (remote_next_view.cpp).
 void add_next_view_command(CLI::App& app, RemoteOptions& remote, Action& action);
 /// segment (segment_command.cpp).

@@ -220,6 +220,70 @@ TEST(Change, PersistenceNeedsConsistentFrames) {
   }
 }
 
+// Issue 31: the unconfirmed candidates are listed with ids a planner can target.
+TEST(Change, PendingCandidatesKeepTheirIdsUntilConfirmed) {
+  Config config;
+  config.persistence_frames = 3;
+  auto ids = std::make_shared<PendingIds>();
+  PersistenceFilter filter(config, ids);
+  const Eigen::Vector3d p(0.1, 0.2, 0.8), q(-0.3, 0.1, 0.8);
+  EXPECT_TRUE(filter.pending().empty());
+  filter.update({cluster_at(ChangeKind::kAdded, p)}, nullptr, nullptr, /*camera=*/2);
+  auto listed = filter.pending();
+  ASSERT_EQ(listed.size(), 1u);
+  const std::uint64_t added_id = listed[0].id;
+  EXPECT_EQ(added_id, 1u) << "ids count from 1";
+  EXPECT_EQ(listed[0].kind, PendingKind::kAdded);
+  EXPECT_EQ(listed[0].hits, 1);
+  EXPECT_EQ(listed[0].hits_needed, 3);
+  EXPECT_EQ(listed[0].camera, 2u);
+  EXPECT_TRUE(listed[0].centroid_world.isApprox(p));
+  EXPECT_TRUE(listed[0].box_world.contains(p));
+
+  // Matched 1 cm away: the same id, its latest box; a removal elsewhere is a new candidate (five
+  // times larger, so that it is no move partner the addition would wait for).
+  const Eigen::Vector3d p2 = p + Eigen::Vector3d(0.01, 0, 0);
+  filter.update({cluster_at(ChangeKind::kAdded, p2), cluster_at(ChangeKind::kRemoved, q, 0.4)}, nullptr, nullptr, 2);
+  listed = filter.pending();
+  ASSERT_EQ(listed.size(), 2u);
+  EXPECT_EQ(listed[0].id, added_id);
+  EXPECT_EQ(listed[0].hits, 2);
+  EXPECT_TRUE(listed[0].centroid_world.isApprox(p2));
+  const std::uint64_t removed_id = listed[1].id;
+  EXPECT_EQ(removed_id, 2u);
+  EXPECT_EQ(listed[1].kind, PendingKind::kRemoved);
+  EXPECT_EQ(listed[1].hits, 1);
+
+  // The third sighting confirms the addition: the change names the candidate, the list drops it.
+  auto fired = filter.update({cluster_at(ChangeKind::kAdded, p)}, nullptr, nullptr, 2);
+  ASSERT_EQ(fired.size(), 1u);
+  EXPECT_EQ(fired[0].kind, EventKind::kObjectAdded);
+  EXPECT_EQ(fired[0].pending_ids, std::vector<std::uint64_t>{added_id});
+  EXPECT_EQ(to_event(fired[0]).pending_ids, std::vector<std::uint64_t>{added_id});
+  listed = filter.pending();
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_EQ(listed[0].id, removed_id);
+
+  // The removal, not seen again, is dropped after persistence_frames misses: the list empties.
+  filter.update({}, nullptr, nullptr, 2);
+  filter.update({}, nullptr, nullptr, 2);
+  EXPECT_TRUE(filter.pending().empty());
+
+  // A new candidate where the first one was gets a new id, never one given before; the ids are
+  // shared with every filter that holds the same counter (one id names one change).
+  filter.update({cluster_at(ChangeKind::kAdded, p + Eigen::Vector3d(0, 0.3, 0))}, nullptr, nullptr, 2);
+  ASSERT_EQ(filter.pending().size(), 1u);
+  EXPECT_EQ(filter.pending()[0].id, 3u);
+  PersistenceFilter other(config, ids);
+  other.update({cluster_at(ChangeKind::kAdded, p)}, nullptr);
+  ASSERT_EQ(other.pending().size(), 1u);
+  EXPECT_EQ(other.pending()[0].id, 4u);
+  filter.reset();
+  EXPECT_TRUE(filter.pending().empty());
+  filter.update({cluster_at(ChangeKind::kAdded, p)}, nullptr);
+  EXPECT_EQ(filter.pending()[0].id, 5u) << "a reset does not restart the ids";
+}
+
 TEST(Change, PersistencePairsAMoveConfirmedAFrameApart) {
   Config config;
   config.persistence_frames = 2;
@@ -234,6 +298,8 @@ TEST(Change, PersistencePairsAMoveConfirmedAFrameApart) {
   const Event e = to_event(fired[0]);
   ASSERT_TRUE(e.displacement_world.has_value());
   EXPECT_NEAR(e.displacement_world->x(), 0.3, 1e-9);
+  EXPECT_EQ(e.pending_ids, (std::vector<std::uint64_t>{1, 2})) << "both halves: the removal, then the addition";
+  EXPECT_TRUE(filter.pending().empty());
 }
 
 }  // namespace

@@ -191,6 +191,40 @@ TEST(EventFusion, AnAppearanceChangeMustPersistInAFamiliarView) {
   EXPECT_EQ(told[0].evidence.at("frames_seen"), 5.0);
 }
 
+// Issue 31: appearance candidates are pending changes too, in the id space they share with the
+// geometric ones; the event that tells a candidate names its id.
+TEST(EventFusion, AppearanceCandidatesAreListedUntilTold) {
+  auto ids = std::make_shared<change::PendingIds>();
+  EXPECT_EQ(ids->next(), 1u) << "say the persistence filter took 1";
+  EventFusion fusion({}, ids);
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_TRUE(fusion.update({region_at(0.5 + 0.005 * i, 0.5)}, {}, {}, {}, true, {}, {}, /*camera=*/3).empty());
+    const auto listed = fusion.pending();
+    ASSERT_EQ(listed.size(), 1u);
+    EXPECT_EQ(listed[0].id, 2u) << "the same id while it is matched";
+    EXPECT_EQ(listed[0].kind, change::PendingKind::kAppearance);
+    EXPECT_EQ(listed[0].hits, i + 1);
+    EXPECT_EQ(listed[0].hits_needed, 5);
+    EXPECT_EQ(listed[0].camera, 3u);
+    EXPECT_NEAR(listed[0].centroid_world.x(), 0.5 + 0.005 * i, 1e-12);
+  }
+  auto told = fusion.update({region_at(0.52, 0.5)}, {}, {}, {}, true, {}, {}, 3);
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_EQ(told[0].pending_ids, std::vector<std::uint64_t>{2});
+  EXPECT_TRUE(fusion.pending().empty());
+
+  // A candidate where a geometric change is then confirmed is that change: its id goes with it.
+  fusion.update({region_at(-0.3, 0.0)}, {}, {}, {}, true, {}, {}, 3);
+  ASSERT_EQ(fusion.pending().size(), 1u);
+  EXPECT_EQ(fusion.pending()[0].id, 3u);
+  Event added = geometric_at(EventKind::kObjectAdded, -0.3, 0.0);
+  added.pending_ids = {1};
+  told = fusion.update({}, {}, {added}, {added.box_world}, true, {}, {}, 3);
+  ASSERT_EQ(told.size(), 1u);
+  EXPECT_EQ(told[0].pending_ids, (std::vector<std::uint64_t>{1, 3}));
+  EXPECT_TRUE(fusion.pending().empty());
+}
+
 TEST(EventFusion, SurpriseWhereGeometryChangesIsItsEvidence) {
   EventFusion fusion;
   change::ChangeCluster pending;

@@ -94,7 +94,7 @@ TEST_F(CliTest, SegmentPrintsPlanesAndObjectsWithIndices) {
 TEST_F(CliTest, HelpAndUsageErrors) {
   EXPECT_EQ(cli({"--help"}).exit_code, 0);
   for (const char* command : {"health", "stats", "localization", "ingest", "planes", "objects", "occupancy", "clear-box", "reset",
-                              "save", "load", "events", "watch", "segment", "fit"}) {
+                              "save", "load", "events", "watch", "pending", "next-view", "segment", "fit"}) {
     const auto result = cli({command, "--help"});
     EXPECT_EQ(result.exit_code, 0) << command;
     EXPECT_NE(result.out.find("--json"), std::string::npos) << command << ":\n" << result.out;

@@ -2,7 +2,9 @@
 // next-view` against it: the simulator's cup_added seen by a hand-held camera from one side.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -10,6 +12,7 @@
 #include "scenewatch.pb.h"
 #include "scenewatch/service/frame_parser.h"
 #include "scenewatch/sim/scenario_yaml.h"
+#include "scenewatch/sim/shapes.h"
 #include "scenewatch/sim/simulator.h"
 
 namespace scenewatch::test {
@@ -29,6 +32,31 @@ void set_pose(const Pose& T, proto::Pose* out) {
     for (int c = 0; c < 4; ++c) out->add_matrix(T.matrix()(r, c));
 }
 
+Aabb box_of(const proto::Box& b) {
+  return {Eigen::Vector3d(b.min().x(), b.min().y(), b.min().z()), Eigen::Vector3d(b.max().x(), b.max().y(), b.max().z())};
+}
+
+// The world box of a placed simulator object: its local bounding box's corners moved.
+Aabb world_box(const sim::PlacedObject& placed) {
+  Eigen::Vector3d lo, hi;
+  sim::bounding_box(placed.object.shape, &lo, &hi);
+  Aabb out{Eigen::Vector3d::Constant(1e9), Eigen::Vector3d::Constant(-1e9)};
+  for (int k = 0; k < 8; ++k) {
+    const Eigen::Vector3d corner((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z());
+    const Eigen::Vector3d w = placed.T_world_object * corner;
+    out = out.united({w, w});
+  }
+  return out;
+}
+
+// The overlap of two boxes over the smaller one's volume (0 when apart).
+double overlap_of_smaller(const Aabb& a, const Aabb& b) {
+  const Eigen::Vector3d lo = a.min.cwiseMax(b.min), hi = a.max.cwiseMin(b.max);
+  if ((hi.array() <= lo.array()).any()) return 0.0;
+  const double va = (a.max - a.min).prod(), vb = (b.max - b.min).prod();
+  return (hi - lo).prod() / std::min(va, vb);
+}
+
 class NextViewTest : public ::testing::Test {
  protected:
   void TearDown() override {
@@ -37,37 +65,47 @@ class NextViewTest : public ::testing::Test {
     std::error_code ec;
     fs::remove_all(tmp_, ec);
   }
+  // cup_added at 320x240, 12 frames a phase, and the daemon (z up) its frames go to.
+  void start_cup_added() {
+    auto loaded = sim::load_scenario(source_dir() / "sample_clouds/scenarios/cup_added.yaml");
+    ASSERT_TRUE(loaded.ok()) << loaded.error().message;
+    scenario_ = sim::with_frames(sim::with_resolution(*loaded, 320, 240), 12);
+    auto simulator = sim::Simulator::create(scenario_);
+    ASSERT_TRUE(simulator.ok()) << simulator.error().message;
+    simulator_.emplace(std::move(*simulator));
+    ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "  model_dir: " + (tmp_ / "model").string() +
+                                                    "\nsegmentation:\n  up_vector: [0, 0, 1]\n"));
+  }
+  // Renders frame f of a phase and ingests it, 30 frames a second; keeps the pose it reported.
+  void ingest(Client& client, std::size_t phase, int f) {
+    const sim::SimFrame rendered = simulator_->render(phase, f);
+    last_camera_ = rendered.truth.T_world_camera_reported;
+    auto frame = sim::as_frame(rendered, scenario_.intrinsics, stamp_ += 1.0 / 30);
+    ASSERT_TRUE(frame.ok());
+    proto::Request r;
+    *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
+    ASSERT_EQ(call(client, r).status().code(), proto::Status::OK);
+  }
+
   fs::path tmp_ = make_temp_dir("next_view");
   Daemon daemon_;
+  sim::Scenario scenario_;
+  std::optional<sim::Simulator> simulator_;
+  double stamp_ = 0;
+  Pose last_camera_ = Pose::Identity();
 };
 
 TEST_F(NextViewTest, ObjectsAndEventsGetViewsOfWhatIsUnseen) {
-  auto loaded = sim::load_scenario(source_dir() / "sample_clouds/scenarios/cup_added.yaml");
-  ASSERT_TRUE(loaded.ok()) << loaded.error().message;
-  const sim::Scenario scenario = sim::with_frames(sim::with_resolution(*loaded, 320, 240), 12);
-  auto simulator = sim::Simulator::create(scenario);
-  ASSERT_TRUE(simulator.ok()) << simulator.error().message;
-  ASSERT_NO_FATAL_FAILURE(daemon_.start(tmp_, "  model_dir: " + (tmp_ / "model").string() +
-                                                  "\nsegmentation:\n  up_vector: [0, 0, 1]\n"));
+  ASSERT_NO_FATAL_FAILURE(start_cup_added());
   Client client = daemon_.connect();
-  double stamp = 0;
-  Pose last_camera = Pose::Identity();
-  for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
-    for (int f = 0; f < simulator->frame_count(phase); ++f) {
-      const sim::SimFrame rendered = simulator->render(phase, f);
-      last_camera = rendered.truth.T_world_camera_reported;
-      auto frame = sim::as_frame(rendered, scenario.intrinsics, stamp += 1.0 / 30);
-      ASSERT_TRUE(frame.ok());
-      proto::Request r;
-      *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
-      ASSERT_EQ(call(client, r).status().code(), proto::Status::OK);
-    }
+  for (std::size_t phase = 0; phase < simulator_->phase_count(); ++phase) {
+    for (int f = 0; f < simulator_->frame_count(phase); ++f) ASSERT_NO_FATAL_FAILURE(ingest(client, phase, f));
   }
 
   // The blue box (id 1 of the scenario, at x 0.15 y 0.12): the tracked object nearest it.
   const auto objects = call(client, request([](proto::Request& r) { r.mutable_get_objects(); }));
   ASSERT_GT(objects.objects().objects_size(), 0);
-  const Eigen::Vector3d box_truth = scenario.objects[0].T_world_object.translation();
+  const Eigen::Vector3d box_truth = scenario_.objects[0].T_world_object.translation();
   const proto::Object* box = nullptr;
   for (const auto& o : objects.objects().objects()) {
     const Eigen::Vector2d c(o.centroid().x(), o.centroid().y());
@@ -122,15 +160,15 @@ TEST_F(NextViewTest, ObjectsAndEventsGetViewsOfWhatIsUnseen) {
   EXPECT_NE(seed_box.status().message().find("object_id"), std::string::npos) << seed_box.status().message();
 
   // A list of two reachable poses: where the camera was, and its mirror image through the box.
-  Pose mirrored = last_camera;
-  mirrored.translation() = 2.0 * centre - last_camera.translation();
-  mirrored.translation().z() = last_camera.translation().z();
-  mirrored.linear() = (Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()) * last_camera.linear()).matrix();
+  Pose mirrored = last_camera_;
+  mirrored.translation() = 2.0 * centre - last_camera_.translation();
+  mirrored.translation().z() = last_camera_.translation().z();
+  mirrored.linear() = (Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitZ()) * last_camera_.linear()).matrix();
   auto listed = call(client, request([&](proto::Request& r) {
     auto* q = r.mutable_next_best_view();
     q->set_object_id(box->id());
     q->set_constraint(proto::NextBestView::CONSTRAINT_LIST);
-    set_pose(last_camera, q->add_poses());
+    set_pose(last_camera_, q->add_poses());
     set_pose(mirrored, q->add_poses());
   }));
   ASSERT_EQ(listed.status().code(), proto::Status::OK) << listed.status().message();
@@ -187,6 +225,132 @@ TEST_F(NextViewTest, ObjectsAndEventsGetViewsOfWhatIsUnseen) {
   EXPECT_EQ(js.at("views")[0].at("pose").size(), 16u);
   auto usage = run_command({cli_binary().string(), "next-view", "--port", std::to_string(daemon_.port())}, tmp_);
   EXPECT_EQ(usage.exit_code, 2) << usage.err;
+}
+
+// Issue 31, "Attention": a change the detector has seen but not yet confirmed is a target too,
+// listed with its id (GetPendingChanges) from the cup's first sighting until its event.
+TEST_F(NextViewTest, APendingChangeIsATargetUntilItIsConfirmed) {
+  ASSERT_NO_FATAL_FAILURE(start_cup_added());
+  const auto changes = simulator_->changes();
+  ASSERT_EQ(changes.size(), 1u);
+  ASSERT_EQ(changes[0].added.size(), 1u);
+  const Aabb cup = world_box(changes[0].added[0]);
+  Client client = daemon_.connect();
+  auto pending_now = [&] { return call(client, request([](proto::Request& r) { r.mutable_get_pending_changes(); })); };
+  auto nbv_of = [&](std::uint64_t id) {
+    return call(client, request([&](proto::Request& r) { r.mutable_next_best_view()->set_pending_id(id); }));
+  };
+  for (int f = 0; f < simulator_->frame_count(0); ++f) ASSERT_NO_FATAL_FAILURE(ingest(client, 0, f));
+
+  // The cup's phase, frame by frame, until a pending addition lies on the cup.
+  std::optional<proto::PendingChange> at_cup;
+  int first_seen = -1, f = 0;
+  for (; f < simulator_->frame_count(1) && !at_cup; ++f) {
+    ASSERT_NO_FATAL_FAILURE(ingest(client, 1, f));
+    const auto listed = pending_now();
+    ASSERT_EQ(listed.status().code(), proto::Status::OK) << listed.status().message();
+    for (const auto& c : listed.pending_changes().changes()) {
+      if (c.kind() == proto::PendingChange::ADDED && overlap_of_smaller(box_of(c.box_world()), cup) > 0.5) at_cup = c;
+    }
+    first_seen = f;
+  }
+  ASSERT_TRUE(at_cup.has_value()) << "no pending addition on the cup in " << f << " frames";
+  const Aabb pending_box = box_of(at_cup->box_world());
+  std::printf("pending %llu at the cup after frame %d: hits %u of %u, camera '%s', overlap %.2f of the smaller box\n",
+              static_cast<unsigned long long>(at_cup->id()), first_seen, at_cup->hits(), at_cup->hits_needed(),
+              at_cup->camera().c_str(), overlap_of_smaller(pending_box, cup));
+  EXPECT_EQ(first_seen, 0) << "the cup's first frame shows it";
+  EXPECT_GT(overlap_of_smaller(pending_box, cup), 0.85) << "measured 0.92";
+  EXPECT_EQ(at_cup->hits(), 1u);
+  EXPECT_EQ(at_cup->hits_needed(), 3u) << "change.persistence_frames";
+  EXPECT_TRUE(at_cup->camera().empty()) << "the frames named no camera";
+  EXPECT_TRUE(pending_box.contains(Eigen::Vector3d(at_cup->centroid_world().x(), at_cup->centroid_world().y(),
+                                                   at_cup->centroid_world().z())));
+
+  // The views that best confirm or dismiss it: its box grown as an event's, measure visible.
+  auto confirm = nbv_of(at_cup->id());
+  ASSERT_EQ(confirm.status().code(), proto::Status::OK) << confirm.status().message();
+  const auto& reply = confirm.next_best_view();
+  EXPECT_EQ(reply.measure(), "visible");
+  ASSERT_EQ(reply.views_size(), 5);
+  const Aabb target = box_of(reply.target());
+  EXPECT_TRUE(target.min.isApprox(pending_box.min - Eigen::Vector3d::Constant(0.04), 1e-9));
+  EXPECT_TRUE(target.max.isApprox(pending_box.max + Eigen::Vector3d::Constant(0.04), 1e-9));
+  // Its voxels are known (free: the cup's points stay out of the map while it is pending), so
+  // `visible` counts the target voxels a view's rays reach: measured 576 of 576.
+  EXPECT_GE(reply.target_voxels(), 500u);
+  EXPECT_GE(reply.views(0).score(), 0.95 * reply.target_voxels());
+  std::printf("views of pending %llu: best score %.1f, coverage %.3f now, %.3f expected, %llu target voxels\n",
+              static_cast<unsigned long long>(at_cup->id()), reply.views(0).score(), reply.coverage(),
+              reply.views(0).expected_coverage(), static_cast<unsigned long long>(reply.target_voxels()));
+
+  // The CLI lists it and plans for it.
+  const std::string port = std::to_string(daemon_.port());
+  auto listed_cli = run_command({cli_binary().string(), "pending", "--json", "--port", port}, tmp_);
+  ASSERT_EQ(listed_cli.exit_code, 0) << listed_cli.err;
+  bool listed_by_cli = false;
+  const json listed_json = json::parse(listed_cli.out);
+  for (const auto& c : listed_json.at("changes")) {
+    listed_by_cli = listed_by_cli || (c.at("id").get<std::uint64_t>() == at_cup->id() && c.at("kind") == "ADDED");
+  }
+  EXPECT_TRUE(listed_by_cli) << listed_cli.out;
+  auto text_cli = run_command({cli_binary().string(), "pending", "--port", port}, tmp_);
+  ASSERT_EQ(text_cli.exit_code, 0) << text_cli.err;
+  EXPECT_NE(text_cli.out.find("pending " + std::to_string(at_cup->id()) + " ADDED"), std::string::npos) << text_cli.out;
+  auto nbv_cli = run_command({cli_binary().string(), "next-view", "--pending", std::to_string(at_cup->id()), "--json", "--port", port},
+                             tmp_);
+  ASSERT_EQ(nbv_cli.exit_code, 0) << nbv_cli.err;
+  EXPECT_EQ(json::parse(nbv_cli.out).at("measure"), "visible");
+
+  // Seen again, it keeps its id and counts its sightings, until the event that confirms it.
+  std::uint32_t hits = at_cup->hits();
+  int gone_after = -1;
+  for (; f < simulator_->frame_count(1) && gone_after < 0; ++f) {
+    ASSERT_NO_FATAL_FAILURE(ingest(client, 1, f));
+    const auto listed = pending_now();
+    const auto& all = listed.pending_changes().changes();
+    const auto it = std::find_if(all.begin(), all.end(), [&](const proto::PendingChange& c) { return c.id() == at_cup->id(); });
+    if (it == all.end()) {
+      gone_after = f;
+      break;
+    }
+    EXPECT_EQ(it->hits(), hits + 1) << "frame " << f;
+    hits = it->hits();
+  }
+  ASSERT_GE(gone_after, 0) << "pending " << at_cup->id() << " was never confirmed";
+  EXPECT_EQ(gone_after, 2) << "confirmed by the cup's third frame";
+  const auto events = call(client, request([](proto::Request& r) { r.mutable_get_events(); }));
+  const proto::Event* confirmed = nullptr;
+  for (const auto& e : events.events().events()) {
+    if (std::find(e.pending_ids().begin(), e.pending_ids().end(), at_cup->id()) != e.pending_ids().end()) confirmed = &e;
+  }
+  ASSERT_NE(confirmed, nullptr) << "no event names pending " << at_cup->id();
+  EXPECT_EQ(confirmed->kind(), proto::Event::OBJECT_ADDED);
+  const double event_overlap = overlap_of_smaller(box_of(confirmed->box_world()), cup);
+  EXPECT_GT(event_overlap, 0.85) << "measured 0.92";
+  auto gone = nbv_of(at_cup->id());
+  EXPECT_EQ(gone.status().code(), proto::Status::NOT_FOUND);
+  const std::string expected = "pending change " + std::to_string(at_cup->id()) + " is no longer pending: it was confirmed as event " +
+                               std::to_string(confirmed->id());
+  EXPECT_NE(gone.status().message().find(expected), std::string::npos) << gone.status().message();
+  std::printf("after frame %d: event %llu (overlap %.2f with the cup): %s\n", gone_after,
+              static_cast<unsigned long long>(confirmed->id()), event_overlap, gone.status().message().c_str());
+
+  // Bad targets get errors that say what is wrong; the daemon goes on answering.
+  auto zero = nbv_of(0);
+  EXPECT_EQ(zero.status().code(), proto::Status::INVALID_ARGUMENT);
+  EXPECT_NE(zero.status().message().find("pending_id: 0"), std::string::npos) << zero.status().message();
+  auto unknown = nbv_of(999999);
+  EXPECT_EQ(unknown.status().code(), proto::Status::NOT_FOUND);
+  EXPECT_NE(unknown.status().message().find("pending change 999999 was never given"), std::string::npos)
+      << unknown.status().message();
+  auto no_target = call(client, request([](proto::Request& r) { r.mutable_next_best_view(); }));
+  EXPECT_NE(no_target.status().message().find("pending_id"), std::string::npos) << no_target.status().message();
+  auto bad_cli = run_command({cli_binary().string(), "next-view", "--pending", "0", "--port", port}, tmp_);
+  EXPECT_EQ(bad_cli.exit_code, 1);
+  EXPECT_NE(bad_cli.err.find("pending_id: 0"), std::string::npos) << bad_cli.err;
+  EXPECT_EQ(call(client, request([](proto::Request& r) { r.mutable_health(); })).status().code(), proto::Status::OK);
+  EXPECT_EQ(pending_now().status().code(), proto::Status::OK);
 }
 
 }  // namespace

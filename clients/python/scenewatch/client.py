@@ -229,24 +229,35 @@ class Client:
             message.box.CopyFrom(_box(*box))
         return self._call("query_occupancy", message, result="occupancy")
 
+    def get_pending_changes(self):
+        """The changes seen but not yet confirmed (not yet events): pb.PendingChangesReply
+        (``.changes``, each with ``id``, ``kind`` pb.PendingChange.ADDED / REMOVED /
+        APPEARANCE_CHANGE, ``box_world``, ``centroid_world``, ``hits`` of ``hits_needed``,
+        ``camera``). An id is a ``next_best_view(pending_id=...)`` target while it is listed."""
+        return self._call("get_pending_changes", pb.GetPendingChanges(), result="pending_changes")
+
     def next_best_view(self, object_id=None, box=None, event_id=None, workspace=False, measure="", n=5,
-                       radius_m=0.0, current_pose=None):
+                       radius_m=0.0, current_pose=None, pending_id=None):
         """Where to look next: give exactly one target (an object id, a box ((min xyz), (max xyz)),
-        an event id, or workspace=True). pb.NextBestViewReply: ``views`` best first, each with
+        an event id, a pending change's id, or workspace=True); a pending change no longer pending
+        raises StatusError NOT_FOUND, naming the event that confirmed it when the daemon's log has
+        it. pb.NextBestViewReply: ``views`` best first, each with
         ``pose.matrix`` (16 numbers, row-major T_world_camera), ``score``, ``expected_coverage``
         and ``why``. ``current_pose`` (16 numbers) adds the cost of moving there. ``measure``
         "covariance" (or "covariance_321", "covariance_322") with an object_id: the seed's planner,
         one view on the sphere of radius_m; the daemon checks the name."""
         message = pb.NextBestView(measure=measure, n=n, radius_m=radius_m)
-        given = [object_id is not None, box is not None, event_id is not None, bool(workspace)]
+        given = [object_id is not None, box is not None, event_id is not None, pending_id is not None, bool(workspace)]
         if sum(given) != 1:
-            raise ValueError("next_best_view: give exactly one of object_id, box, event_id, workspace")
+            raise ValueError("next_best_view: give exactly one of object_id, box, event_id, pending_id, workspace")
         if object_id is not None:
             message.object_id = object_id
         elif box is not None:
             message.box.CopyFrom(_box(*box))
         elif event_id is not None:
             message.event_id = event_id
+        elif pending_id is not None:
+            message.pending_id = pending_id
         else:
             message.workspace = True
         if current_pose is not None:

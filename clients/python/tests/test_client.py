@@ -154,12 +154,22 @@ class ClientTest(unittest.TestCase):
         subscription = listener.subscribe(timeout_s=60)
         self.assertEqual(subscription.last_event_id, 0)
         replied = []
+        pending_at_cup = None  # the cup while it is seen but not yet confirmed
         for phase in ("before", "after"):
             sequence = Sequence(os.path.join(rendered, phase))
             self.assertEqual(len(sequence), 12)
             for i in range(len(sequence)):
                 reply = self.client.ingest_frame(sequence.frame(i, stamp_s=len(replied) / 30.0))
                 replied.append(reply)
+                for c in self.client.get_pending_changes().changes:
+                    near = math.hypot(c.centroid_world.x - cup_xy[0], c.centroid_world.y - cup_xy[1]) < 0.10
+                    if pending_at_cup is None and c.kind == pb.PendingChange.ADDED and near:
+                        pending_at_cup = c
+                        views = self.client.next_best_view(pending_id=c.id)
+                        self.assertEqual(views.measure, "visible")
+                        self.assertGreater(views.views[0].score, 0)
+        self.assertIsNotNone(pending_at_cup, "the cup was pending before it was confirmed")
+        self.assertEqual(pending_at_cup.hits_needed, 3)
         events = [e for r in replied for e in r.events]
         self.assertEqual([pb.Event.Kind.Name(e.kind) for e in events], ["OBJECT_ADDED"])
         self.assertTrue(all(len(r.events) == 0 for r in replied[:12]), "nothing changed before the cup")
@@ -171,6 +181,11 @@ class ClientTest(unittest.TestCase):
         with self.assertRaises(scenewatch.Timeout):
             subscription.next(timeout_s=0.5)  # one fact, one event
         self.assertEqual([e.id for e in self.client.get_events(since=0)], [event.id])
+        self.assertIn(pending_at_cup.id, event.pending_ids)
+        with self.assertRaises(scenewatch.StatusError) as caught:
+            self.client.next_best_view(pending_id=pending_at_cup.id)
+        self.assertEqual(caught.exception.code, pb.Status.NOT_FOUND)
+        self.assertIn("confirmed as event %d" % event.id, caught.exception.message)
 
         # The surprise map of the last posed frame: one float per pixel of the 320x240 frames.
         surprise = self.client.get_surprise_map(include_channels=True)

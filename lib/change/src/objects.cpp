@@ -267,6 +267,7 @@ Event to_event(const ObjectChange& change) {
   os.precision(3);
   if (change.before) e.indices_before = change.before->indices;
   if (change.after) e.indices_after = change.after->indices;
+  e.pending_ids = change.pending_ids;
   switch (change.kind) {
     case EventKind::kObjectMoved: {
       const Eigen::Vector3d d = change.after->centroid_world - change.before->centroid_world;

@@ -1,5 +1,6 @@
 // Persistence filter: candidates are matched frame to frame by kind and centroid; a candidate
-// fires after persistence_frames hits, paired into a move when its opposite is ready too.
+// fires after persistence_frames hits, paired into a move when its opposite is ready too. A
+// candidate keeps its id while it is matched; the change it fires names it (pending_ids).
 #include "scenewatch/change/persistence.h"
 
 #include <algorithm>
@@ -47,7 +48,7 @@ std::vector<char> PersistenceFilter::match(const std::vector<ChangeCluster>& clu
       }
     }
     if (best < 0) {
-      candidates_.push_back(Candidate{c, 1, 0, 0, camera});
+      candidates_.push_back(Candidate{ids_->next(), c, 1, 0, 0, camera});
       matched.push_back(1);
       continue;
     }
@@ -100,6 +101,7 @@ std::vector<ObjectChange> PersistenceFilter::pair_moves(std::vector<char>& done)
     c.before = candidates_[r].latest;
     c.after = candidates_[a].latest;
     c.similarity = -neg;
+    c.pending_ids = {candidates_[r].id, candidates_[a].id};
     out.push_back(std::move(c));
   }
   return out;
@@ -129,13 +131,15 @@ void PersistenceFilter::fire_singles(std::vector<char>& done, std::vector<Object
     done[i] = 1;
     // Another piece of an object whose change fired in this frame (a vanished box seen through
     // in two parts): written into the model, no second event.
-    bool part_of_fired = false;
-    for (const auto& f : out) {
+    ObjectChange* part_of_fired = nullptr;
+    for (auto& f : out) {
       const auto& side = c.latest.kind == ChangeKind::kAdded ? f.after : f.before;
-      if (!side) continue;
-      part_of_fired = part_of_fired || side->box_world.grown(kZoneMargin_m).contains(c.latest.centroid_world);
+      if (part_of_fired == nullptr && side && side->box_world.grown(kZoneMargin_m).contains(c.latest.centroid_world)) {
+        part_of_fired = &f;
+      }
     }
-    if (part_of_fired) {
+    if (part_of_fired != nullptr) {
+      part_of_fired->pending_ids.push_back(c.id);  // confirmed, as a piece of that change
       if (absorbed != nullptr) absorbed->push_back(c.latest);
       continue;
     }
@@ -147,6 +151,7 @@ void PersistenceFilter::fire_singles(std::vector<char>& done, std::vector<Object
       change.kind = EventKind::kObjectRemoved;
       change.before = c.latest;
     }
+    change.pending_ids = {c.id};
     out.push_back(std::move(change));
   }
 }
@@ -171,6 +176,15 @@ void PersistenceFilter::keep_unfired(const std::vector<char>& done, const std::v
     rest.push_back(std::move(candidates_[i]));
   }
   candidates_.swap(rest);
+}
+
+std::vector<PendingChange> PersistenceFilter::pending() const {
+  std::vector<PendingChange> out;
+  for (const auto& c : candidates_) {
+    const PendingKind kind = c.latest.kind == ChangeKind::kAdded ? PendingKind::kAdded : PendingKind::kRemoved;
+    out.push_back({c.id, kind, c.latest.box_world, c.latest.centroid_world, c.hits, config_.persistence_frames, c.camera});
+  }
+  return out;
 }
 
 void PersistenceFilter::forget_camera(std::uint32_t camera) {

@@ -6,7 +6,8 @@ namespace scenewatch::pipeline {
 std::shared_ptr<SceneSnapshot> compose_snapshot(std::uint64_t frames, const std::vector<Plane>& planes,
                                                 const ObjectTracker& tracker, const ForegroundStage& foreground,
                                                 const std::optional<Eigen::Vector3d>& configured_up,
-                                                const Pose& T_world_camera, double last_stamp_s) {
+                                                const Pose& T_world_camera, double last_stamp_s,
+                                                std::vector<PendingChangeSeen> pending) {
   auto s = std::make_shared<SceneSnapshot>();
   s->frames_processed = frames;
   s->planes = planes;
@@ -26,6 +27,7 @@ std::shared_ptr<SceneSnapshot> compose_snapshot(std::uint64_t frames, const std:
   s->up_world = up_direction(configured_up, planes, T_world_camera);
   s->camera_world = T_world_camera.translation();
   s->last_stamp_s = last_stamp_s;
+  s->pending = std::move(pending);
   return s;
 }
 

@@ -64,6 +64,7 @@ std::vector<Event> merge_pieces(std::vector<Event> geometric) {
       continue;
     }
     named->evidence["pieces"] = named->evidence.count("pieces") ? named->evidence["pieces"] + 1 : 2;
+    named->pending_ids.insert(named->pending_ids.end(), e.pending_ids.begin(), e.pending_ids.end());
     if (named->kind == EventKind::kObjectRemoved) named->box_world = named->box_world.united(e.box_world);
   }
   return merged;
@@ -163,9 +164,11 @@ void EventFusion::tell(Event& e, const std::vector<Aabb>& geometric_boxes) {
     e.evidence["appearance_kl_mean"] = kl;
     e.evidence["appearance_area_px"] = area;
   }
-  candidates_.erase(std::remove_if(candidates_.begin(), candidates_.end(),
-                                   [&](const Candidate& c) { return where.overlaps(c.latest.box_world); }),
-                    candidates_.end());
+  // Those candidates are this event now: their ids go with it.
+  const auto same_fact = std::remove_if(candidates_.begin(), candidates_.end(),
+                                        [&](const Candidate& c) { return where.overlaps(c.latest.box_world); });
+  for (auto c = same_fact; c != candidates_.end(); ++c) e.pending_ids.push_back(c->id);
+  candidates_.erase(same_fact, candidates_.end());
 }
 
 // Appearance-only regions persist at one place in the world, in frames of the camera that saw
@@ -185,7 +188,7 @@ void EventFusion::follow_appearance(const std::vector<const Event*>& free_region
       }
     }
     if (best < 0) {
-      candidates_.push_back(Candidate{*region, 1, 0, region->score, camera});
+      candidates_.push_back(Candidate{ids_->next(), *region, 1, 0, region->score, camera});
       matched.push_back(1);
       continue;
     }
@@ -204,6 +207,7 @@ void EventFusion::follow_appearance(const std::vector<const Event*>& free_region
       Event e = c.latest;
       e.evidence["frames_seen"] = c.hits;
       e.evidence["kl_mean_best"] = c.best_kl;
+      e.pending_ids = {c.id};
       out.push_back(e);
       zones_.push_back(Zone{e.box_world.grown(config_.margin_m), ZoneKind::kAppearance, 0});
       continue;
@@ -211,6 +215,15 @@ void EventFusion::follow_appearance(const std::vector<const Event*>& free_region
     if (c.misses < config_.persistence_frames) kept.push_back(std::move(c));
   }
   candidates_.swap(kept);
+}
+
+std::vector<change::PendingChange> EventFusion::pending() const {
+  std::vector<change::PendingChange> out;
+  for (const auto& c : candidates_) {
+    out.push_back({c.id, change::PendingKind::kAppearance, c.latest.box_world, c.latest.centroid_world, c.hits,
+                   config_.persistence_frames, c.camera});
+  }
+  return out;
 }
 
 void EventFusion::forget_camera(std::uint32_t camera) {

@@ -42,6 +42,15 @@ std::vector<Event> EventLog::since(std::uint64_t since, std::size_t max_count) c
   return out;
 }
 
+std::optional<std::uint64_t> EventLog::confirmed_by(std::uint64_t pending_id) const {
+  // A linear search: asked only of an id that is no longer pending, over a bounded log.
+  std::lock_guard<std::mutex> lock(mutex_);
+  for (auto e = events_.rbegin(); e != events_.rend(); ++e) {
+    if (std::find(e->pending_ids.begin(), e->pending_ids.end(), pending_id) != e->pending_ids.end()) return e->id;
+  }
+  return std::nullopt;
+}
+
 std::uint64_t EventLog::emitted() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return emitted_;

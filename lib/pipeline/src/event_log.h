@@ -8,6 +8,7 @@
 #include <functional>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <vector>
 
 #include "scenewatch/core/event.h"
@@ -25,6 +26,9 @@ class EventLog {
   void unsubscribe(int token);
   /// Events with id > since, oldest first, at most max_count.
   std::vector<Event> since(std::uint64_t since, std::size_t max_count) const;
+  /// The id of the kept event that confirmed pending change `pending_id` (Event::pending_ids);
+  /// nullopt when no kept event names it.
+  std::optional<std::uint64_t> confirmed_by(std::uint64_t pending_id) const;
   /// Events emitted since the start (not lessened by clear()).
   std::uint64_t emitted() const;
   /// Forgets the kept events; ids keep counting, so none is given twice.

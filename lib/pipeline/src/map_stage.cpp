@@ -43,7 +43,8 @@ CloudConstPtr without_pending(const Cloud& cloud, const std::vector<change::Chan
 
 }  // namespace
 
-MapStage::MapStage(const Config& c) : map_(c.background), witness_(c.background.resolution_m), changes_(c.change) {}
+MapStage::MapStage(const Config& c, std::shared_ptr<change::PendingIds> pending_ids)
+    : map_(c.background), witness_(c.background.resolution_m), changes_(c.change, std::move(pending_ids)) {}
 
 // Geometric change detection against the map as it stands before this frame. Candidates stay
 // out of the map until the persistence filter confirms them, so the comparison keeps being made

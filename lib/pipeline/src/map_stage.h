@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <shared_mutex>
@@ -31,7 +32,8 @@ struct ChangeOutcome {
 
 class MapStage {
  public:
-  explicit MapStage(const Config& config);
+  /// `pending_ids`: where the change candidates' ids come from (shared with the event fusion).
+  MapStage(const Config& config, std::shared_ptr<change::PendingIds> pending_ids);
 
   /// Change detection (when `detect`) against the map as it stands before this frame, then the
   /// frame into the map; fills the result's change and insertion figures. Runs beside the
@@ -59,6 +61,10 @@ class MapStage {
     std::unique_lock<std::shared_mutex> lock(mutex_);
     return fn(map_);
   }
+
+  /// The change candidates not yet confirmed. For the writer only, between frames (the filter
+  /// is not guarded).
+  std::vector<change::PendingChange> pending() const { return changes_.pending(); }
 
   /// Forgets what is kept of a camera that is no longer followed.
   void forget_camera(std::uint32_t camera) {

@@ -49,8 +49,13 @@ Config with_sensor(Config c) {
 
 struct WorkingMemory::Impl {
   explicit Impl(const Config& c)
-      : map(c), appearance(c.appearance, c.surprise), localizer(c.localization, c.sensor), colour(c.sensor), tracker(c.tracking),
-        fusion(c.fusion), foreground(c.foreground), snapshot(std::make_shared<SceneSnapshot>()), up(c.segmentation.up) {}
+      : map(c, pending_ids), appearance(c.appearance, c.surprise), localizer(c.localization, c.sensor), colour(c.sensor),
+        tracker(c.tracking), fusion(c.fusion, pending_ids), foreground(c.foreground), snapshot(std::make_shared<SceneSnapshot>()),
+        up(c.segmentation.up) {}
+
+  // The ids of pending changes, geometric and appearance alike (one id names one change); never
+  // reset, so an id is not given twice while the memory lives. Declared first: the stages share it.
+  const std::shared_ptr<change::PendingIds> pending_ids = std::make_shared<change::PendingIds>();
 
   // process() and the other writers hold this for their whole duration.
   mutable std::mutex writer;
@@ -78,8 +83,19 @@ struct WorkingMemory::Impl {
   std::optional<Eigen::Vector3d> up;  // the configured up direction (segmentation.up_vector)
 
   void publish() {
-    auto s = compose_snapshot(frames, planes, tracker, foreground, up, last_camera, last_stamp_s);
+    auto s = compose_snapshot(frames, planes, tracker, foreground, up, last_camera, last_stamp_s, pending_seen());
     std::atomic_store(&snapshot, std::shared_ptr<const SceneSnapshot>(std::move(s)));
+  }
+
+  // The unconfirmed changes, geometric then appearance-only, each with its camera's name.
+  std::vector<PendingChangeSeen> pending_seen() const {
+    std::map<std::uint32_t, std::string> names;
+    for (const auto& [name, id] : cameras.names()) names[id] = name;
+    std::vector<PendingChangeSeen> out;
+    for (const auto& list : {map.pending(), fusion.pending()}) {
+      for (const auto& c : list) out.push_back({c, names[c.camera]});
+    }
+    return out;
   }
 
   // The object list (no events: a change is reported by the change detector, once); the
@@ -395,6 +411,12 @@ void WorkingMemory::unsubscribe(int token) { impl_->events.unsubscribe(token); }
 std::vector<Event> WorkingMemory::events_since(std::uint64_t since, std::size_t max_count) const {
   return impl_->events.since(since, max_count);
 }
+
+std::optional<std::uint64_t> WorkingMemory::event_of_pending(std::uint64_t pending_id) const {
+  return impl_->events.confirmed_by(pending_id);
+}
+
+std::uint64_t WorkingMemory::last_pending_id() const { return impl_->pending_ids->last(); }
 
 Result<std::shared_ptr<const SurpriseResult>> WorkingMemory::surprise(const Frame& observation) const {
   if (auto valid = io::validate_frame(observation, config_.workspace_radius_m); !valid) return valid.error();

@@ -14,6 +14,29 @@ namespace {
 // Largest dense copy of the map one call may ask for: 2^24 voxels (16 MB), a 5 m cube at 2 cm.
 constexpr std::size_t kMaxPlanningVoxels = std::size_t{1} << 24;
 
+// The box of a pending change, or why there is none: what became of an id no longer pending.
+Result<Aabb> pending_box(const pipeline::WorkingMemory& memory, std::uint64_t id) {
+  const std::string name = "pending_id: pending change " + std::to_string(id);
+  if (id == 0) return invalid_argument("pending_id: 0 names no pending change (ids count from 1; GetPendingChanges lists them)");
+  const auto snapshot = memory.snapshot();
+  for (const auto& seen : snapshot->pending) {
+    if (seen.change.id == id) return seen.change.box_world;
+  }
+  // The snapshot was published after the frame's events were logged: an id it no longer lists
+  // is in the log already if an event confirmed it.
+  if (const auto event = memory.event_of_pending(id)) {
+    return not_found(name + " is no longer pending: it was confirmed as event " + std::to_string(*event) +
+                     " (target that with event_id " + std::to_string(*event) + ")");
+  }
+  if (id <= memory.last_pending_id()) {
+    return not_found(name + " is no longer pending, and no event in the log names it: it was dropped (not seen again, or "
+                            "forgotten by a Reset or a load) or confirmed as a piece of a change told before; "
+                            "GetPendingChanges lists those pending now");
+  }
+  return not_found(name + " was never given (the last id given is " + std::to_string(memory.last_pending_id()) +
+                   "; GetPendingChanges lists those pending now)");
+}
+
 Result<planning::NextBestViewRequest> to_request(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg) {
   planning::NextBestViewRequest r;
   switch (msg.target_case()) {
@@ -33,6 +56,12 @@ Result<planning::NextBestViewRequest> to_request(const pipeline::WorkingMemory& 
       r = planning::confirm_event_request(events.front().box_world);
       break;
     }
+    case proto::NextBestView::kPendingId: {
+      auto box = pending_box(memory, msg.pending_id());
+      if (!box) return box.error();
+      r = planning::confirm_event_request(*box);
+      break;
+    }
     case proto::NextBestView::kBox: {
       auto box = convert::decode_box(msg.box(), "box");
       if (!box) return box.error();
@@ -47,7 +76,8 @@ Result<planning::NextBestViewRequest> to_request(const pipeline::WorkingMemory& 
       r = planning::complete_object_request(all);
       break;
     }
-    case proto::NextBestView::TARGET_NOT_SET: return invalid_argument("target: give object_id, box, event_id or workspace");
+    case proto::NextBestView::TARGET_NOT_SET:
+      return invalid_argument("target: give object_id, box, event_id, pending_id or workspace");
   }
   switch (msg.constraint()) {
     case proto::NextBestView::CONSTRAINT_SPHERE: r.constraint.kind = planning::ConstraintKind::kSphere; break;
@@ -91,7 +121,7 @@ Status covariance_view(const pipeline::WorkingMemory& memory, const proto::NextB
   const std::string measure = planning::covariance_measure_name(rule);
   if (msg.target_case() != proto::NextBestView::kObjectId) {
     return invalid_argument("measure " + measure + ": plans from a tracked object's points; give object_id, not a box, "
-                            "an event or the workspace");
+                            "an event, a pending change or the workspace");
   }
   if (msg.constraint() != proto::NextBestView::CONSTRAINT_CAP && msg.constraint() != proto::NextBestView::CONSTRAINT_SPHERE) {
     return invalid_argument("constraint: measure " + measure + " plans on the sphere of radius_m (cap or sphere), not a shell or a list");

@@ -194,6 +194,7 @@ void to_proto(const Event& event, proto::Event* out) {
   if (event.displacement_world) to_proto(*event.displacement_world, out->mutable_displacement_world());
   out->mutable_indices_before()->Add(event.indices_before.begin(), event.indices_before.end());
   out->mutable_indices_after()->Add(event.indices_after.begin(), event.indices_after.end());
+  out->mutable_pending_ids()->Add(event.pending_ids.begin(), event.pending_ids.end());
 }
 
 void to_proto(const Pose& pose, proto::Pose* out) {

@@ -168,6 +168,7 @@ Status RequestHandler::Impl::dispatch(const proto::Request& request, SessionCont
     case proto::Request::kGetPlanes: return get_planes(response);
     case proto::Request::kGetObjects: return get_objects(request.get_objects(), response);
     case proto::Request::kGetHands: return get_hands(response);
+    case proto::Request::kGetPendingChanges: return get_pending_changes(response);
     case proto::Request::kQueryOccupancy: return query_occupancy(request.query_occupancy(), response);
     case proto::Request::kClearBox: return clear_box(request.clear_box(), response);
     case proto::Request::kReset:

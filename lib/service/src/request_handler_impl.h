@@ -67,6 +67,7 @@ struct RequestHandler::Impl {
   Status get_map(proto::Response& response);
   Status get_objects(const proto::GetObjects& msg, proto::Response& response);
   Status get_hands(proto::Response& response);
+  Status get_pending_changes(proto::Response& response);
   Status query_occupancy(const proto::QueryOccupancy& msg, proto::Response& response);
   static proto::OccupancyState to_proto(background::Occupancy state);
   Status subscribe(SessionContext* context, proto::Response& response);

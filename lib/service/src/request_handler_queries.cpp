@@ -1,5 +1,6 @@
 // The calls that read the model: health, stats, planes, objects (described by their classes),
-// hands, occupancy, the map, localization, and the event log with its subscription.
+// hands, the pending changes, occupancy, the map, localization, and the event log with its
+// subscription.
 #include <algorithm>
 #include <optional>
 
@@ -127,6 +128,28 @@ Status RequestHandler::Impl::get_hands(proto::Response& response) {
   }
   out->set_person_pixels(seen.person_pixels);
   if (seen.person_box_world) convert::to_proto(*seen.person_box_world, out->mutable_person_box_world());
+  return {};
+}
+
+Status RequestHandler::Impl::get_pending_changes(proto::Response& response) {
+  const auto snapshot = memory.snapshot();
+  auto* out = response.mutable_pending_changes();
+  out->set_frames_processed(snapshot->frames_processed);
+  for (const auto& seen : snapshot->pending) {
+    const change::PendingChange& c = seen.change;
+    auto* o = out->add_changes();
+    o->set_id(c.id);
+    switch (c.kind) {
+      case change::PendingKind::kAdded: o->set_kind(proto::PendingChange::ADDED); break;
+      case change::PendingKind::kRemoved: o->set_kind(proto::PendingChange::REMOVED); break;
+      case change::PendingKind::kAppearance: o->set_kind(proto::PendingChange::APPEARANCE_CHANGE); break;
+    }
+    convert::to_proto(c.box_world, o->mutable_box_world());
+    convert::to_proto(c.centroid_world, o->mutable_centroid_world());
+    o->set_hits(static_cast<std::uint32_t>(c.hits));
+    o->set_hits_needed(static_cast<std::uint32_t>(c.hits_needed));
+    o->set_camera(convert::valid_utf8(seen.camera));
+  }
   return {};
 }
 

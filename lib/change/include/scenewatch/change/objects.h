@@ -2,6 +2,7 @@
 /// From mismatch pixels and voxels to object-level changes: connected clusters with a metric size
 /// filter, then vanished/appeared pairs of similar shape and colour as moves.
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "scenewatch/change/mismatch.h"
@@ -37,6 +38,8 @@ struct ObjectChange {
   std::optional<ChangeCluster> before;       ///< the vanished side (removed, moved)
   std::optional<ChangeCluster> after;        ///< the appeared side (added, moved)
   double similarity = 0.0;                   ///< moves: 1 = same size and colour
+  /// The persistence filter's candidates it confirmed (PendingChange ids); empty from a diff.
+  std::vector<std::uint64_t> pending_ids;
 };
 
 /// Inputs of clustering besides the mismatch: the observation and, for same-camera pairs or

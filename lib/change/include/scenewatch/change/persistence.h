@@ -2,18 +2,23 @@
 /// The persistence filter of sequences: a candidate change fires only after it was re-observed in
 /// `persistence_frames` consistent frames, so depth noise that comes and goes raises nothing.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "scenewatch/change/objects.h"
+#include "scenewatch/change/pending_change.h"
 
 namespace scenewatch::change {
 
-/// NOT thread safe: one per stream, owned by its caller.
+/// NOT thread safe: one per stream, owned by its caller. Each candidate has an id from `ids`
+/// (shared with other sources of pending changes, or a counter of its own).
 class PersistenceFilter {
  public:
-  explicit PersistenceFilter(const Config& config) : config_(config) {}
+  explicit PersistenceFilter(const Config& config, std::shared_ptr<PendingIds> ids = std::make_shared<PendingIds>())
+      : config_(config), ids_(std::move(ids)) {}
 
-  /// Feeds one frame's clusters. Returns the changes confirmed by this frame (moves paired).
+  /// Feeds one frame's clusters. Returns the changes confirmed by this frame (moves paired), each
+  /// with the ids of the candidates it confirmed (ObjectChange::pending_ids).
   /// `pending` receives the clusters of this frame that belong to unconfirmed candidates: their
   /// pixels should be kept out of the model until confirmed. `absorbed` receives clusters that
   /// lie where a change of their kind was already confirmed (the other sides of an object that
@@ -27,6 +32,10 @@ class PersistenceFilter {
   void forget_camera(std::uint32_t camera);
 
   std::size_t candidates() const { return candidates_.size(); }
+  /// The unconfirmed candidates after the last update(), oldest first: what a planner may look at
+  /// to confirm or dismiss. A candidate keeps its id while it is matched; once confirmed or
+  /// dropped it is gone from the list, and its id is never listed again.
+  std::vector<PendingChange> pending() const;
   void reset() {
     candidates_.clear();
     zones_.clear();
@@ -34,6 +43,7 @@ class PersistenceFilter {
 
  private:
   struct Candidate {
+    std::uint64_t id = 0;  ///< from ids_, kept across the frames it is matched in
     ChangeCluster latest;
     int hits = 0;
     int misses = 0;  ///< consecutive frames without a match
@@ -64,6 +74,7 @@ class PersistenceFilter {
   void keep_unfired(const std::vector<char>& done, const std::vector<char>& matched, std::vector<ChangeCluster>* pending);
 
   Config config_;
+  std::shared_ptr<PendingIds> ids_;
   std::vector<Candidate> candidates_;
   std::vector<Zone> zones_;  ///< confirmed changes, most recent last (bounded)
 };

@@ -49,6 +49,9 @@ struct Event {
   /// Indices of the event's points in the observation(s) it came from (e.g. BEFORE / AFTER of a
   /// diff, or the ingested frame's cloud as "after"). Empty when not applicable.
   std::vector<int> indices_before, indices_after;
+  /// The pending changes this event confirmed (their ids while they were pending, issue 31). Not
+  /// saved with the model: the ids count anew in each run of the daemon.
+  std::vector<std::uint64_t> pending_ids;
 };
 
 }  // namespace scenewatch

@@ -17,10 +17,14 @@
 //   a removal confirmed later inside the place of an earlier removal (or move) is another piece of
 //   the same object, seen from a new side; likewise for additions; no appearance-only change is
 //   reported where any event fired.
+// Each event carries the ids of the pending changes it confirmed (Event::pending_ids): the
+// geometric candidates' (from the persistence filter), and its own appearance candidates'.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "scenewatch/change/objects.h"
+#include "scenewatch/change/pending_change.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/scene.h"
 
@@ -33,9 +37,13 @@ struct FusionConfig {
   int zone_frames = 300;       ///< a fired event silences its place for this many frames
 };
 
+/// NOT thread safe: owned by the working memory's writer. The appearance candidates' ids come
+/// from `ids`, the space the persistence filter's candidates share (so one id names one change).
 class EventFusion {
  public:
-  explicit EventFusion(const FusionConfig& config = {}) : config_(config) {}
+  explicit EventFusion(const FusionConfig& config = {},
+                       std::shared_ptr<change::PendingIds> ids = std::make_shared<change::PendingIds>())
+      : config_(config), ids_(std::move(ids)) {}
 
   /// One frame: `appearance` holds this frame's surprise regions as events, `pending` the
   /// geometric candidates seen in this frame, `geometric` the geometric events confirmed by it and
@@ -55,10 +63,13 @@ class EventFusion {
   void forget_camera(std::uint32_t camera);
 
   std::size_t candidates() const { return candidates_.size(); }
+  /// The appearance-only candidates not yet persistent (kind kAppearance), oldest first.
+  std::vector<change::PendingChange> pending() const;
   void reset();
 
  private:
   struct Candidate {
+    std::uint64_t id = 0;  ///< from ids_, kept while the region is matched
     Event latest;
     int hits = 0;
     int misses = 0;
@@ -86,6 +97,7 @@ class EventFusion {
   void follow_appearance(const std::vector<const Event*>& free_regions, std::uint32_t camera, std::vector<Event>& out);
 
   FusionConfig config_;
+  std::shared_ptr<change::PendingIds> ids_;
   std::vector<Candidate> candidates_;
   std::vector<Claimed> claimed_;
   std::vector<Zone> zones_;

@@ -1,15 +1,18 @@
 #pragma once
-/// The scene as readers see it: planes, objects (background and foreground), hands and each
-/// object's points, published by WorkingMemory after each frame.
+/// The scene as readers see it: planes, objects (background and foreground), hands, each
+/// object's points and the changes seen but not yet confirmed, published by WorkingMemory after
+/// each frame.
 #include <cstddef>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "scenewatch/change/pending_change.h"
 #include "scenewatch/core/scene.h"
 #include "scenewatch/core/geometry.h"
 
@@ -33,6 +36,12 @@ struct HandsSeen {
   std::optional<Aabb> person_box_world;
 };
 
+/// A change seen but not yet confirmed (not yet an event), with the name of the camera that saw it.
+struct PendingChangeSeen {
+  change::PendingChange change;
+  std::string camera;  ///< as the frames named it ("" the unnamed camera)
+};
+
 /// An immutable view of the scene, swapped atomically after each frame: readers never wait for
 /// a frame being processed.
 struct SceneSnapshot {
@@ -46,6 +55,9 @@ struct SceneSnapshot {
   Eigen::Vector3d up_world = Eigen::Vector3d::UnitZ();      ///< the support's up (config or largest plane)
   Eigen::Vector3d camera_world = Eigen::Vector3d::Zero();   ///< where the last frame was taken
   double last_stamp_s = 0.0;
+  /// The geometric change detector's unconfirmed candidates, then the appearance-only ones, as
+  /// this frame left them: targets for the view that confirms or dismisses them (issue 31).
+  std::vector<PendingChangeSeen> pending;
 };
 
 }  // namespace scenewatch::pipeline

@@ -128,6 +128,13 @@ class WorkingMemory {
   void unsubscribe(int token);
   /// Events with id > since, oldest first, at most max_count.
   std::vector<Event> events_since(std::uint64_t since, std::size_t max_count = 1000) const;
+  /// The event that confirmed a pending change (snapshot().pending lists those still pending),
+  /// while that event is in the log. nullopt when it is not there: the change was dropped (not
+  /// seen again), was confirmed as a piece of a change told before, or its event left the log
+  /// (a Reset, a load, max_event_log). Thread safe.
+  std::optional<std::uint64_t> event_of_pending(std::uint64_t pending_id) const;
+  /// The largest pending change id given so far (0: none); ids are never given twice. Thread safe.
+  std::uint64_t last_pending_id() const;
 
   /// The surprise of an observation (organized, with intrinsics, colour and usually a pose)
   /// against the appearance memory. Nothing in the model changes. kNotFound before any keyframe.
