@@ -30,13 +30,10 @@ struct NormalEquations {
   double h[21] = {};
   double b[6] = {};
   void add(const double (&J)[6], double r, double w) {
-    int k = 0;
-    for (int i = 0; i < 6; ++i) {
-      const double wi = w * J[i];
-      b[i] += r * wi;
-      for (int j = i; j < 6; ++j) h[k++] += wi * J[j];
-    }
+    add_information(J, w);
+    for (int i = 0; i < 6; ++i) b[i] += r * (w * J[i]);
   }
+  /// H alone.
   void add_information(const double (&J)[6], double w) {
     int k = 0;
     for (int i = 0; i < 6; ++i) {

@@ -42,6 +42,12 @@ class CameraRegistry {
     if (it == cameras_.end()) return std::nullopt;
     return it->second.id;
   }
+  /// The name of a followed camera's id ("" for an id not followed, or the unnamed camera).
+  std::string name_of(std::uint32_t id) const {
+    for (const auto& [name, entry] : cameras_)
+      if (entry.id == id) return name;
+    return {};
+  }
   /// Every followed camera: name and id, by name.
   std::map<std::string, std::uint32_t> names() const {
     std::map<std::string, std::uint32_t> out;

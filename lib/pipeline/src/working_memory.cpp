@@ -89,12 +89,9 @@ struct WorkingMemory::Impl {
 
   // The unconfirmed changes, geometric then appearance-only, each with its camera's name.
   std::vector<PendingChangeSeen> pending_seen() const {
-    std::map<std::uint32_t, std::string> names;
-    for (const auto& [name, id] : cameras.names()) names[id] = name;
     std::vector<PendingChangeSeen> out;
-    for (const auto& list : {map.pending(), fusion.pending()}) {
-      for (const auto& c : list) out.push_back({c, names[c.camera]});
-    }
+    for (const auto& c : map.pending()) out.push_back({c, cameras.name_of(c.camera)});
+    for (const auto& c : fusion.pending()) out.push_back({c, cameras.name_of(c.camera)});
     return out;
   }
 
