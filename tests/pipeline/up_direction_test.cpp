@@ -17,13 +17,15 @@ namespace {
 
 // Also the object list: what stands on the wall (the relief of a whiteboard, posters) is not an
 // object. Two objects stand on the table (a bin and a toy). The most listed in any frame from the
-// fifth on, measured: pick_toy_1 6, pick_toy_2 8 (7 and 10 while a cluster seen in one frame was
-// listed, tracking.confirm_frames 1; at the end 18 and 25-26 before strips narrower
-// than the sensor resolves, pieces seen in place without a cluster of their own and pieces of
-// hands were dropped; 41 and 60 when the wall's pieces were listed). What remains: two pieces of
-// the chair beside the table, inside the table's hull (bands of the wall and the chair's back at
-// the table's height stretch it), and the person's arm.
-void expect_table_up_on_every_frame(const std::string& name, std::size_t max_objects) {
+// fifth on, and at the end, measured: pick_toy_1 5 and 4, pick_toy_2 7 and 5 (6 and 8, 6 and 8
+// while the person's body seen before the detector found the arm stayed listed and pieces of the
+// bin cut off by the toy were new objects; 7 and 10 while a cluster seen in one frame was listed,
+// tracking.confirm_frames 1; at the end 18 and 25-26 before strips narrower than the sensor
+// resolves, pieces seen in place without a cluster of their own and pieces of hands were dropped;
+// 41 and 60 when the wall's pieces were listed). What remains: two pieces of the chair beside the
+// table, inside the table's hull (bands of the wall and the chair's back at the table's height
+// stretch it), and a piece by the hand at the end of pick_toy_2.
+void expect_table_up_on_every_frame(const std::string& name, std::size_t max_objects, std::size_t max_at_end) {
   std::vector<std::string> sections = pipeline_sections();
   sections.push_back("server");  // the daemon's own sections
   sections.push_back("ontology");
@@ -61,6 +63,7 @@ void expect_table_up_on_every_frame(const std::string& name, std::size_t max_obj
               name.c_str(), worst_deg, wall_frames, listed, most_listed, on_wall);
   EXPECT_EQ(on_wall, 0u);
   EXPECT_LE(most_listed, max_objects);
+  EXPECT_LE(listed, max_at_end);
   EXPECT_EQ(wall_frames, 0);
   // The table's fitted normal: within 0.4 degrees of the base's z on every frame of both (3.0
   // degrees on pick_toy_1's frame 35 when it was first measured, with every pixel segmented).
@@ -69,12 +72,12 @@ void expect_table_up_on_every_frame(const std::string& name, std::size_t max_obj
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy1AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_1");
-  expect_table_up_on_every_frame("pick_toy_1", 6);
+  expect_table_up_on_every_frame("pick_toy_1", 5, 4);
 }
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy2AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_2");
-  expect_table_up_on_every_frame("pick_toy_2", 8);
+  expect_table_up_on_every_frame("pick_toy_2", 7, 5);
 }
 
 }  // namespace

@@ -38,6 +38,9 @@ class ForegroundStage {
                                       FrameResult& result);
 
   const HandsSeen& hands() const { return hands_; }
+  /// This frame's hands, arms and person, pixel by pixel (empty labels when the frame had none to
+  /// look for: no colour, not organized).
+  const foreground::HandDetection& agents() const { return detection_; }
   foreground::ForegroundTracker& tracker() { return tracker_; }
   const foreground::ForegroundTracker& tracker() const { return tracker_; }
   void reset();

@@ -39,15 +39,18 @@ std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectClu
 }
 
 // A box that lies for the most part (half its volume or more) in one of the frame's hands or arms,
-// each grown by `margin_m`: a finger or a sleeve, not an object the hand reaches for.
-bool touches_hand(const Aabb& box, const HandsSeen& hands, double margin_m) {
+// or in the person's body, each grown by `margin_m`: a finger, a sleeve, a shirt or a leg the
+// detector left out, not an object the hand reaches for.
+bool touches_person(const Aabb& box, const HandsSeen& hands, double margin_m) {
   const double volume = (box.max - box.min).cwiseMax(1e-6).prod();
-  for (const auto& h : hands.hands) {
-    const Eigen::Vector3d lo = (h.box_world.min.array() - margin_m).max(box.min.array());
-    const Eigen::Vector3d hi = (h.box_world.max.array() + margin_m).min(box.max.array());
-    if ((hi.array() > lo.array()).all() && (hi - lo).prod() >= 0.5 * volume) return true;
-  }
-  return false;
+  const auto mostly_in = [&](const Aabb& agent) {
+    const Eigen::Vector3d lo = (agent.min.array() - margin_m).max(box.min.array());
+    const Eigen::Vector3d hi = (agent.max.array() + margin_m).min(box.max.array());
+    return (hi.array() > lo.array()).all() && (hi - lo).prod() >= 0.5 * volume;
+  };
+  for (const auto& h : hands.hands)
+    if (mostly_in(h.box_world)) return true;
+  return hands.person_box_world && mostly_in(*hands.person_box_world);
 }
 
 // Objects stand on tables, shelves and floors, not on walls: the clusters whose supporting plane
@@ -76,7 +79,7 @@ std::vector<TrackerObservation> tracker_input(const FrameResult& result, const C
   std::vector<TrackerObservation> observations = tracker_observations(result.objects, cloud, T, claimed);
   for (auto& o : observations) {
     o.resolution_m = std::max(config.segmentation.voxel_size_m, 2 * config.sensor.sigma_z(o.range_m));
-    if (hands.frame_index == frame_index) o.touches_person = touches_hand(o.cluster.box.aabb(), hands, config.segmentation.cluster_tolerance_m);
+    if (hands.frame_index == frame_index) o.touches_person = touches_person(o.cluster.box.aabb(), hands, config.segmentation.cluster_tolerance_m);
   }
   // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
   if (const auto up = level_up(configured_up, result.planes, T)) keep_on_level_supports(observations, result.planes, *up, T.translation());
@@ -90,8 +93,13 @@ double free_fraction(const background::OccupancyMap& map, const std::vector<Eige
   return static_cast<double>(n) / pts.size();
 }
 
-double seen_in_place(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
-                     const std::vector<Eigen::Vector3d>& points) {
+namespace {
+
+// The share of `points` (world) that project into the organized frame's image onto a pixel whose
+// depth lies within the sensor's 3 sigma plus a voxel of theirs and that `counts` accepts.
+template <typename Counts>
+double share_in_place(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                      const std::vector<Eigen::Vector3d>& points, const Counts& counts) {
   if (!K || cloud.height <= 1 || points.empty() || static_cast<int>(cloud.width) != K->width) return 0.0;
   const Pose T_camera_world = T.inverse();
   std::size_t n = 0;
@@ -100,11 +108,26 @@ double seen_in_place(const Cloud& cloud, const Pose& T, const std::optional<Intr
     if (q.z() <= 0) continue;
     const long u = std::lround(K->fx * q.x() / q.z() + K->cx), v = std::lround(K->fy * q.y() / q.z() + K->cy);
     if (u < 0 || v < 0 || u >= static_cast<long>(cloud.width) || v >= static_cast<long>(cloud.height)) continue;
-    const PointT& f = cloud.points[static_cast<std::size_t>(v) * cloud.width + static_cast<std::size_t>(u)];
+    const std::size_t i = static_cast<std::size_t>(v) * cloud.width + static_cast<std::size_t>(u);
+    const PointT& f = cloud.points[i];
     if (!is_valid(f)) continue;
-    n += std::abs(f.z - q.z()) < 3 * config.sensor.sigma_z(q.z()) + config.segmentation.voxel_size_m;
+    n += std::abs(f.z - q.z()) < 3 * config.sensor.sigma_z(q.z()) + config.segmentation.voxel_size_m && counts(i);
   }
   return static_cast<double>(n) / static_cast<double>(points.size());
+}
+
+}  // namespace
+
+double seen_in_place(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                     const std::vector<Eigen::Vector3d>& points) {
+  return share_in_place(cloud, T, K, config, points, [](std::size_t) { return true; });
+}
+
+double seen_on_person(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                      const foreground::HandDetection& agents, const std::vector<Eigen::Vector3d>& points) {
+  if (agents.labels.size() != cloud.points.size()) return 0.0;
+  return share_in_place(cloud, T, K, config, points,
+                        [&](std::size_t i) { return agents.labels[i] == foreground::AgentLabel::kPerson; });
 }
 
 }  // namespace scenewatch::pipeline

@@ -9,6 +9,7 @@
 
 #include "scenewatch/background/occupancy_map.h"
 #include "scenewatch/core/frame.h"
+#include "scenewatch/foreground/hand_detector.h"
 #include "scenewatch/pipeline/config.h"
 #include "scenewatch/pipeline/frame_result.h"
 #include "scenewatch/pipeline/object_tracker.h"
@@ -30,5 +31,10 @@ double free_fraction(const background::OccupancyMap& map, const std::vector<Eige
 /// frame's depth there within the sensor's 3 sigma plus a voxel of theirs.
 double seen_in_place(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
                      const std::vector<Eigen::Vector3d>& points);
+
+/// The share of `points` (world) the frame sees where they are (as seen_in_place) on pixels the
+/// hand detector gave to the person's body: a listed object found there was a piece of the person.
+double seen_on_person(const Cloud& cloud, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
+                      const foreground::HandDetection& agents, const std::vector<Eigen::Vector3d>& points);
 
 }  // namespace scenewatch::pipeline

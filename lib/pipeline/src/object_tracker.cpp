@@ -1,7 +1,12 @@
 #include "scenewatch/pipeline/object_tracker.h"
 
+#include <tsl/robin_set.h>
+
 #include <algorithm>
+#include <cmath>
 #include <tuple>
+
+#include "scenewatch/core/hash.h"
 
 namespace scenewatch::pipeline {
 namespace {
@@ -29,10 +34,47 @@ std::vector<int> match(const std::vector<TrackerObservation>& obs, const std::ve
   return obs_to_known;
 }
 
+std::uint64_t cell_of(const Eigen::Vector3d& p, double cell_m) {
+  const auto c = [&](double x) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x / cell_m)) + (1 << 20)) & 0x1fffff; };
+  return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
+}
+
+// The share of `samples` within a cell (or its 26 neighbours) of `surface`'s points, on cells of
+// `cell_m`: how much of an observation lies on a surface remembered for an object.
+double share_on_surface(const std::vector<Eigen::Vector3d>& samples, const std::vector<Eigen::Vector3d>& surface,
+                        double cell_m) {
+  if (samples.empty() || surface.empty() || !(cell_m > 0)) return 0.0;
+  tsl::robin_set<std::uint64_t, MixHash64> cells;
+  cells.reserve(surface.size());
+  for (const auto& p : surface) cells.insert(cell_of(p, cell_m));
+  std::size_t n = 0;
+  for (const auto& p : samples) {
+    bool near = false;
+    for (int dx = -1; dx <= 1 && !near; ++dx)
+      for (int dy = -1; dy <= 1 && !near; ++dy)
+        for (int dz = -1; dz <= 1 && !near; ++dz)
+          near = cells.count(cell_of(p + cell_m * Eigen::Vector3d(dx, dy, dz), cell_m)) > 0;
+    n += near;
+  }
+  return static_cast<double>(n) / static_cast<double>(samples.size());
+}
+
 }  // namespace
 
+// The confirmed object (index into tracks_) whose remembered surface most of an unmatched
+// observation lies on, -1 when none: a piece of it (a bin's far wall cut off by what fell in, a
+// box's side beside a hand), seen again where that object was.
+int ObjectTracker::piece_of(const TrackerObservation& o) const {
+  for (std::size_t k = 0; k < tracks_.size(); ++k) {
+    const Track& t = tracks_[k];
+    if (t.surface && share_on_surface(o.samples, *t.surface, o.resolution_m) >= config_.gone_free_fraction)
+      return static_cast<int>(k);
+  }
+  return -1;
+}
+
 void ObjectTracker::update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction,
-                           const SeenFraction& seen_fraction) {
+                           const SeenFraction& seen_fraction, const PersonFraction& on_person) {
   ++frames_;
   // The first frame lists what it sees (a single cloud sent once); later ones need confirming.
   const int confirm = frames_ == 1 ? 1 : config_.confirm_frames;
@@ -72,6 +114,12 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     const int k = matched[c];
     if (k < 0 && observations[c].touches_person) continue;
     if (k < 0) {
+      if (const int whole = piece_of(observations[c]); whole >= 0) {
+        // Seen, in part: the object stays as its largest piece left it.
+        hit[static_cast<std::size_t>(whole)] = 1;
+        tracks_[static_cast<std::size_t>(whole)].misses = 0;
+        continue;
+      }
       Track t;
       t.object.cluster = std::move(observations[c].cluster);
       t.object.first_seen_s = t.object.last_seen_s = stamp_s;
@@ -79,6 +127,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
       t.samples = std::move(observations[c].samples);
       t.points = std::move(observations[c].points);
       t.support_centroid = support[c];
+      remember_surface(t, observations[c].resolution_m);
       tentative_.push_back(std::move(t));
       continue;
     }
@@ -90,7 +139,8 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     t.samples = std::move(observations[c].samples);
     t.points = std::move(observations[c].points);
     t.support_centroid = support[c];
-    t.misses = t.seen_free = t.seen_unmatched = 0;
+    t.misses = t.seen_free = t.seen_unmatched = t.on_person = 0;
+    remember_surface(t, observations[c].resolution_m);
   }
 
   // Confirmed objects unmatched in this frame leave only when their space keeps being seen free.
@@ -99,6 +149,9 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     Track& t = tracks_[i];
     if (!hit[i]) {
       ++t.misses;
+      const bool person = on_person && on_person(t.samples) >= config_.gone_free_fraction;
+      t.on_person = person ? t.on_person + 1 : 0;
+      if (t.on_person >= config_.gone_frames) continue;
       const bool free = free_fraction && free_fraction(t.samples) >= config_.gone_free_fraction;
       t.seen_free = free ? t.seen_free + 1 : 0;
       if (t.seen_free >= config_.gone_frames) continue;
@@ -127,6 +180,17 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
   resolve_supports();
   objects_.clear();
   for (const auto& t : tracks_) objects_.push_back(t.object);
+}
+
+// The surface an object is remembered by: its fullest view, as long as its views since lie on it
+// (a part hidden by what fell in front of it is still there); one that does not is where the
+// object is now (it moved).
+void ObjectTracker::remember_surface(Track& t, double resolution_m) const {
+  const bool fuller = t.object.cluster.point_count >= t.surface_point_count;
+  if (!t.surface || fuller || share_on_surface(t.samples, *t.surface, resolution_m) < config_.gone_free_fraction) {
+    t.surface = t.points;
+    t.surface_point_count = t.object.cluster.point_count;
+  }
 }
 
 void ObjectTracker::resolve_supports() {

@@ -104,7 +104,10 @@ struct WorkingMemory::Impl {
     map.read([&](const background::OccupancyMap& bg) {
       tracker.update(std::move(observations), frame.stamp_s,
                      [&](const std::vector<Eigen::Vector3d>& pts) { return free_fraction(bg, pts); },
-                     [&](const std::vector<Eigen::Vector3d>& pts) { return seen_in_place(*frame.cloud, T, K, config, pts); });
+                     [&](const std::vector<Eigen::Vector3d>& pts) { return seen_in_place(*frame.cloud, T, K, config, pts); },
+                     [&](const std::vector<Eigen::Vector3d>& pts) {
+                       return seen_on_person(*frame.cloud, T, K, config, foreground.agents(), pts);
+                     });
     });
   }
 

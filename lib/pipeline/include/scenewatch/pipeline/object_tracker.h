@@ -14,7 +14,10 @@
 /// occluded or out-of-view object keeps its place), and silently when its surface is seen where
 /// it was but no cluster stands for it there (a piece of a larger object, a fragment of an edge)
 /// in as many frames in a row as half its sightings, at least `gone_frames`. A cluster that lies
-/// mostly in a hand or an arm starts no track (never part of a person).
+/// mostly in a hand, an arm or the person's box starts no track, nor does one that lies mostly on
+/// a listed object's surface as its fullest view saw it (a piece of it), and an object whose place the
+/// frame sees on the person's body in `gone_frames` frames leaves (never part of a person: a body
+/// in view before the hand detector found its arm was listed at first sight).
 ///
 /// The tracker raises no events: what changed in the scene is reported once, by the change
 /// detector (OBJECT_ADDED / OBJECT_REMOVED / OBJECT_MOVED); the list is what GetObjects returns.
@@ -58,9 +61,9 @@ struct TrackerObservation {
   double range_m = 0.0;  ///< distance of its centroid from the camera
   /// The smallest extent the sensor resolves at that range: max(voxel, 2 sigma_z(range_m)).
   double resolution_m = 0.0;
-  /// Half its box or more lies in a hand or arm seen in the same frame (grown by the
-  /// segmentation's link distance): fingers and sleeves cut off the hand. It keeps a listed
-  /// object's track but starts none.
+  /// Half its box or more lies in a hand, an arm or the person's body seen in the same frame (each
+  /// box grown by the segmentation's link distance): fingers and sleeves cut off the hand, a shirt
+  /// or a leg the detector left out. It keeps a listed object's track but starts none.
   bool touches_person = false;
 };
 
@@ -76,9 +79,14 @@ class ObjectTracker {
   /// gone): an object unmatched although seen so was not an object of its own.
   using SeenFraction = std::function<double(const std::vector<Eigen::Vector3d>& points)>;
 
-  /// One frame. `free_fraction` and `seen_fraction` are asked about objects that were not matched.
+  /// The share of `points` the frame sees where they are on a person's body: an object unmatched
+  /// there in `gone_frames` frames in a row was a piece of the person, and leaves the list.
+  using PersonFraction = SeenFraction;
+
+  /// One frame. `free_fraction`, `seen_fraction` and `on_person` are asked about objects that were
+  /// not matched.
   void update(std::vector<TrackerObservation> observations, double stamp_s, const FreeFraction& free_fraction,
-              const SeenFraction& seen_fraction = {});
+              const SeenFraction& seen_fraction = {}, const PersonFraction& on_person = {});
 
   /// Confirmed objects, in the order they were confirmed.
   const std::vector<TrackedObject>& objects() const { return objects_; }
@@ -104,10 +112,16 @@ class ObjectTracker {
     int misses = 0;       ///< consecutive frames unmatched
     int seen_free = 0;    ///< consecutive frames unmatched with its space seen free
     int seen_unmatched = 0;  ///< consecutive frames unmatched with its surface seen in place
+    int on_person = 0;       ///< consecutive frames unmatched with its place seen on a person
     /// Centroid of the observation it stood on in its last frame (a box on a box), if any.
     std::optional<Eigen::Vector3d> support_centroid;
+    /// Its fullest view's points and their count: a piece of it seen again is no new object.
+    std::shared_ptr<const std::vector<Eigen::Vector3d>> surface;
+    std::size_t surface_point_count = 0;
   };
   void resolve_supports();
+  void remember_surface(Track& t, double resolution_m) const;
+  int piece_of(const TrackerObservation& o) const;
   TrackingConfig config_;
   std::vector<Track> tracks_;          ///< confirmed
   std::vector<Track> tentative_;       ///< seen, not yet confirmed
