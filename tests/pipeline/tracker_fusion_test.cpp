@@ -175,6 +175,29 @@ TEST(ObjectTracker, AnObjectWhosePlaceIsSeenOnThePersonLeaves) {
   EXPECT_EQ(tracker.objects().size(), 1u) << "a matched object is never asked";
 }
 
+// A cluster that crosses its support's height (not `rests`) starts no track, and a listed one seen
+// so in gone_frames sightings in a row leaves; seen so once, it stays.
+TEST(ObjectTracker, WhatCrossesItsSupportsHeightIsNotListed) {
+  TrackingConfig config;
+  config.gone_frames = 2;
+  ObjectTracker tracker(config);
+  TrackerObservation crossing = seen_at(0.4, 0);
+  crossing.rests = false;
+  tracker.update({seen_at(0, 0), crossing}, 0, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 1u) << "not even at first sight";
+  for (int i = 1; i < 4; ++i) tracker.update({seen_at(0, 0), crossing}, i, kOccluded);
+  EXPECT_EQ(tracker.objects().size(), 1u);
+  EXPECT_EQ(tracker.tentative(), 0u);
+  TrackerObservation once = seen_at(0, 0);
+  once.rests = false;
+  tracker.update({once}, 4, kOccluded);
+  tracker.update({seen_at(0, 0)}, 5, kOccluded);
+  tracker.update({once}, 6, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 1u) << "crossing in sightings apart: it stays";
+  tracker.update({once}, 7, kOccluded);
+  EXPECT_TRUE(tracker.objects().empty()) << "twice in a row: it leaves";
+}
+
 // Points on a line from `from` to `to`, `n` of them: a stand-in for an object's surface.
 std::shared_ptr<std::vector<Eigen::Vector3d>> strip(const Eigen::Vector3d& from, const Eigen::Vector3d& to, int n) {
   auto pts = std::make_shared<std::vector<Eigen::Vector3d>>();

@@ -6,6 +6,7 @@
 #include <memory>
 
 #include "foreground_stage.h"
+#include "support_contact.h"
 
 namespace scenewatch::pipeline {
 
@@ -53,6 +54,19 @@ bool touches_person(const Aabb& box, const HandsSeen& hands, double margin_m) {
   return hands.person_box_world && mostly_in(*hands.person_box_world);
 }
 
+// Whether a cluster rests on its plane (support_contact.h), judged in the camera's frame.
+bool rests_on_its_plane(const ObjectCluster& cluster, const std::vector<Plane>& planes, const Cloud& cloud, const Pose& T,
+                        const Intrinsics& K, const segmentation::Config& seg) {
+  const auto plane = std::find_if(planes.begin(), planes.end(), [&](const Plane& p) { return p.id == cluster.plane_id; });
+  if (plane == planes.end() || cluster.supported_by >= 0) return true;  // on another object: its own contacts
+  const Eigen::Vector3d up = plane->normal_towards(T.translation());
+  const double d = plane->normal.normalized().dot(up) > 0 ? plane->d / plane->normal.norm() : -plane->d / plane->normal.norm();
+  // In the camera's frame: up . (R x + t) + d = (R^T up) . x + (up . t + d).
+  const SupportContact c = support_contact(cluster.indices, cloud, K, T.linear().transpose() * up, up.dot(T.translation()) + d,
+                                           seg.plane_distance_m, seg.cluster_tolerance_m, seg.patch_size_m);
+  return c.rests();
+}
+
 // Objects stand on tables, shelves and floors, not on walls: the clusters whose supporting plane
 // faces more than 45 degrees away from the world's up (up_direction's own bound) are a wall's
 // relief (a whiteboard, a poster, a socket), not objects to list. Their space is never seen free,
@@ -73,8 +87,8 @@ void keep_on_level_supports(std::vector<TrackerObservation>& observations, const
 }  // namespace
 
 std::vector<TrackerObservation> tracker_input(const FrameResult& result, const Cloud& cloud, const Pose& T,
-                                              const std::vector<std::size_t>& claimed, const HandsSeen& hands,
-                                              std::uint64_t frame_index, const Config& config) {
+                                              const std::optional<Intrinsics>& K, const std::vector<std::size_t>& claimed,
+                                              const HandsSeen& hands, std::uint64_t frame_index, const Config& config) {
   const std::optional<Eigen::Vector3d>& configured_up = config.segmentation.up;
   std::vector<TrackerObservation> observations = tracker_observations(result.objects, cloud, T, claimed);
   for (auto& o : observations) {
@@ -83,6 +97,8 @@ std::vector<TrackerObservation> tracker_input(const FrameResult& result, const C
   }
   // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
   if (const auto up = level_up(configured_up, result.planes, T)) keep_on_level_supports(observations, result.planes, *up, T.translation());
+  if (K)
+    for (auto& o : observations) o.rests = rests_on_its_plane(o.cluster, result.planes, cloud, T, *K, config.segmentation);
   return observations;
 }
 

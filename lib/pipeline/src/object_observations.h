@@ -21,8 +21,8 @@ namespace scenewatch::pipeline {
 /// did not claim, each with its resolution and, when the hands are this frame's, whether a hand
 /// holds it; when the up is to be trusted, only those on level supports.
 std::vector<TrackerObservation> tracker_input(const FrameResult& result, const Cloud& cloud, const Pose& T,
-                                              const std::vector<std::size_t>& claimed, const HandsSeen& hands,
-                                              std::uint64_t frame_index, const Config& config);
+                                              const std::optional<Intrinsics>& K, const std::vector<std::size_t>& claimed,
+                                              const HandsSeen& hands, std::uint64_t frame_index, const Config& config);
 
 /// The share of `points` (world) that the map's last insertion freed or holds free.
 double free_fraction(const background::OccupancyMap& map, const std::vector<Eigen::Vector3d>& points);

@@ -112,7 +112,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
   std::vector<char> hit(known.size(), 0);
   for (std::size_t c = 0; c < observations.size(); ++c) {
     const int k = matched[c];
-    if (k < 0 && observations[c].touches_person) continue;
+    if (k < 0 && (observations[c].touches_person || !observations[c].rests)) continue;
     if (k < 0) {
       if (const int whole = piece_of(observations[c]); whole >= 0) {
         // Seen, in part: the object stays as its largest piece left it.
@@ -140,6 +140,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     t.points = std::move(observations[c].points);
     t.support_centroid = support[c];
     t.misses = t.seen_free = t.seen_unmatched = t.on_person = 0;
+    t.not_resting = observations[c].rests ? 0 : t.not_resting + 1;
     remember_surface(t, observations[c].resolution_m);
   }
 
@@ -147,6 +148,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
   std::vector<Track> kept;
   for (std::size_t i = 0; i < tracks_.size(); ++i) {
     Track& t = tracks_[i];
+    if (t.not_resting >= config_.gone_frames) continue;  // seen crossing its support's height
     if (!hit[i]) {
       ++t.misses;
       const bool person = on_person && on_person(t.samples) >= config_.gone_free_fraction;
@@ -167,7 +169,8 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     Track& t = tentative_[i];
     const bool seen_now = n_confirmed + i < hit.size() ? hit[n_confirmed + i] != 0 : true;  // new ones are seen now
     if (!seen_now) ++t.misses;
-    if (t.object.observations >= confirm) {
+    if (t.not_resting >= config_.gone_frames) continue;
+    if (t.object.observations >= confirm && t.not_resting == 0) {
       t.object.id = next_id_++;
       t.misses = 0;
       kept.push_back(std::move(t));

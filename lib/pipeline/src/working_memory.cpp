@@ -100,7 +100,7 @@ struct WorkingMemory::Impl {
   void track_objects(const FrameResult& result, const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
                      const std::vector<std::size_t>& claimed, const Config& config) {
     std::vector<TrackerObservation> observations =
-        tracker_input(result, *frame.cloud, T, claimed, foreground.hands(), frames, config);
+        tracker_input(result, *frame.cloud, T, K, claimed, foreground.hands(), frames, config);
     map.read([&](const background::OccupancyMap& bg) {
       tracker.update(std::move(observations), frame.stamp_s,
                      [&](const std::vector<Eigen::Vector3d>& pts) { return free_fraction(bg, pts); },

@@ -65,6 +65,10 @@ struct TrackerObservation {
   /// box grown by the segmentation's link distance): fingers and sleeves cut off the hand, a shirt
   /// or a leg the detector left out. It keeps a listed object's track but starts none.
   bool touches_person = false;
+  /// It rests on its support (pipeline/src/support_contact.h): most pixels next to its foot in the
+  /// support's band face up. A cluster that crosses the support's height instead (the back of a
+  /// chair beside a table, a person's body) keeps a listed object's track but starts none.
+  bool rests = true;
 };
 
 /// NOT thread safe: owned by the working memory's writer.
@@ -113,6 +117,7 @@ class ObjectTracker {
     int seen_free = 0;    ///< consecutive frames unmatched with its space seen free
     int seen_unmatched = 0;  ///< consecutive frames unmatched with its surface seen in place
     int on_person = 0;       ///< consecutive frames unmatched with its place seen on a person
+    int not_resting = 0;     ///< consecutive sightings crossing its support's height
     /// Centroid of the observation it stood on in its last frame (a box on a box), if any.
     std::optional<Eigen::Vector3d> support_centroid;
     /// Its fullest view's points and their count: a piece of it seen again is no new object.
