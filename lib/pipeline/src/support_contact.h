@@ -18,23 +18,24 @@ namespace scenewatch::pipeline {
 struct SupportContact {
   std::size_t contacts = 0;  ///< band pixels next to the cluster's pixels whose normal could be measured
   std::size_t flat = 0;      ///< of them, facing within 45 degrees of the support's up
-  /// Rests on the support: a quarter or more of the contacts face up, or there is no contact to
-  /// judge by (a foot hidden behind the object, an unorganized cloud). A resting object's contacts
-  /// are the support around its foot and the lowest strip of its own side, which lies in the
-  /// band too; beyond that strip the patch reaches the support, so about half or more face up
-  /// (hrt1's bin 47-67 %, the toy 63-100 %). A crossing surface's contacts are its own, facing
-  /// sideways (hrt1's chair back 0-21 %, its seat 0-29 %). A quarter lies between the two; the
-  /// tracker asks for it in consecutive sightings both ways.
-  bool rests() const { return contacts == 0 || 4 * flat >= contacts; }
+  /// Rests on the support: half or more of the contacts face up, or there is no contact to judge
+  /// by (a foot hidden behind the object or by its neighbours, an unorganized cloud). A resting
+  /// object meets the support's top beyond its foot (hrt1's bin 94-99 % of its contacts face up,
+  /// the toy 94-100 %); a surface that runs on through the support's height meets only itself in
+  /// the band, facing sideways (hrt1's chair back 0-23 %, the rim of its seat 0-25 %).
+  bool rests() const { return contacts == 0 || 2 * flat >= contacts; }
 };
 
 /// The contacts of a cluster (`indices` into the organized camera-frame `cloud`) with its support,
 /// the plane up_camera . x + d_camera = 0 (up_camera a unit vector towards the objects): the
 /// pixels 4-adjacent to the cluster's, outside it, within `band_m` of the plane and within
 /// `link_m` of the cluster's pixel in 3D. Each contact's normal is measured on a `patch_m` patch
-/// (at its depth, with the intrinsics `K`) beyond it, away from the cluster: the surface the
-/// cluster meets there, not the cluster's own side. A patch that leaves the image or holds a
-/// pixel without depth is not counted.
+/// (at its depth, with the intrinsics `K`) one patch beyond it, away from the cluster: the surface
+/// the cluster meets there, not the strip of its own side that lies in the band too. A patch that
+/// leaves the image, holds a pixel without depth or leaves the band is not counted: so what is
+/// seen is a surface that lies in the support's band beside the foot, sideways (a chair's curved
+/// back or the rim of its seat, meeting the table's height at a slant), not a post that crosses
+/// it upright (its side leaves the band within a patch).
 SupportContact support_contact(const std::vector<int>& indices, const Cloud& cloud, const Intrinsics& K,
                                const Eigen::Vector3d& up_camera, double d_camera, double band_m, double link_m,
                                double patch_m);
