@@ -8,8 +8,8 @@
 #include <thread>
 
 #include "scenewatch/io/cloud_io.h"
-#include "scenewatch/pipeline/config_loader.h"
 #include "scenewatch/pipeline/working_memory.h"
+#include "shipped_config.h"
 #include "test_data.h"
 
 namespace scenewatch::pipeline {
@@ -439,18 +439,13 @@ TEST(WorkingMemory, RealKinectFrame) {
 // test59's sponge, given the plane of a book's top beside it, with the table 3 cm lower.
 TEST(WorkingMemory, EveryObjectOfAMosdPileIsListed) {
   SCENEWATCH_REQUIRE_DATA("mosd/test_dev/test59.pcd");
-  std::vector<std::string> sections = pipeline_sections();
-  sections.push_back("server");  // the daemon's own sections
-  sections.push_back("ontology");
-  auto root = load_yaml_file(test::source_dir() / "config/scenewatchd.yaml", sections);
-  ASSERT_TRUE(root) << root.error().message;
-  Config shipped;
-  ASSERT_TRUE(read_pipeline_config(*root, shipped).ok());
+  const std::optional<Config> shipped = test::shipped_pipeline_config();
+  ASSERT_TRUE(shipped);
   std::size_t clusters = 0, listed = 0;
   for (int n = 43; n <= 59; ++n) {
     auto file = io::read_cloud(test::data_dir() / ("mosd/test_dev/test" + std::to_string(n) + ".pcd"));
     ASSERT_TRUE(file.ok()) << file.error().message;
-    WorkingMemory wm(shipped);
+    WorkingMemory wm(*shipped);
     Frame f;
     f.cloud = file->cloud;
     f.stamp_s = 1;

@@ -10,6 +10,7 @@
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/pipeline/config_loader.h"
 #include "scenewatch/pipeline/working_memory.h"
+#include "shipped_config.h"
 #include "test_data.h"
 
 namespace scenewatch::pipeline {
@@ -28,13 +29,9 @@ namespace {
 // the table's edge (listed in frames 4-7 and 14-31), pieces by the person (frames 0-13, 17-18,
 // 29-31) and by the hand (from frame 40).
 void expect_table_up_on_every_frame(const std::string& name, std::size_t max_objects, std::size_t max_at_end) {
-  std::vector<std::string> sections = pipeline_sections();
-  sections.push_back("server");  // the daemon's own sections
-  sections.push_back("ontology");
-  auto root = load_yaml_file(test::source_dir() / "config/scenewatchd.yaml", sections);
-  ASSERT_TRUE(root) << root.error().message;
-  Config config;
-  ASSERT_TRUE(read_pipeline_config(*root, config).ok());
+  const std::optional<Config> shipped = test::shipped_pipeline_config();
+  ASSERT_TRUE(shipped);
+  const Config& config = *shipped;
   ASSERT_FALSE(config.segmentation.up) << "the shipped config sets no up: the test is about finding it";
   auto seq = io::open_sequence(test::data_dir() / "hrt1" / name);
   ASSERT_TRUE(seq) << seq.error().message;
