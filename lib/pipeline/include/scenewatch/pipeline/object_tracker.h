@@ -15,9 +15,10 @@
 /// it was but no cluster stands for it there (a piece of a larger object, a fragment of an edge)
 /// in as many frames in a row as half its sightings, at least `gone_frames`. A cluster that lies
 /// mostly in a hand, an arm or the person's box starts no track, nor does one that lies mostly on
-/// a listed object's surface as its fullest view saw it (a piece of it), and an object whose place the
-/// frame sees on the person's body in `gone_frames` frames leaves (never part of a person: a body
-/// in view before the hand detector found its arm was listed at first sight).
+/// a listed object's surface as its fullest view saw it (a piece of it), nor one that does not rest
+/// on its support (TrackerObservation::rests); an object whose place the frame sees on the
+/// person's body in `gone_frames` frames leaves (never part of a person: a body in view before the
+/// hand detector found its arm was listed at first sight).
 ///
 /// The tracker raises no events: what changed in the scene is reported once, by the change
 /// detector (OBJECT_ADDED / OBJECT_REMOVED / OBJECT_MOVED); the list is what GetObjects returns.
@@ -65,9 +66,10 @@ struct TrackerObservation {
   /// box grown by the segmentation's link distance): fingers and sleeves cut off the hand, a shirt
   /// or a leg the detector left out. It keeps a listed object's track but starts none.
   bool touches_person = false;
-  /// It rests on its support (pipeline/src/support_contact.h): most pixels next to its foot in the
-  /// support's band face up. A cluster that crosses the support's height instead (the back of a
-  /// chair beside a table, a person's body) keeps a listed object's track but starts none.
+  /// It rests on its support (pipeline/src/support_contact.h): half or more of the surface beside
+  /// its foot, in the support's band, faces up (or none of it could be judged). A cluster that
+  /// crosses the support's height instead (the back of a chair beside a table) starts no track, and
+  /// a listed object seen so in `gone_frames` sightings in a row leaves.
   bool rests = true;
 };
 
