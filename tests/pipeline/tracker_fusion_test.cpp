@@ -1,6 +1,7 @@
 // The object list's hysteresis and the one-fact-one-event rules, each on hand-made inputs.
 #include <gtest/gtest.h>
 
+#include <functional>
 #include <memory>
 
 #include "scenewatch/pipeline/event_fusion.h"
@@ -20,8 +21,13 @@ TrackerObservation seen_at(double x, double y, double range_m = 1.0) {
   return o;
 }
 
-const ObjectTracker::FreeFraction kSeenFree = [](const std::vector<Eigen::Vector3d>&) { return 1.0; };
-const ObjectTracker::FreeFraction kOccluded = [](const std::vector<Eigen::Vector3d>&) { return 0.0; };
+// The tracker's evidence callbacks, answering the same share for any points.
+std::function<double(const std::vector<Eigen::Vector3d>&)> share(double s) {
+  return [s](const std::vector<Eigen::Vector3d>&) { return s; };
+}
+
+const ObjectTracker::FreeFraction kSeenFree = share(1.0);
+const ObjectTracker::FreeFraction kOccluded = share(0.0);
 
 TEST(ObjectTracker, JoinsAfterConfirmFramesAndNoiseNeverJoins) {
   TrackingConfig config;
@@ -119,8 +125,7 @@ TEST(ObjectTracker, StripsNarrowerThanTheSensorResolvesAreNotObjects) {
 TEST(ObjectTracker, SeenInPlaceWithoutAClusterLeavesAfterHalfItsSightings) {
   TrackingConfig config;
   config.gone_frames = 2;
-  const ObjectTracker::SeenFraction seen = [](const std::vector<Eigen::Vector3d>&) { return 1.0; };
-  const ObjectTracker::SeenFraction hidden = [](const std::vector<Eigen::Vector3d>&) { return 0.0; };
+  const ObjectTracker::SeenFraction seen = share(1.0), hidden = share(0.0);
   ObjectTracker tracker(config);
   for (int i = 0; i < 10; ++i) tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, i, kOccluded, seen);
   tracker.update({seen_at(0.3, 0), seen_at(0.6, 0)}, 10, kOccluded, seen);  // a fragment at 0.6, twice
@@ -160,8 +165,7 @@ TEST(ObjectTracker, PiecesOfAPersonStartNoTrack) {
 TEST(ObjectTracker, AnObjectWhosePlaceIsSeenOnThePersonLeaves) {
   TrackingConfig config;
   config.gone_frames = 2;
-  const ObjectTracker::SeenFraction on_person = [](const std::vector<Eigen::Vector3d>&) { return 1.0; };
-  const ObjectTracker::SeenFraction elsewhere = [](const std::vector<Eigen::Vector3d>&) { return 0.0; };
+  const ObjectTracker::PersonFraction on_person = share(1.0), elsewhere = share(0.0);
   ObjectTracker tracker(config);
   for (int i = 0; i < 10; ++i) tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, i, kOccluded, {}, elsewhere);
   tracker.update({seen_at(0, 0)}, 10, kOccluded, {}, on_person);

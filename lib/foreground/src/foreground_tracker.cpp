@@ -20,7 +20,7 @@
 #include "reacquisition.h"
 #include "skin_model.h"
 #include "touched_object.h"
-#include "voxel_set.h"
+#include "scenewatch/core/voxel_set.h"
 
 namespace scenewatch::foreground {
 namespace {

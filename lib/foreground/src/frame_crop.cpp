@@ -6,7 +6,7 @@
 #include <cmath>
 
 #include "object_points.h"
-#include "voxel_set.h"
+#include "scenewatch/core/voxel_set.h"
 
 namespace scenewatch::foreground {
 namespace {

@@ -5,7 +5,7 @@
 #include <vector>
 
 #include "scenewatch/foreground/foreground_tracker.h"
-#include "voxel_set.h"
+#include "scenewatch/core/voxel_set.h"
 
 namespace scenewatch::foreground {
 

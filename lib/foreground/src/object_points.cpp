@@ -1,7 +1,7 @@
 // Points of objects and clusters (object_points.h), as the foreground tracker had them.
 #include "object_points.h"
 
-#include "voxel_set.h"
+#include "scenewatch/core/voxel_set.h"
 
 namespace scenewatch::foreground {
 

@@ -2,7 +2,7 @@
 #include "point_model.h"
 
 #include "skin_model.h"
-#include "voxel_set.h"
+#include "scenewatch/core/voxel_set.h"
 
 namespace scenewatch::foreground {
 

@@ -9,7 +9,7 @@
 
 #include "frame_crop.h"
 #include "object_points.h"
-#include "voxel_set.h"
+#include "scenewatch/core/voxel_set.h"
 
 namespace scenewatch::foreground {
 namespace {

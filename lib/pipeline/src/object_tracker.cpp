@@ -1,12 +1,9 @@
 #include "scenewatch/pipeline/object_tracker.h"
 
-#include <tsl/robin_set.h>
-
 #include <algorithm>
-#include <cmath>
 #include <tuple>
 
-#include "scenewatch/core/hash.h"
+#include "scenewatch/core/voxel_set.h"
 
 namespace scenewatch::pipeline {
 namespace {
@@ -34,29 +31,15 @@ std::vector<int> match(const std::vector<TrackerObservation>& obs, const std::ve
   return obs_to_known;
 }
 
-std::uint64_t cell_of(const Eigen::Vector3d& p, double cell_m) {
-  const auto c = [&](double x) { return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x / cell_m)) + (1 << 20)) & 0x1fffff; };
-  return (c(p.x()) << 42) | (c(p.y()) << 21) | c(p.z());
-}
-
 // The share of `samples` within a cell (or its 26 neighbours) of `surface`'s points, on cells of
 // `cell_m`: how much of an observation lies on a surface remembered for an object.
 double share_on_surface(const std::vector<Eigen::Vector3d>& samples, const std::vector<Eigen::Vector3d>& surface,
                         double cell_m) {
   if (samples.empty() || surface.empty() || !(cell_m > 0)) return 0.0;
-  tsl::robin_set<std::uint64_t, MixHash64> cells;
-  cells.reserve(surface.size());
-  for (const auto& p : surface) cells.insert(cell_of(p, cell_m));
-  std::size_t n = 0;
-  for (const auto& p : samples) {
-    bool near = false;
-    for (int dx = -1; dx <= 1 && !near; ++dx)
-      for (int dy = -1; dy <= 1 && !near; ++dy)
-        for (int dz = -1; dz <= 1 && !near; ++dz)
-          near = cells.count(cell_of(p + cell_m * Eigen::Vector3d(dx, dy, dz), cell_m)) > 0;
-    n += near;
-  }
-  return static_cast<double>(n) / static_cast<double>(samples.size());
+  VoxelSet cells(cell_m);
+  for (const auto& p : surface) cells.insert(p);
+  const auto near = std::count_if(samples.begin(), samples.end(), [&](const Eigen::Vector3d& p) { return cells.near(p); });
+  return static_cast<double>(near) / static_cast<double>(samples.size());
 }
 
 }  // namespace

@@ -1,13 +1,14 @@
 #pragma once
-// A set of occupied voxels for "is there a point within about one voxel of p" questions: cheaper
-// than a k-d tree for the few thousand points of an object or a hand.
+/// A set of occupied voxels for "is there a point within about one voxel of p" questions: cheaper
+/// than a k-d tree for the few thousand points of an object or a hand (the foreground's contacts
+/// and masks, the object list's remembered surfaces).
 #include <cmath>
 #include <cstdint>
 #include <unordered_set>
 
 #include <Eigen/Core>
 
-namespace scenewatch::foreground {
+namespace scenewatch {
 
 class VoxelSet {
  public:
@@ -57,4 +58,4 @@ class VoxelSet {
   std::unordered_set<std::uint64_t> set_;
 };
 
-}  // namespace scenewatch::foreground
+}  // namespace scenewatch
