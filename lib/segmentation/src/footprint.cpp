@@ -18,9 +18,12 @@ Footprint footprint(const Cloud& cloud, const std::vector<int>& part, const Eige
   }
   f.hull = convex_hull(f.points);
   if (!heights.empty()) {
-    std::sort(heights.begin(), heights.end());
-    f.low = heights[heights.size() / 20];
-    f.high = heights[heights.size() - 1 - heights.size() / 20];
+    // The 5th and 95th percentiles: two selections, not a sort.
+    const std::size_t k = heights.size() / 20, n = heights.size();
+    std::nth_element(heights.begin(), heights.begin() + static_cast<std::ptrdiff_t>(k), heights.end());
+    f.low = heights[k];
+    std::nth_element(heights.begin() + static_cast<std::ptrdiff_t>(k), heights.begin() + static_cast<std::ptrdiff_t>(n - 1 - k), heights.end());
+    f.high = heights[n - 1 - k];
   }
   return f;
 }

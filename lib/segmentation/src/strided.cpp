@@ -105,18 +105,25 @@ Segmentation segment_strided(const Cloud& cloud, const Config& config, const Eig
   }
   const int w = static_cast<int>(cloud.width), h = static_cast<int>(cloud.height), sw = static_cast<int>(samples.width);
   for (Plane& plane : out.planes) {
+    // The samples row by row (make_plane lists them in index order), and each row of samples
+    // pixel row by pixel row: the pixels come out in index order without a sort.
+    if (!std::is_sorted(plane.indices.begin(), plane.indices.end())) std::sort(plane.indices.begin(), plane.indices.end());
     std::vector<int> pixels;
     pixels.reserve(plane.indices.size() * static_cast<std::size_t>(area));
-    for (int s : plane.indices) {
-      const int u0 = s % sw * stride, v0 = s / sw * stride;
-      for (int v = v0; v < std::min(h, v0 + stride); ++v)
-        for (int u = u0; u < std::min(w, u0 + stride); ++u) {
-          const PointT& p = cloud.points[static_cast<std::size_t>(v) * w + u];
-          if (is_valid(p) && std::abs(plane.signed_distance(p.getVector3fMap().cast<double>())) <= config.plane_distance_m)
-            pixels.push_back(v * w + u);
+    for (auto row = plane.indices.begin(); row != plane.indices.end();) {
+      const int sv = *row / sw;
+      const auto row_end = std::find_if(row, plane.indices.end(), [&](int s) { return s / sw != sv; });
+      for (int v = sv * stride; v < std::min(h, (sv + 1) * stride); ++v)
+        for (auto s = row; s != row_end; ++s) {
+          const int u0 = *s % sw * stride;
+          for (int u = u0; u < std::min(w, u0 + stride); ++u) {
+            const PointT& p = cloud.points[static_cast<std::size_t>(v) * w + u];
+            if (is_valid(p) && std::abs(plane.signed_distance(p.getVector3fMap().cast<double>())) <= config.plane_distance_m)
+              pixels.push_back(v * w + u);
+          }
         }
+      row = row_end;
     }
-    std::sort(pixels.begin(), pixels.end());
     plane.indices = std::move(pixels);
     plane.inlier_count = plane.indices.size();
   }

@@ -456,19 +456,21 @@ std::vector<Piece> euclidean_clusters(const Cloud& cloud, const VoxelIndex& grid
   // wall, a cabinet) and takes its cluster out.
   std::vector<char> attached(object_voxels.size(), 0);
   const VoxelColumns columns(grid);
-  for (std::size_t i = 0; i < object_voxels.size(); ++i) {
-    const int v = object_voxels[i];
-    columns.for_each_near(grid.coords[v], reach, [&](int w, int dx, int dy, int dz) {
-      if ((centroids[w] - centroids[v]).squaredNorm() > tol2) return;
-      if (local[w] < 0) {
-        if (!in_plane[w] && frames[owner[v]].model.distance(centroids[w]) > cfg.max_object_height_m) attached[i] = 1;
-        return;
-      }
-      // Each unordered pair once: only neighbours after this voxel in lexicographic order.
-      if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dz <= 0)))) return;
-      if (owner[w] == owner[v]) uf.unite(static_cast<int>(i), local[w]);
-    });
-  }
+  // Each pair of neighbours once, in no set order: the partition and the flags do not depend on it.
+  // Plane voxels that are no object voxels take no part.
+  columns.for_each_pair(
+      reach, [&](int v) { return local[v] >= 0 || !in_plane[v]; },
+      [&](int a, int b) {
+        if ((centroids[a] - centroids[b]).squaredNorm() > tol2) return;
+        const int ia = local[a], ib = local[b];
+        if (ia >= 0 && ib >= 0) {
+          if (owner[a] == owner[b]) uf.unite(ia, ib);
+        } else if (ia >= 0) {
+          if (frames[owner[a]].model.distance(centroids[b]) > cfg.max_object_height_m) attached[ia] = 1;
+        } else if (ib >= 0) {
+          if (frames[owner[b]].model.distance(centroids[a]) > cfg.max_object_height_m) attached[ib] = 1;
+        }
+      });
   for (std::size_t i = 0; i < object_voxels.size(); ++i) {
     if (attached[i]) attached[uf.find(static_cast<int>(i))] = 1;
   }

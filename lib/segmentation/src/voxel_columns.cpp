@@ -1,5 +1,7 @@
 #include "voxel_columns.h"
 
+#include <algorithm>
+
 namespace scenewatch::segmentation {
 
 VoxelColumns::VoxelColumns(const VoxelIndex& grid) {
@@ -9,11 +11,14 @@ VoxelColumns::VoxelColumns(const VoxelIndex& grid) {
   for (std::size_t v = 0; v < n; ++v) {
     const auto& c = grid.coords[v];
     const auto [it, inserted] = columns_.try_emplace(pack(c[0], c[1]), static_cast<int>(offsets_.size()));
-    if (inserted) offsets_.push_back(0);
+    if (inserted) {
+      offsets_.push_back(0);
+      xy_.push_back({c[0], c[1]});
+    }
     column_of[v] = it->second;
     ++offsets_[it->second];
   }
-  // Counts become offsets; voxels enter their column in index order.
+  // Counts become offsets; voxels enter their column in index order, then go in order of z.
   offsets_.push_back(0);
   int running = 0;
   for (int& o : offsets_) {
@@ -24,6 +29,9 @@ VoxelColumns::VoxelColumns(const VoxelIndex& grid) {
   entries_.resize(n);
   std::vector<int> fill(offsets_.begin(), offsets_.end() - 1);
   for (std::size_t v = 0; v < n; ++v) entries_[fill[column_of[v]]++] = {grid.coords[v][2], static_cast<int>(v)};
+  for (std::size_t c = 0; c < xy_.size(); ++c)
+    std::sort(entries_.begin() + offsets_[c], entries_.begin() + offsets_[c + 1],
+              [](const Entry& a, const Entry& b) { return a.z < b.z || (a.z == b.z && a.voxel < b.voxel); });
 }
 
 }  // namespace scenewatch::segmentation

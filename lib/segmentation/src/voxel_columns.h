@@ -1,8 +1,11 @@
 #pragma once
 // The voxels of a VoxelIndex grouped in columns along the grid's third axis, for neighbourhood
-// queries: the voxels within `reach` of a voxel take one hash lookup per column (25 at reach 2)
-// instead of one per cell (125). Camera-frame clouds hold few voxels per column (the third axis
-// is depth), so scanning a column's short list costs little.
+// queries. Each column is sorted along that axis. The pairs within reach are found column by
+// column: the neighbouring columns ahead of a column are looked up once for it, not once per voxel,
+// and each is read through a window that slides along it as the voxels of the column rise; each
+// pair is found once, from the earlier of its two columns. A camera
+// looking across a floor or a table sees long columns (the third axis is depth): per-voxel lookups
+// were most of hrt1's clustering (16 ms of a 47 ms segmentation, 28,000 object voxels).
 #include <tsl/robin_map.h>
 
 #include <array>
@@ -17,19 +20,37 @@ class VoxelColumns {
  public:
   explicit VoxelColumns(const VoxelIndex& grid);
 
-  /// Calls f(w, dx, dy, dz) for every voxel w with |dx|, |dy|, |dz| <= reach from coords c
-  /// (c itself included).
-  template <typename F>
-  void for_each_near(const std::array<int, 3>& c, int reach, F&& f) const {
-    for (int dx = -reach; dx <= reach; ++dx)
-      for (int dy = -reach; dy <= reach; ++dy) {
-        const auto it = columns_.find(pack(c[0] + dx, c[1] + dy));
-        if (it == columns_.end()) continue;
-        for (int k = offsets_[it->second]; k < offsets_[it->second + 1]; ++k) {
-          const int dz = entries_[k].z - c[2];
-          if (dz >= -reach && dz <= reach) f(entries_[k].voxel, dx, dy, dz);
+  /// Calls f(a, b) once for every unordered pair of distinct voxels a, b with keep(a) and keep(b)
+  /// and |dx|, |dy|, |dz| <= reach between them. The order of the pairs is unspecified.
+  template <typename Keep, typename F>
+  void for_each_pair(int reach, Keep&& keep, F&& f) const {
+    struct Window {
+      const Entry* begin;
+      const Entry* end;
+    };
+    std::vector<Window> ahead;  // the columns after this one: dx > 0, or dx == 0 and dy > 0
+    ahead.reserve(static_cast<std::size_t>((2 * reach + 1) * reach + reach));
+    for (std::size_t c = 0; c < xy_.size(); ++c) {
+      const Entry* first = entries_.data() + offsets_[c];
+      const Entry* last = entries_.data() + offsets_[c + 1];
+      ahead.clear();
+      for (int dx = 0; dx <= reach; ++dx)
+        for (int dy = dx == 0 ? 1 : -reach; dy <= reach; ++dy) {
+          const auto it = columns_.find(pack(xy_[c][0] + dx, xy_[c][1] + dy));
+          if (it != columns_.end()) ahead.push_back({entries_.data() + offsets_[it->second], entries_.data() + offsets_[it->second + 1]});
+        }
+      for (const Entry* e = first; e != last; ++e) {
+        if (!keep(e->voxel)) continue;
+        // The own column: the voxels above this one (one voxel per cell, so none at the same z).
+        for (const Entry* k = e + 1; k != last && k->z <= e->z + reach; ++k)
+          if (keep(k->voxel)) f(e->voxel, k->voxel);
+        for (Window& w : ahead) {
+          while (w.begin != w.end && w.begin->z < e->z - reach) ++w.begin;  // e->z only rises
+          for (const Entry* k = w.begin; k != w.end && k->z <= e->z + reach; ++k)
+            if (keep(k->voxel)) f(e->voxel, k->voxel);
         }
       }
+    }
   }
 
  private:
@@ -41,8 +62,9 @@ class VoxelColumns {
     return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) | static_cast<std::uint32_t>(y);
   }
   tsl::robin_map<std::uint64_t, int, MixHash64> columns_;  ///< (x, y) -> column
+  std::vector<std::array<int, 2>> xy_;                     ///< per column: its (x, y)
   std::vector<int> offsets_;                               ///< CSR: entries of column c are [offsets_[c], offsets_[c + 1])
-  std::vector<Entry> entries_;
+  std::vector<Entry> entries_;                             ///< within a column, by z (then voxel)
 };
 
 }  // namespace scenewatch::segmentation
