@@ -229,14 +229,7 @@ std::vector<MissingVoxel> missing_surfaces(const background::DenseGrid& grid, co
 }
 }  // namespace
 
-Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& cloud, const Pose& T,
-                                      const Intrinsics& K, const Config& config, background::DenseGrid* grid_scratch,
-                                      const SurfaceWitness* witness, std::uint32_t camera) {
-  if (!K.valid()) return invalid_argument("mismatch: intrinsics are invalid");
-  Mismatch out;
-  out.voxel_m = map.resolution();
-  const auto t0 = Clock::now();
-  // 1. A dense copy of the map over the frame's rays: the camera and every valid point.
+std::optional<Aabb> comparison_box(const Cloud& cloud, const Pose& T, const Config& config, double res) {
   const Eigen::Isometry3f Tf = T.cast<float>();
   Aabb box;
   box.min = box.max = T.translation();
@@ -248,13 +241,29 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
     box.max = box.max.cwiseMax(w);
     ++valid;
   }
-  if (valid == 0) return Mismatch{};  // nothing within range: nothing to claim
-  const double res = map.resolution();
+  if (valid == 0) return std::nullopt;
   box.min.array() -= 2 * res;
   box.max.array() += 2 * res;
+  return box;
+}
+
+Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& cloud, const Pose& T,
+                                      const Intrinsics& K, const Config& config, background::DenseGrid* grid_scratch,
+                                      const SurfaceWitness* witness, std::uint32_t camera, bool grid_filled) {
+  if (!K.valid()) return invalid_argument("mismatch: intrinsics are invalid");
+  Mismatch out;
+  out.voxel_m = map.resolution();
+  const auto t0 = Clock::now();
+  const double res = map.resolution();
+  const Eigen::Isometry3f Tf = T.cast<float>();
+  // 1. A dense copy of the map over the frame's rays: the camera and every valid point.
+  const std::optional<Aabb> box = comparison_box(cloud, T, config, res);
+  if (!box) return Mismatch{};  // nothing within range: nothing to claim
   background::DenseGrid local;
   background::DenseGrid& grid = grid_scratch != nullptr ? *grid_scratch : local;
-  if (auto filled = map.fill_dense_grid(box, grid, config.max_grid_voxels); !filled) return filled.error();
+  if (!(grid_filled && grid_scratch != nullptr)) {
+    if (auto filled = map.fill_dense_grid(*box, grid, config.max_grid_voxels); !filled) return filled.error();
+  }
   out.grid_ms = ms_since(t0);
 
   // What the sensor model makes of each pixel (in range, off the border, away from depth edges and

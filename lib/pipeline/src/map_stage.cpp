@@ -53,12 +53,19 @@ MapStage::MapStage(const Config& c, std::shared_ptr<change::PendingIds> pending_
 // left without change detection.
 ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
                                        const change::Config& config, std::uint32_t camera) {
+  const bool prefilled = prefilled_.valid() && prefilled_.get();
   ChangeOutcome out;
   if (!K) return out;
   out.K = *K;
   std::shared_lock<std::shared_mutex> read(mutex_);
+  bool grid_filled = false;
+  if (prefilled) {
+    const auto box = change::comparison_box(*frame.cloud, T, config, map_.resolution());
+    const double eps = 1e-6 * map_.resolution();  // as the fill's key range: faces on a voxel boundary
+    grid_filled = box && map_grid_.index_of(box->min.array() + eps) >= 0 && map_grid_.index_of(box->max.array() - eps) >= 0;
+  }
   auto mismatch = change::mismatch_against_map(map_, *frame.cloud, T, *K, config, &map_grid_,
-                                               config.witness_per_camera ? &witness_ : nullptr, camera);
+                                               config.witness_per_camera ? &witness_ : nullptr, camera, grid_filled);
   if (!mismatch) return out;
   {
     std::lock_guard<std::mutex> lock(pose_mutex_);
@@ -70,6 +77,15 @@ ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const 
   input.K_after = *K;
   out.confirmed = changes_.update(change::cluster_mismatch(*mismatch, input, config), &out.pending, &out.absorbed, camera);
   return out;
+}
+
+void MapStage::prefill(const Frame& frame, const Pose& T, const change::Config& config) {
+  if (prefilled_.valid()) prefilled_.wait();  // a fill no update() took (a frame that failed)
+  prefilled_ = std::async(std::launch::async, [this, cloud = frame.cloud, T, config] {
+    std::shared_lock<std::shared_mutex> read(mutex_);
+    const auto box = change::comparison_box(*cloud, T, config, map_.resolution());
+    return box && map_.fill_dense_grid(*box, map_grid_, config.max_grid_voxels).ok();
+  });
 }
 
 ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
@@ -137,6 +153,8 @@ std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d&
 }
 
 void MapStage::reset() {
+  if (prefilled_.valid()) prefilled_.wait();
+  prefilled_ = {};
   {
     std::unique_lock<std::shared_mutex> write(mutex_);
     map_.reset();
@@ -150,6 +168,8 @@ void MapStage::reset() {
 }
 
 void MapStage::replace(background::OccupancyMap map) {
+  if (prefilled_.valid()) prefilled_.wait();
+  prefilled_ = {};
   {
     std::unique_lock<std::shared_mutex> write(mutex_);
     map_ = std::move(map);

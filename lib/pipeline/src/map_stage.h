@@ -6,6 +6,7 @@
 // writer lock; read() takes the map's shared lock and may run beside update()'s change detection.
 #include <cstdint>
 #include <functional>
+#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -40,6 +41,12 @@ class MapStage {
   /// segmentation and the image surprise, which do not read the map.
   ChangeOutcome update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
                        bool detect, FrameResult& result, std::uint32_t camera);
+
+  /// Starts filling the change detection's dense copy of the map around `frame` (placed with T)
+  /// on a thread of its own, to run beside the work before update() (the hands). update() waits
+  /// for it, and uses it when its box holds the box of the frame update() is given (the hands'
+  /// pixels blanked out of that frame can only shrink it); otherwise it fills the copy again.
+  void prefill(const Frame& frame, const Pose& T, const change::Config& config);
 
   /// The share of world points on surfaces the map remembers (occupied, within the change
   /// detector's tolerance along the ray from `camera`), for the foreground. The tolerance holds,
@@ -85,6 +92,7 @@ class MapStage {
   mutable std::shared_mutex mutex_;
   background::OccupancyMap map_;
   background::DenseGrid map_grid_;  // the change detector's dense copy of the map, its buffers kept between frames
+  std::future<bool> prefilled_;     // prefill()'s fill of map_grid_: true when it succeeded
   change::SurfaceWitness witness_;  // which cameras saw each surface of the map (guarded with it)
   change::PersistenceFilter changes_;  // owned by the writer
   // The pose agreement the change detector last measured, per camera.

@@ -5,6 +5,7 @@
 #include "scenewatch/pipeline/working_memory.h"
 
 #include <algorithm>
+#include <atomic>
 #include <future>
 #include <optional>
 
@@ -141,6 +142,12 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   result.frame_index = m.frames;
   result.points = *valid_points;
   const std::uint32_t camera_id = m.camera_of(original);
+  // The change detection's copy of the map is filled at the frame's given pose on a thread of
+  // its own, beside the colour registration, the localization and the hand detection, which the
+  // three parts below wait for (kitchen: a 6.4 ms fill against about 5 ms of those). A pose the
+  // localization moves so far that the copy no longer holds the frame's box has it filled again.
+  const bool detect = config_.change_enabled && m.frames > 0;
+  if (detect && original.T_world_camera && frame_camera(original)) m.map.prefill(original, *original.T_world_camera, config_.change);
   const Frame registered = m.colour.registered(original, camera_id);
   // Where the frame was taken, against the memory; a camera that is lost changes nothing.
   result.localization = m.localizer.localize(
@@ -162,23 +169,30 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   // Three independent parts, each against the memory as it stands before this frame: the
   // geometric change detection with the map update (the octree), the image surprise (keyframes
   // and mesh) and the segmentation of the frame. None reads what another writes; the tracker and
-  // the event fusion below need all three. Two threads for two cores: the map's part, the longest
-  // (the insertion must wait for the change detection), on one; the other two one after the
-  // other on this one. Three threads made the three share two cores, and the map's part, which
-  // the frame waits for, ran at two thirds of a core (kitchen 76.6 -> 57.0 ms per frame).
+  // the event fusion below need all three. Two threads for two cores: the map's part (the
+  // insertion must wait for the change detection) on one, the segmentation on this one, and the
+  // image surprise on whichever is free first. Three threads made the three share two cores, and
+  // the map's part, which the frame waited for, ran at two thirds of a core (kitchen 76.6 -> 57.0
+  // ms per frame). The map's part is the longest in a room (kitchen: 34 against 14 and 14 ms);
+  // with a person or a table across the view the segmentation is (hrt1: 32 against 22 for the
+  // map), and the surprise fixed on this thread made the frame wait for both.
   const auto known_surfaces = m.known.current(*std::atomic_load(&m.snapshot));
   const std::optional<Intrinsics> camera = frame_camera(seen);
-  const auto t_parallel = Clock::now();
-  auto map_update = std::async(std::launch::async, [&] {
-    return m.map.update(seen, T, camera, config_, config_.change_enabled && m.frames > 0, result, camera_id);
-  });
-  {
+  std::atomic<bool> surprise_taken{false};
+  const auto image_surprise = [&] {
+    if (surprise_taken.exchange(true)) return;
     const auto t_surprise = Clock::now();
     result.surprise = m.appearance.process(seen, known_surfaces, camera_id);  // then its keyframe update
     result.surprise_ms = ms_since(t_surprise);
-  }
-
+  };
+  const auto t_parallel = Clock::now();
+  auto map_update = std::async(std::launch::async, [&] {
+    ChangeOutcome out = m.map.update(seen, T, camera, config_, detect, result, camera_id);
+    image_surprise();
+    return out;
+  });
   segment_frame(seen, T, camera, config_, result);  // in the camera frame, then moved to the world
+  image_surprise();
 
   const ChangeOutcome changed = map_update.get();
   result.parallel_ms = ms_since(t_parallel);

@@ -146,10 +146,19 @@ struct Mismatch {
 /// so that its buffers are allocated once. With `witness`, the observation's camera (`camera`)
 /// claims nothing against a surface only other cameras have seen: a point in free space whose ray
 /// meets such a surface behind it, a voxel only they saw (surface_witness.h).
+///
+/// `grid_filled`: `grid_scratch` already holds the map around comparison_box() of this
+/// observation or a larger box (filled ahead, beside other work); it is used as it is.
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& points_camera,
                                       const Pose& T_world_camera, const Intrinsics& K, const Config& config,
                                       background::DenseGrid* grid_scratch = nullptr, const SurfaceWitness* witness = nullptr,
-                                      std::uint32_t camera = 0);
+                                      std::uint32_t camera = 0, bool grid_filled = false);
+
+/// The box of the map mismatch_against_map() compares an observation with: its points within
+/// max_range_m, placed in the world, widened by two voxels of `resolution_m`. Nullopt when no
+/// point is within range.
+std::optional<Aabb> comparison_box(const Cloud& points_camera, const Pose& T_world_camera, const Config& config,
+                                   double resolution_m);
 
 /// Same-camera pair of organized clouds of equal size (the camera did not move): exact per-pixel
 /// reasoning. A pixel whose AFTER depth is in front of BEFORE by more than the tolerance is added
