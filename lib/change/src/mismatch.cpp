@@ -257,11 +257,11 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   const double res = map.resolution();
   const Eigen::Isometry3f Tf = T.cast<float>();
   // 1. A dense copy of the map over the frame's rays: the camera and every valid point.
-  const std::optional<Aabb> box = comparison_box(cloud, T, config, res);
-  if (!box) return Mismatch{};  // nothing within range: nothing to claim
   background::DenseGrid local;
   background::DenseGrid& grid = grid_scratch != nullptr ? *grid_scratch : local;
-  if (!(grid_filled && grid_scratch != nullptr)) {
+  if (!(grid_filled && grid_scratch != nullptr)) {  // a filled grid's caller found the box (and a point in range)
+    const std::optional<Aabb> box = comparison_box(cloud, T, config, res);
+    if (!box) return Mismatch{};  // nothing within range: nothing to claim
     if (auto filled = map.fill_dense_grid(*box, grid, config.max_grid_voxels); !filled) return filled.error();
   }
   out.grid_ms = ms_since(t0);

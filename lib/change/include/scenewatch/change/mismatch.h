@@ -148,7 +148,8 @@ struct Mismatch {
 /// meets such a surface behind it, a voxel only they saw (surface_witness.h).
 ///
 /// `grid_filled`: `grid_scratch` already holds the map around comparison_box() of this
-/// observation or a larger box (filled ahead, beside other work); it is used as it is.
+/// observation or a larger box (filled ahead, beside other work), and that box was found (some
+/// point is within range); the grid is used as it is.
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& points_camera,
                                       const Pose& T_world_camera, const Intrinsics& K, const Config& config,
                                       background::DenseGrid* grid_scratch = nullptr, const SurfaceWitness* witness = nullptr,
