@@ -14,6 +14,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <chrono>
 #include <cmath>
@@ -399,9 +400,11 @@ TEST(Listening, ABadAddressNamesItsKeyAndATakenPortNamesTheEndpoint) {
 
 const char* const kChromium = "/usr/bin/chromium";
 
-/// Streams the simulator's cup_added (320x240, 12 frames per phase) into the daemon; returns
-/// the ground truth of where the cup was put.
-Eigen::Vector3d ingest_cup_added(const Daemon& daemon) {
+/// Renders the simulator's cup_added (320x240, 12 frames per phase) and hands each frame to
+/// `ingest`: the table's phase, then the first `cup_frames` of the cup's. Returns the ground truth
+/// of where the cup was put.
+template <class Ingest>
+Eigen::Vector3d render_cup_added(int cup_frames, const std::string& camera, Ingest ingest) {
   auto loaded = sim::load_scenario(source_dir() / "sample_clouds/scenarios/cup_added.yaml");
   EXPECT_TRUE(loaded.ok()) << loaded.error().message;
   if (!loaded.ok()) return {};
@@ -409,19 +412,28 @@ Eigen::Vector3d ingest_cup_added(const Daemon& daemon) {
   auto simulator = sim::Simulator::create(scenario);
   EXPECT_TRUE(simulator.ok()) << simulator.error().message;
   if (!simulator.ok()) return {};
-  service::Client client = daemon.connect();
   double stamp = 0;
   for (std::size_t phase = 0; phase < simulator->phase_count(); ++phase) {
-    for (int f = 0; f < simulator->frame_count(phase); ++f) {
+    const int frames = phase == 1 ? std::min(cup_frames, simulator->frame_count(phase)) : simulator->frame_count(phase);
+    for (int f = 0; f < frames; ++f) {
       auto frame = sim::as_frame(simulator->render(phase, f), scenario.intrinsics, stamp += 1.0 / 30);
       EXPECT_TRUE(frame.ok());
       if (!frame.ok()) return {};
-      proto::Request r;
-      *r.mutable_ingest_frame() = service::make_ingest_frame(*frame);
-      EXPECT_EQ(call(client, r).status().code(), proto::Status::OK);
+      frame->camera = camera;
+      ingest(*frame);
     }
   }
   return simulator->changes().at(0).added.at(0).T_world_object.translation();
+}
+
+/// Streams cup_added into the daemon, the cup's phase up to `cup_frames` (see render_cup_added).
+Eigen::Vector3d ingest_cup_added(const Daemon& daemon, int cup_frames = 12, const std::string& camera = "") {
+  service::Client client = daemon.connect();
+  return render_cup_added(cup_frames, camera, [&](const Frame& frame) {
+    proto::Request r;
+    *r.mutable_ingest_frame() = service::make_ingest_frame(frame);
+    EXPECT_EQ(call(client, r).status().code(), proto::Status::OK);
+  });
 }
 
 /// Reads /api/events (Server-Sent Events) until `wanted` came or timeout_s passed; returns what came.
@@ -456,6 +468,32 @@ CommandResult run_chromium(const fs::path& work_dir, const std::string& url, con
                       "--use-angle=swiftshader", "--user-data-dir=" + (work_dir / "chromium-profile").string(),
                       "--window-size=1280,800", "--hide-scrollbars", output_flag, url},
                      work_dir, 240.0);
+}
+
+/// The 3D view of a headless Chromium screenshot of `url` (saved at `shot`): right of the 440 px
+/// side column, below the header. Empty when there is none (the test has failed then).
+cv::Mat screenshot_3d_view(const fs::path& work_dir, const std::string& url, const fs::path& shot) {
+  const CommandResult screenshot = run_chromium(work_dir, url, "--screenshot=" + shot.string());
+  if (screenshot.exit_code != 0) {
+    ADD_FAILURE() << screenshot.err;
+    return {};
+  }
+  const cv::Mat image = cv::imread(shot.string(), cv::IMREAD_COLOR);
+  if (image.empty()) {
+    ADD_FAILURE() << "no screenshot at " << shot;
+    return {};
+  }
+  EXPECT_EQ(image.cols, 1280);
+  return image(cv::Rect(450, 40, image.cols - 450, image.rows - 40));
+}
+
+/// The pixels of a BGR image that `match` takes.
+template <class Match>
+int count_pixels(const cv::Mat& bgr_image, Match match) {
+  int n = 0;
+  for (int y = 0; y < bgr_image.rows; ++y)
+    for (int x = 0; x < bgr_image.cols; ++x) n += match(bgr_image.at<cv::Vec3b>(y, x)) ? 1 : 0;
+  return n;
 }
 
 // The views the last NextBestView suggested are in the state (both polls), as the API gave them,
@@ -533,29 +571,15 @@ TEST_F(LiveViewTest, ChromiumShowsTheObjectTheEventAndTheSuggestedViewsAfterACup
   EXPECT_NE(dom.out.find("3 suggested views (" + nbv.next_best_view().measure() + "), best first"), std::string::npos) << dom.out;
 
   const fs::path shot = tmp_ / "live-view.png";
-  const CommandResult screenshot = run_chromium(tmp_, url, "--screenshot=" + shot.string());
-  ASSERT_EQ(screenshot.exit_code, 0) << screenshot.err;
-  const cv::Mat image = cv::imread(shot.string(), cv::IMREAD_COLOR);
-  ASSERT_FALSE(image.empty()) << "no screenshot at " << shot;
-  EXPECT_EQ(image.cols, 1280);
-  // The 3D view is right of the 440 px side column; the boxes are drawn in pure magenta, a colour
-  // nothing else on the page has (the heatmap is a jet colour map over grey).
-  const cv::Mat view = image(cv::Rect(450, 40, image.cols - 450, image.rows - 40));
-  int magenta = 0;
-  for (int y = 0; y < view.rows; ++y)
-    for (int x = 0; x < view.cols; ++x) {
-      const cv::Vec3b bgr = view.at<cv::Vec3b>(y, x);
-      magenta += bgr[2] > 230 && bgr[0] > 230 && bgr[1] < 40;
-    }
+  const cv::Mat view = screenshot_3d_view(tmp_, url, shot);
+  ASSERT_FALSE(view.empty());
+  // The boxes are drawn in pure magenta, a colour nothing else on the page has (the heatmap is a
+  // jet colour map over grey, and in the side column besides).
+  const int magenta = count_pixels(view, [](const cv::Vec3b& bgr) { return bgr[2] > 230 && bgr[0] > 230 && bgr[1] < 40; });
   EXPECT_GT(magenta, 1000) << "the object's box is not drawn in the 3D view: " << shot;
   // The suggested views' frusta are drawn in cyan (#00e5ff, the best view; #00a0b4 the others),
   // a colour nothing else on the page has either (the voxels' lit blue-grey keeps some red).
-  int cyan = 0;
-  for (int y = 0; y < view.rows; ++y)
-    for (int x = 0; x < view.cols; ++x) {
-      const cv::Vec3b bgr = view.at<cv::Vec3b>(y, x);
-      cyan += bgr[2] < 50 && bgr[1] > 140 && bgr[0] > 160;
-    }
+  const int cyan = count_pixels(view, [](const cv::Vec3b& bgr) { return bgr[2] < 50 && bgr[1] > 140 && bgr[0] > 160; });
   EXPECT_GT(cyan, 200) << "the suggested views are not drawn in the 3D view: " << shot;
   std::printf("3D view: %d magenta pixels (the objects), %d cyan (the suggested views)\n", magenta, cyan);
   if (const char* keep = std::getenv("SCENEWATCH_LIVE_VIEW_SCREENSHOT")) fs::copy_file(shot, keep, fs::copy_options::overwrite_existing);
