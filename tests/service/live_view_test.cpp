@@ -3,7 +3,8 @@
 // servers refusing a bad address or a taken port, and headless Chromium on the page after a
 // simulated cup was put on the table: the event and the object with its class are in the page's
 // DOM, the object's box is drawn in the 3D view of the screenshot, and so are the views the last
-// NextBestView suggested, as camera frusta.
+// NextBestView suggested, as camera frusta;
+// the state's pending changes are the snapshot's, and empty when nothing is pending.
 #include <gtest/gtest.h>
 
 #include <arpa/inet.h>
@@ -32,6 +33,7 @@
 #include "scenewatch/service/http_request.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/service/http_server.h"
+#include "scenewatch/service/live_view.h"
 #include "scenewatch/service/server.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"
@@ -202,6 +204,10 @@ TEST_F(LiveViewTest, BadRequestsGetAnErrorAndTheDaemonKeepsServing) {
   EXPECT_NE(body_of(state).find("\"frames_processed\":0"), std::string::npos) << state;
   EXPECT_NE(body_of(state).find("\"voxels\":{"), std::string::npos) << state;
   EXPECT_EQ(body_of(get(http_port_, "/api/state?voxels=0")).find("\"voxels\""), std::string::npos) << "the light poll";
+  for (const char* target : {"/api/state", "/api/state?voxels=0"}) {
+    EXPECT_EQ(nlohmann::json::parse(body_of(get(http_port_, target))).at("pending"), nlohmann::json::array())
+        << target << ": nothing seen, nothing pending";
+  }
   EXPECT_EQ(status_of(get(http_port_, "/api/frame.png")), 404) << "no frame yet";
   EXPECT_EQ(body_of(get(http_port_, "/api/events?since=0")), "{\"events\":[]}");
   EXPECT_EQ(status_of(silent.get()), 408);
@@ -584,6 +590,38 @@ TEST_F(LiveViewTest, ChromiumShowsTheObjectTheEventAndTheSuggestedViewsAfterACup
   std::printf("3D view: %d magenta pixels (the objects), %d cyan (the suggested views)\n", magenta, cyan);
   if (const char* keep = std::getenv("SCENEWATCH_LIVE_VIEW_SCREENSHOT")) fs::copy_file(shot, keep, fs::copy_options::overwrite_existing);
   ASSERT_EQ(daemon_.terminate(), std::optional<int>(0)) << daemon_.log();
+}
+
+// ---- the changes seen but not yet confirmed (issue 31, item 4)
+
+// A camera's name is the frames' own (only control characters are refused): one that is not
+// UTF-8 must not cost the page its state. The live view on a working memory of its own (as the
+// daemon wires them), fed the same frames under such a name; the state agrees with the snapshot.
+TEST(LiveView, AStateWithACameraNameThatIsNotUtf8IsStillServed) {
+  pipeline::Config config;
+  config.segmentation.up = Eigen::Vector3d::UnitZ();
+  pipeline::WorkingMemory memory(config);
+  service::LiveView live(memory, {});
+  render_cup_added(1, "cam\xff", [&](const Frame& frame) {
+    auto processed = memory.process(frame);
+    EXPECT_TRUE(processed.ok()) << processed.error().message;
+  });
+  const auto snapshot = memory.snapshot();
+  ASSERT_FALSE(snapshot->pending.empty()) << "the cup's first frame leaves a change pending";
+  service::HttpRequest request;
+  request.method = "GET";
+  request.path = "/api/state";
+  const service::HttpResponse response = live.handle(request);
+  ASSERT_EQ(response.status, 200) << response.body;
+  const nlohmann::json pending = nlohmann::json::parse(response.body).at("pending");
+  ASSERT_EQ(pending.size(), snapshot->pending.size());
+  for (std::size_t k = 0; k < pending.size(); ++k) {
+    const change::PendingChange& c = snapshot->pending[k].change;
+    EXPECT_EQ(pending[k].at("id").get<std::uint64_t>(), c.id);
+    EXPECT_EQ(pending[k].at("box_world").at("min"), nlohmann::json::array({c.box_world.min.x(), c.box_world.min.y(), c.box_world.min.z()}));
+    EXPECT_EQ(pending[k].at("hits").get<int>(), c.hits);
+    EXPECT_EQ(pending[k].at("camera").get<std::string>(), "cam\xef\xbf\xbd") << "U+FFFD in place of the byte";
+  }
 }
 
 }  // namespace
