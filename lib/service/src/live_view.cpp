@@ -15,6 +15,7 @@
 #include "scenewatch/core/event_json.h"
 #include "scenewatch/core/scene_json.h"
 #include "scenewatch/io/image_io.h"
+#include "scenewatch/pipeline/scene_snapshot.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/surprise/surprise_map.h"
 
@@ -26,7 +27,9 @@ namespace {
 HttpResponse json_response(const json& j) {
   HttpResponse r;
   r.content_type = "application/json";
-  r.body = j.dump();
+  // A camera's name is the frames' (only control characters are refused): a byte that is not
+  // UTF-8 becomes U+FFFD rather than an exception, which would answer the whole state with 500.
+  r.body = j.dump(-1, ' ', false, json::error_handler_t::replace);
   return r;
 }
 
@@ -39,6 +42,31 @@ json event_json(const Event& event) {
   j.erase("indices_before");
   j.erase("indices_after");
   return j;
+}
+
+/// The names GetPendingChanges gives the kinds (scenewatch.proto, PendingChange.Kind).
+const char* pending_kind_name(change::PendingKind kind) {
+  switch (kind) {
+    case change::PendingKind::kAdded: return "ADDED";
+    case change::PendingKind::kRemoved: return "REMOVED";
+    case change::PendingKind::kAppearance: return "APPEARANCE_CHANGE";
+  }
+  return "KIND_UNSPECIFIED";
+}
+
+/// The changes seen but not yet confirmed, field for field as GetPendingChanges answers them;
+/// the box in metres as measured, like the objects' boxes (not rounded: a client may compare).
+json pending_json(const std::vector<pipeline::PendingChangeSeen>& pending) {
+  const auto vec = [](const Eigen::Vector3d& v) { return json::array({v.x(), v.y(), v.z()}); };
+  json out = json::array();
+  for (const auto& seen : pending) {
+    const change::PendingChange& c = seen.change;
+    out.push_back({{"id", c.id}, {"kind", pending_kind_name(c.kind)},
+                   {"box_world", {{"min", vec(c.box_world.min)}, {"max", vec(c.box_world.max)}}},
+                   {"centroid_world", vec(c.centroid_world)}, {"hits", c.hits}, {"hits_needed", c.hits_needed},
+                   {"camera", seen.camera}});
+  }
+  return out;
 }
 
 std::string sse_message(const Event& event) {
@@ -144,7 +172,8 @@ struct LiveView::Impl {
                     {"mean_frame_ms", stats.mean_frame_ms}, {"keyframes", stats.keyframes}}},
                   {"planes", planes},
                   {"objects", objects},
-                  {"views", suggested_views_json()}};
+                  {"views", suggested_views_json()},
+                  {"pending", pending_json(snapshot->pending)}};
     if (with_voxels) {
       const pipeline::OccupiedVoxels voxels = memory.occupied_voxels(config.max_voxels);
       std::vector<double> centers;

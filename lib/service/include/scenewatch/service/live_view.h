@@ -6,7 +6,8 @@
 ///   GET /three.min.js      three.js, read from Debian's libjs-three (LiveViewConfig::three_js)
 ///   GET /api/state         frames, stats, planes (hulls), objects (boxes, and their class when
 ///                          LiveViewConfig::classes is set), the last NextBestView's suggested
-///                          views (LiveViewConfig::suggested_views), occupied voxels (JSON);
+///                          views (LiveViewConfig::suggested_views), the pending changes (as
+///                          GetPendingChanges answers them), occupied voxels (JSON);
 ///                          (?voxels=0: without the voxels and the classes: the page's cheap poll)
 ///   GET /api/frame.png     the last colour frame with the surprise heatmap laid over it
 ///   GET /api/events        the events as they are emitted (Server-Sent Events)
