@@ -70,7 +70,8 @@ json pending_json(const std::vector<pipeline::PendingChangeSeen>& pending) {
 }
 
 std::string sse_message(const Event& event) {
-  return "id: " + std::to_string(event.id) + "\ndata: " + event_json(event).dump() + "\n\n";
+  // As json_response: an event's strings (its camera) may hold a byte that is not UTF-8.
+  return "id: " + std::to_string(event.id) + "\ndata: " + event_json(event).dump(-1, ' ', false, json::error_handler_t::replace) + "\n\n";
 }
 
 }  // namespace
