@@ -102,20 +102,21 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
   const auto t_ins = Clock::now();
   const background::Config& b = config.background;
   const int stride = sample_stride(frame, K, b.resolution_m, b.max_range_m, b.insert_stride_px);
-  std::unique_lock<std::shared_mutex> write(mutex_);
-  // The witness and the octree are apart: the frame's surfaces are witnessed on a thread of their
-  // own while the insertion runs (the map's part is the frame's longest; the other core has room).
-  std::future<void> witnessed;
-  if (config.change.witness_per_camera) {
-    witnessed = std::async(std::launch::async, [&] { witness_.witness(*to_insert, T, camera, stride); });
+  // The witness and the octree are apart: the frame's surfaces are witnessed by whichever thread
+  // is free first (witness_frame()), while the insertion runs or after it. Then the surfaces of
+  // confirmed removals are forgotten, as they were after the witness before.
+  {
+    WitnessJob job{to_insert, T, camera, stride, {}};
+    for (const auto& c : changed.confirmed)
+      if (c.before) job.forget.push_back(c.before->points_world);
+    std::lock_guard<std::mutex> lock(witness_mutex_);
+    witness_job_ = std::move(job);
+    witness_on_ = config.change.witness_per_camera;
   }
+  std::unique_lock<std::shared_mutex> write(mutex_);
   result.insert_stats = map_.insert(*to_insert, T, stride);
-  if (witnessed.valid()) witnessed.get();
   for (const auto& c : changed.confirmed) {
-    if (c.before) {
-      map_.set_voxels(c.before->points_world, background::Occupancy::kFree);
-      witness_.forget(c.before->points_world);
-    }
+    if (c.before) map_.set_voxels(c.before->points_world, background::Occupancy::kFree);
     if (c.after) map_.set_voxels(c.after->points_world, background::Occupancy::kOccupied);
   }
   for (const auto& c : changed.absorbed) {
@@ -124,6 +125,15 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
   }
   result.insert_ms = ms_since(t_ins);
   return changed;
+}
+
+void MapStage::witness_frame() {
+  std::lock_guard<std::mutex> lock(witness_mutex_);  // a second caller waits until the job is done
+  if (!witness_job_) return;
+  const WitnessJob job = std::move(*witness_job_);
+  witness_job_.reset();
+  if (witness_on_) witness_.witness(*job.cloud, job.T, job.camera, job.stride);
+  for (const auto& points : job.forget) witness_.forget(points);
 }
 
 std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d&)> MapStage::occupied_fraction(
@@ -156,6 +166,10 @@ void MapStage::reset() {
   if (prefilled_.valid()) prefilled_.wait();
   prefilled_ = {};
   {
+    std::lock_guard<std::mutex> lock(witness_mutex_);
+    witness_job_.reset();
+  }
+  {
     std::unique_lock<std::shared_mutex> write(mutex_);
     map_.reset();
     witness_.reset();
@@ -170,6 +184,10 @@ void MapStage::reset() {
 void MapStage::replace(background::OccupancyMap map) {
   if (prefilled_.valid()) prefilled_.wait();
   prefilled_ = {};
+  {
+    std::lock_guard<std::mutex> lock(witness_mutex_);
+    witness_job_.reset();
+  }
   {
     std::unique_lock<std::shared_mutex> write(mutex_);
     map_ = std::move(map);

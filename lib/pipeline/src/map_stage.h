@@ -42,6 +42,12 @@ class MapStage {
   ChangeOutcome update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
                        bool detect, FrameResult& result, std::uint32_t camera);
 
+  /// Records the surfaces of the frame update() last took in the surface witness (which cameras
+  /// saw each surface), and forgets those of the removals it confirmed. update() leaves this to
+  /// whichever of the frame's threads is free first: the first call does it, a call during it
+  /// waits for it, later calls do nothing. Before the next update().
+  void witness_frame();
+
   /// Starts filling the change detection's dense copy of the map around `frame` (placed with T)
   /// on a thread of its own, to run beside the work before update() (the hands). update() waits
   /// for it, and uses it when its box holds the box of the frame update() is given (the hands'
@@ -88,12 +94,23 @@ class MapStage {
   ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
                                const change::Config& config, std::uint32_t camera);
 
-  // Guards `map_` and `witness_` between writers and concurrent occupancy readers.
+  // Guards `map_` between writers and concurrent occupancy readers. `witness_` is read by the change
+  // detection and written by witness_frame(), one after the other within a frame.
   mutable std::shared_mutex mutex_;
   background::OccupancyMap map_;
   background::DenseGrid map_grid_;  // the change detector's dense copy of the map, its buffers kept between frames
   std::future<bool> prefilled_;     // prefill()'s fill of map_grid_: true when it succeeded
-  change::SurfaceWitness witness_;  // which cameras saw each surface of the map (guarded with it)
+  change::SurfaceWitness witness_;  // which cameras saw each surface of the map (written by witness_frame())
+  struct WitnessJob {
+    CloudConstPtr cloud;  // the points update() inserted
+    Pose T;
+    std::uint32_t camera = 0;
+    int stride = 1;
+    std::vector<std::vector<Eigen::Vector3d>> forget;  // the surfaces of confirmed removals
+  };
+  std::mutex witness_mutex_;                // witness_job_, and witness_ while a job runs
+  std::optional<WitnessJob> witness_job_;   // the last update()'s, until witness_frame() takes it
+  bool witness_on_ = false;                 // change.witness_per_camera of that update()
   change::PersistenceFilter changes_;  // owned by the writer
   // The pose agreement the change detector last measured, per camera.
   mutable std::mutex pose_mutex_;

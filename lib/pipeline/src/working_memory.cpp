@@ -189,10 +189,12 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   auto map_update = std::async(std::launch::async, [&] {
     ChangeOutcome out = m.map.update(seen, T, camera, config_, detect, result, camera_id);
     image_surprise();
+    m.map.witness_frame();
     return out;
   });
   segment_frame(seen, T, camera, config_, result);  // in the camera frame, then moved to the world
   image_surprise();
+  m.map.witness_frame();  // taken here when the map's thread is still inserting
 
   const ChangeOutcome changed = map_update.get();
   result.parallel_ms = ms_since(t_parallel);
