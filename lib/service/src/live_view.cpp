@@ -11,6 +11,7 @@
 
 #include "class_records.h"
 #include "live_view_page.h"
+#include "proto_convert.h"
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/core/event_json.h"
 #include "scenewatch/core/scene_json.h"
@@ -24,12 +25,14 @@ using nlohmann::json;
 
 namespace {
 
+// A camera's name is the frames' (only control characters are refused): a byte that is not
+// UTF-8 becomes U+FFFD rather than an exception, which would answer the whole state with 500.
+std::string dump_text(const json& j) { return j.dump(-1, ' ', false, json::error_handler_t::replace); }
+
 HttpResponse json_response(const json& j) {
   HttpResponse r;
   r.content_type = "application/json";
-  // A camera's name is the frames' (only control characters are refused): a byte that is not
-  // UTF-8 becomes U+FFFD rather than an exception, which would answer the whole state with 500.
-  r.body = j.dump(-1, ' ', false, json::error_handler_t::replace);
+  r.body = dump_text(j);
   return r;
 }
 
@@ -44,16 +47,6 @@ json event_json(const Event& event) {
   return j;
 }
 
-/// The names GetPendingChanges gives the kinds (scenewatch.proto, PendingChange.Kind).
-const char* pending_kind_name(change::PendingKind kind) {
-  switch (kind) {
-    case change::PendingKind::kAdded: return "ADDED";
-    case change::PendingKind::kRemoved: return "REMOVED";
-    case change::PendingKind::kAppearance: return "APPEARANCE_CHANGE";
-  }
-  return "KIND_UNSPECIFIED";
-}
-
 /// The changes seen but not yet confirmed, field for field as GetPendingChanges answers them;
 /// the box in metres as measured, like the objects' boxes (not rounded: a client may compare).
 json pending_json(const std::vector<pipeline::PendingChangeSeen>& pending) {
@@ -61,7 +54,7 @@ json pending_json(const std::vector<pipeline::PendingChangeSeen>& pending) {
   json out = json::array();
   for (const auto& seen : pending) {
     const change::PendingChange& c = seen.change;
-    out.push_back({{"id", c.id}, {"kind", pending_kind_name(c.kind)},
+    out.push_back({{"id", c.id}, {"kind", proto::PendingChange::Kind_Name(convert::to_proto(c.kind))},
                    {"box_world", {{"min", vec(c.box_world.min)}, {"max", vec(c.box_world.max)}}},
                    {"centroid_world", vec(c.centroid_world)}, {"hits", c.hits}, {"hits_needed", c.hits_needed},
                    {"camera", seen.camera}});
@@ -70,8 +63,7 @@ json pending_json(const std::vector<pipeline::PendingChangeSeen>& pending) {
 }
 
 std::string sse_message(const Event& event) {
-  // As json_response: an event's strings (its camera) may hold a byte that is not UTF-8.
-  return "id: " + std::to_string(event.id) + "\ndata: " + event_json(event).dump(-1, ' ', false, json::error_handler_t::replace) + "\n\n";
+  return "id: " + std::to_string(event.id) + "\ndata: " + dump_text(event_json(event)) + "\n\n";
 }
 
 }  // namespace

@@ -226,6 +226,15 @@ void to_proto(const localization::Localization& where, proto::LocalizationResult
   out->set_odom_change_deg(where.odom_change_deg);
 }
 
+proto::PendingChange::Kind to_proto(change::PendingKind kind) {
+  switch (kind) {
+    case change::PendingKind::kAdded: return proto::PendingChange::ADDED;
+    case change::PendingKind::kRemoved: return proto::PendingChange::REMOVED;
+    case change::PendingKind::kAppearance: return proto::PendingChange::APPEARANCE_CHANGE;
+  }
+  return proto::PendingChange::KIND_UNSPECIFIED;
+}
+
 proto::LocalizationMode to_proto(const std::optional<LocalizationMode>& mode) {
   if (!mode) return proto::LOCALIZATION_CONFIGURED;
   switch (*mode) {

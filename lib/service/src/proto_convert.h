@@ -6,6 +6,7 @@
 #include <string_view>
 
 #include "scenewatch.pb.h"
+#include "scenewatch/change/pending_change.h"
 #include "scenewatch/core/cloud.h"
 #include "scenewatch/core/event.h"
 #include "scenewatch/core/geometry.h"
@@ -31,6 +32,8 @@ void to_proto(const Pose& pose, proto::Pose* out);
 void to_proto(const localization::Localization& where, proto::LocalizationResult* out);
 /// A frame's localization mode on the wire; unset is LOCALIZATION_CONFIGURED (the daemon's own).
 proto::LocalizationMode to_proto(const std::optional<LocalizationMode>& mode);
+/// The kind of a pending change as GetPendingChanges and the live view name it.
+proto::PendingChange::Kind to_proto(change::PendingKind kind);
 /// ... and back; an unknown number is an error naming it.
 Result<std::optional<LocalizationMode>> decode_localization_mode(int value);
 void to_proto(const Intrinsics& intrinsics, proto::Intrinsics* out);

@@ -139,11 +139,7 @@ Status RequestHandler::Impl::get_pending_changes(proto::Response& response) {
     const change::PendingChange& c = seen.change;
     auto* o = out->add_changes();
     o->set_id(c.id);
-    switch (c.kind) {
-      case change::PendingKind::kAdded: o->set_kind(proto::PendingChange::ADDED); break;
-      case change::PendingKind::kRemoved: o->set_kind(proto::PendingChange::REMOVED); break;
-      case change::PendingKind::kAppearance: o->set_kind(proto::PendingChange::APPEARANCE_CHANGE); break;
-    }
+    o->set_kind(convert::to_proto(c.kind));
     convert::to_proto(c.box_world, o->mutable_box_world());
     convert::to_proto(c.centroid_world, o->mutable_centroid_world());
     o->set_hits(static_cast<std::uint32_t>(c.hits));
