@@ -106,12 +106,11 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
   // is free first (witness_frame()), while the insertion runs or after it. Then the surfaces of
   // confirmed removals are forgotten, as they were after the witness before.
   {
-    WitnessJob job{to_insert, T, camera, stride, {}};
+    WitnessJob job{to_insert, T, camera, stride, config.change.witness_per_camera, {}};
     for (const auto& c : changed.confirmed)
       if (c.before) job.forget.push_back(c.before->points_world);
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_ = std::move(job);
-    witness_on_ = config.change.witness_per_camera;
   }
   std::unique_lock<std::shared_mutex> write(mutex_);
   result.insert_stats = map_.insert(*to_insert, T, stride);
@@ -132,7 +131,7 @@ void MapStage::witness_frame() {
   if (!witness_job_) return;
   const WitnessJob job = std::move(*witness_job_);
   witness_job_.reset();
-  if (witness_on_) witness_.witness(*job.cloud, job.T, job.camera, job.stride);
+  if (job.record) witness_.witness(*job.cloud, job.T, job.camera, job.stride);
   for (const auto& points : job.forget) witness_.forget(points);
 }
 

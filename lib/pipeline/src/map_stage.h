@@ -106,11 +106,11 @@ class MapStage {
     Pose T;
     std::uint32_t camera = 0;
     int stride = 1;
+    bool record = false;                               // change.witness_per_camera
     std::vector<std::vector<Eigen::Vector3d>> forget;  // the surfaces of confirmed removals
   };
   std::mutex witness_mutex_;                // witness_job_, and witness_ while a job runs
   std::optional<WitnessJob> witness_job_;   // the last update()'s, until witness_frame() takes it
-  bool witness_on_ = false;                 // change.witness_per_camera of that update()
   change::PersistenceFilter changes_;  // owned by the writer
   // The pose agreement the change detector last measured, per camera.
   mutable std::mutex pose_mutex_;
