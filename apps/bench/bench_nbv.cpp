@@ -8,12 +8,14 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <random>
 
 #include "bench.h"
 #include "closed_loop.h"
 #include "nbv_plot.h"
 #include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/ontology/class_library.h"
 #include "scenewatch/planning/covariance_planner.h"
 #include "scenewatch/planning/next_best_view.h"
 #include "scenewatch/planning/point_filter.h"
@@ -228,6 +230,55 @@ int run_closed_loops(const sim::Scenario& scenario) {
   return 0;
 }
 
+// Issue 31 item 3: the view that completes one object, aimed at what a robot knows of it (the box
+// of its points seen so far, or the ontology's completion of them) beside the true box (an oracle)
+// and random, on the same candidates.
+int run_completion_loops(const sim::Scenario& scenario) {
+  auto classes = ontology::load_classes_file(std::filesystem::path(SCENEWATCH_SOURCE_DIR) / "config/ontology.yaml");
+  if (!classes) return std::fprintf(stderr, "nbv: %s\n", classes.error().message.c_str()), 1;
+  const int seeds = 10, views = 10;
+  std::printf("\n== nbv: closed loop, one object, what the planner aims at (measure rear_side_entropy): mean coverage of its "
+              "true surface after the first view and 1-%d chosen views, %d seeds ==\n",
+              views, seeds);
+  std::printf("%-28s %-13s", "object", "aim");
+  for (int v = 0; v <= views; ++v) std::printf(" %5d", v);
+  std::printf("  views to 90%%  classed\n");
+  for (const auto& [id, name] : {std::pair{1, "cereal box (id 1)"}, std::pair{2, "mug (id 2)"}, std::pair{3, "can (id 3)"},
+                                 std::pair{11, "small can (id 11)"}}) {
+    for (int k = 0; k < 4; ++k) {
+      eval::ClosedLoopSetup setup;
+      setup.target_ids = {id};
+      setup.views = views;
+      setup.classes = &*classes;
+      setup.random = k == 3;
+      if (!setup.random) setup.planned_target = static_cast<eval::PlannedTarget>(k);
+      std::vector<double> mean(views + 1, 0.0);
+      int completed = 0;
+      std::map<std::string, int> classed;
+      for (int seed = 1; seed <= seeds; ++seed) {
+        auto c = eval::run_closed_loop(scenario, setup, seed);
+        if (!c) return std::fprintf(stderr, "nbv: %s\n", c.error().message.c_str()), 1;
+        for (int v = 0; v <= views; ++v) mean[v] += c->coverage[v] / seeds;
+        completed += c->completed_steps;
+        if (!c->last_class.empty()) ++classed[c->last_class];
+      }
+      std::printf("%-28s %-13s", k == 0 ? name : "", setup.random ? "random" : eval::to_string(setup.planned_target));
+      int reach = -1;
+      for (int v = 0; v <= views; ++v) {
+        std::printf(" %5.3f", mean[v]);
+        if (reach < 0 && mean[v] >= 0.9) reach = v;
+      }
+      std::printf("  %-13s", reach < 0 ? "never" : std::to_string(reach).c_str());
+      if (setup.planned_target == eval::PlannedTarget::kCompletion && !setup.random) {
+        std::printf("  %d of %d steps;", completed, seeds * views);
+        for (const auto& [cls, n] : classed) std::printf(" %s %d", cls.c_str(), n);
+      }
+      std::printf("\n");
+    }
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run_nbv(const Options& o) {
@@ -236,6 +287,7 @@ int run_nbv(const Options& o) {
   int rc = run_speed(o, *scenario);
   run_reproduction();
   rc |= run_closed_loops(*scenario);
+  rc |= run_completion_loops(*scenario);
   return rc;
 }
 

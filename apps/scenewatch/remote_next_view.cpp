@@ -36,6 +36,7 @@ int run_next_view(const RemoteOptions& options, const NextViewOptions& next) {
       }
       return print_json({{"views", std::move(views)},
                          {"target", to_json(reply.target())},
+                         {"target_description", reply.target_description()},
                          {"measure", reply.measure()},
                          {"coverage", reply.coverage()},
                          {"target_voxels", reply.target_voxels()},
@@ -44,6 +45,7 @@ int run_next_view(const RemoteOptions& options, const NextViewOptions& next) {
     std::cout << "target " << text(reply.target().min()) << " .. " << text(reply.target().max()) << ", " << reply.target_voxels()
               << " voxels, coverage " << reply.coverage() << "; " << reply.candidates() << " candidates by " << reply.measure()
               << "\n";
+    if (!reply.target_description().empty()) std::cout << "   (" << reply.target_description() << ")\n";
     for (int i = 0; i < reply.views_size(); ++i) {
       const auto& v = reply.views(i);
       const auto& m = v.pose().matrix();

@@ -103,6 +103,48 @@ TEST(ViewScorer, RearSideMeasuresSeeTheBackFromBehindOnly) {
   EXPECT_EQ(again.gain, b.gain);
 }
 
+// The voxel centres of the object box's outer layer (a completed box primitive: 488 of its 1000 voxels).
+std::vector<Eigen::Vector3d> object_shell() {
+  std::vector<Eigen::Vector3d> shell;
+  for (int i = 0; i < 10; ++i)
+    for (int j = 0; j < 10; ++j)
+      for (int k = 0; k < 10; ++k) {
+        if (i % 9 && j % 9 && k % 9) continue;
+        shell.push_back(Eigen::Vector3d(i, j, k) * 0.02 - Eigen::Vector3d::Constant(0.09));
+      }
+  return shell;
+}
+
+// A surface narrows the target to its voxels: the object's inside is unknown but not the object's
+// surface, so it counts for nothing, yet rays still cross it to the face seen from the front.
+TEST(ViewScorer, ASurfaceNarrowsTheTargetToItsVoxels) {
+  const DenseGrid g = front_seen_object();
+  ViewScorer box(g, kObject), surface(g, kObject, {}, object_shell());
+  EXPECT_EQ(surface.target_voxels(), 488u);
+  EXPECT_EQ(surface.target_known(), 100u);  // the -x face, seen
+  const Pose front = look_at(Eigen::Vector3d(-0.6, 0, 0), Eigen::Vector3d::Zero());
+  const Pose back = look_at(Eigen::Vector3d(0.6, 0, 0), Eigen::Vector3d::Zero());
+  EXPECT_EQ(surface.score(front, kIntrinsics, Measure::kRearSideEntropy).gain, 0.0);
+  const ViewGain b_box = box.score(back, kIntrinsics, Measure::kRearSideEntropy);
+  const ViewGain b = surface.score(back, kIntrinsics, Measure::kRearSideEntropy);
+  // From behind, each ray crosses the +x face, then the unknown inside, and ends on the -x face:
+  // the last surface voxels before it are the rear side now (measured: 72, the +x face's 8 x 8
+  // inner voxels and a few of the sides'), not the inside's 100 just behind the -x face. Every
+  // unknown surface voxel is reached (488 - 100); the rear-side entropy counts 255 of them, the
+  // box's 767 (the inside's voxels too).
+  EXPECT_GE(b.rear_side, 64u);
+  EXPECT_LE(b.rear_side, 100u);
+  EXPECT_EQ(b.unknown_reached, 388u);
+  EXPECT_EQ(b_box.unknown_reached, 900u);
+  EXPECT_GT(b.gain, 240.0);
+  EXPECT_LT(b.gain, 0.4 * b_box.gain);
+  EXPECT_NEAR(b.expected_coverage, (100.0 + b.unknown_reached) / 488.0, 1e-12);
+  // Points outside the box are left out; none in it leaves no target.
+  ViewScorer none(g, kObject, {}, {Eigen::Vector3d(0.5, 0.5, 0.5)});
+  EXPECT_EQ(none.target_voxels(), 0u);
+  EXPECT_EQ(none.score(back, kIntrinsics, Measure::kRearSideEntropy).gain, 0.0);
+}
+
 // A free voxel seen free too few times to be settled carries its entropy, and may hide what lies
 // behind it; a settled one carries none. The object box of front_seen_object() seen from +x, its
 // two layers nearest the camera free (the rest stays as it was: unknown inside, an occupied -x face).
@@ -250,6 +292,13 @@ TEST(ViewScorer, GivesTheReferenceWalksGainsOnAMixedGrid) {
     poses.insert(poses.end(), more.begin(), more.end());
   }
   EXPECT_GT(expect_same_as_reference(scorer, poses, kIntrinsics), 60);
+  // A surface of scattered points in the box: the voxels between them pass rays on.
+  std::vector<Eigen::Vector3d> surface(1500);
+  for (auto& p : surface) p = target.min + (target.max - target.min).cwiseProduct(Eigen::Vector3d(u(rng), u(rng), u(rng)));
+  ViewScorer sparse(g, target, {}, surface);
+  EXPECT_GT(sparse.target_voxels(), 500u);
+  EXPECT_LT(sparse.target_voxels(), scorer.target_voxels() / 2);
+  EXPECT_GT(expect_same_as_reference(sparse, poses, kIntrinsics), 60);
   ViewScorer outside(g, Aabb{Eigen::Vector3d(2, 2, 2), Eigen::Vector3d(2.5, 2.5, 2.5)});
   EXPECT_EQ(expect_same_as_reference(outside, poses, kIntrinsics), 0);
 }
@@ -285,7 +334,36 @@ TEST(NextBestView, RanksTheBackFirstAndDiscountsMotion) {
   const auto costly = next_best_views(g, r);
   EXPECT_LT(costly->views[0].T_world_camera.translation().x(), x_free);
   EXPECT_GT(costly->views[0].motion_m, 0.0);
+  // A surface that is all known (the -x face) gives no candidate anything: the box is planned for.
+  r.measure = Measure::kRearSideEntropy;
+  r.current_T_world_camera.reset();
+  for (const Eigen::Vector3d& p : object_shell()) {
+    if (p.x() < -0.08) r.target_surface_world.push_back(p);
+  }
+  const auto known = next_best_views(g, r);
+  ASSERT_TRUE(known) << known.error().message;
+  EXPECT_TRUE(known->planned_for_box);
+  EXPECT_EQ(known->surface_voxels, 100u);
+  EXPECT_EQ(known->surface_coverage, 1.0);
+  EXPECT_EQ(known->target_voxels, 1000u);
+  EXPECT_GT(known->views[0].T_world_camera.translation().x(), 0.1) << known->views[0].why;
+  // The unseen +x face gives the views from behind, and no fallback.
+  r.target_surface_world.clear();
+  for (const Eigen::Vector3d& p : object_shell()) {
+    if (p.x() > 0.08) r.target_surface_world.push_back(p);
+  }
+  const auto back = next_best_views(g, r);
+  ASSERT_TRUE(back) << back.error().message;
+  EXPECT_FALSE(back->planned_for_box);
+  EXPECT_EQ(back->target_voxels, 100u);
+  EXPECT_EQ(back->coverage_now, 0.0);
+  EXPECT_GT(back->views[0].T_world_camera.translation().x(), 0.1) << back->views[0].why;
   // Bad requests are errors naming the field.
+  r.target_surface_world = {Eigen::Vector3d(0.5, 0.5, 0.5)};
+  EXPECT_NE(next_best_views(g, r).error().message.find("target surface: none of its 1 points"), std::string::npos);
+  r.target_surface_world = {Eigen::Vector3d(0.0, std::nan(""), 0.0)};
+  EXPECT_NE(next_best_views(g, r).error().message.find("target surface: a point is not finite"), std::string::npos);
+  r.target_surface_world.clear();
   r.n = 0;
   EXPECT_NE(next_best_views(g, r).error().message.find("n:"), std::string::npos);
 }

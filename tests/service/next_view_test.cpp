@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <optional>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -351,6 +352,52 @@ TEST_F(NextViewTest, APendingChangeIsATargetUntilItIsConfirmed) {
   EXPECT_NE(bad_cli.err.find("pending_id: 0"), std::string::npos) << bad_cli.err;
   EXPECT_EQ(call(client, request([](proto::Request& r) { r.mutable_health(); })).status().code(), proto::Status::OK);
   EXPECT_EQ(pending_now().status().code(), proto::Status::OK);
+}
+
+// Issue 31, "Attention": for an object a class fits, the ontology's completion says which side is
+// unseen. The target is then its completed primitive's surface, not the unknown air of its box.
+TEST_F(NextViewTest, AClassedObjectsCompletedSurfaceIsTheTarget) {
+  ASSERT_NO_FATAL_FAILURE(start_cup_added());
+  Client client = daemon_.connect();
+  for (int f = 0; f < simulator_->frame_count(0); ++f) ASSERT_NO_FATAL_FAILURE(ingest(client, 0, f));
+  const auto objects = call(client, request([](proto::Request& r) { r.mutable_get_objects()->set_describe(true); }));
+  ASSERT_EQ(objects.status().code(), proto::Status::OK);
+  std::set<std::string> classes;
+  for (const auto& o : objects.objects().objects()) {
+    const std::string& name = o.ontology().class_name();
+    classes.insert(name);
+    auto nbv = call(client, request([&](proto::Request& r) { r.mutable_next_best_view()->set_object_id(o.id()); }));
+    ASSERT_EQ(nbv.status().code(), proto::Status::OK) << nbv.status().message();
+    const auto& reply = nbv.next_best_view();
+    ASSERT_GT(reply.views_size(), 0);
+    // The same box as a plain box target: every voxel of it counts.
+    auto as_box = call(client, request([&](proto::Request& r) { *r.mutable_next_best_view()->mutable_box() = reply.target(); }));
+    ASSERT_EQ(as_box.status().code(), proto::Status::OK) << as_box.status().message();
+    const auto& box_reply = as_box.next_best_view();
+    EXPECT_EQ(box_reply.target_description(), "the box given");
+    const Eigen::Vector3d best = matrix_of(reply.views(0).pose()).block<3, 1>(0, 3);
+    std::printf("object %llu %s: %s; %llu voxels, coverage %.3f -> %.3f, best at (%.2f %.2f %.2f) | as a box: %llu voxels, "
+                "coverage %.3f -> %.3f\n",
+                static_cast<unsigned long long>(o.id()), name.c_str(), reply.target_description().c_str(),
+                static_cast<unsigned long long>(reply.target_voxels()), reply.coverage(), reply.views(0).expected_coverage(),
+                best.x(), best.y(), best.z(), static_cast<unsigned long long>(box_reply.target_voxels()), box_reply.coverage(),
+                box_reply.views(0).expected_coverage());
+    if (name == "unknown") {
+      EXPECT_NE(reply.target_description().find("no class fits"), std::string::npos) << reply.target_description();
+      continue;
+    }
+    EXPECT_NE(reply.target_description().find("the completed surface of a " + name), std::string::npos) << reply.target_description();
+    EXPECT_NE(reply.target_description().find("less the face it stands on"), std::string::npos) << reply.target_description();
+    // The surface's voxels are a fifth of the box's (measured 196 of 1040, 64 of 336, 72 of 448).
+    EXPECT_LT(reply.target_voxels(), 0.25 * box_reply.target_voxels());
+    EXPECT_GT(reply.target_voxels(), 0.1 * box_reply.target_voxels());
+    // Seen from -x only: part of the surface is unknown (measured 0.77-0.91 known), and the best
+    // view, from the far side, sees the rest.
+    EXPECT_LT(reply.coverage(), 0.95);
+    EXPECT_GT(reply.views(0).expected_coverage(), 0.99);
+    EXPECT_GT(best.x(), o.centroid().x() + 0.2) << reply.views(0).why();
+  }
+  EXPECT_EQ(classes, (std::set<std::string>{"ball", "box", "can"}));
 }
 
 }  // namespace

@@ -243,7 +243,9 @@ class Client:
         raises StatusError NOT_FOUND, naming the event that confirmed it when the daemon's log has
         it. pb.NextBestViewReply: ``views`` best first, each with
         ``pose.matrix`` (16 numbers, row-major T_world_camera), ``score``, ``expected_coverage``
-        and ``why``. ``current_pose`` (16 numbers) adds the cost of moving there. ``measure``
+        and ``why``; ``target_description`` says what was planned for (for an object a class
+        fits: its completed surface, its unseen side included; else its box, and why).
+        ``current_pose`` (16 numbers) adds the cost of moving there. ``measure``
         "covariance" (or "covariance_321", "covariance_322") with an object_id: the seed's planner,
         one view on the sphere of radius_m; the daemon checks the name."""
         message = pb.NextBestView(measure=measure, n=n, radius_m=radius_m)

@@ -125,6 +125,8 @@ class ClientTest(unittest.TestCase):
         self.assertEqual(len(nbv.views[0].pose.matrix), 16)
         self.assertGreaterEqual(nbv.views[0].score, nbv.views[1].score)
         self.assertGreater(nbv.views[0].expected_coverage, nbv.coverage)
+        self.assertTrue(nbv.target_description.startswith(("the completed surface of a", "the object's box")),
+                        nbv.target_description)
         with self.assertRaises(ValueError):
             self.client.next_best_view(object_id=top.id, workspace=True)
 

@@ -17,6 +17,15 @@ std::vector<std::shared_ptr<const ObjectClassInfo>> ObjectDescriber::describe(co
   return out;
 }
 
+std::shared_ptr<const ObjectClassInfo> ObjectDescriber::describe_one(const SceneSnapshot& snapshot, std::uint64_t object_id,
+                                                                     const ontology::ClassCatalog& classes,
+                                                                     const DescribedCallback& on_described) {
+  for (const auto& object : snapshot.objects) {
+    if (object.id == object_id) return describe(snapshot, object, classes, on_described);
+  }
+  return nullptr;
+}
+
 void ObjectDescriber::clear() {
   std::lock_guard<std::mutex> lock(mutex_);
   described_.clear();
@@ -49,6 +58,8 @@ std::shared_ptr<const ObjectClassInfo> ObjectDescriber::describe(const SceneSnap
       info->score = d->score;
       info->primitive = std::move(d->primitive);
       info->grasps = std::move(d->grasps);
+      info->completed_surface_world = d->completed_points;
+      info->completion_spacing_m = dc.completion_spacing_m;
     }
     cached.info = info;
     cached.points = points->second.get();

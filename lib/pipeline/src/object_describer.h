@@ -26,6 +26,11 @@ class ObjectDescriber {
   std::vector<std::shared_ptr<const ObjectClassInfo>> describe(const SceneSnapshot& snapshot,
                                                                const ontology::ClassCatalog& classes,
                                                                const DescribedCallback& on_described);
+  /// The description of the object `object_id` of `snapshot`, cached as describe()'s; null when
+  /// the snapshot has no such object or it has no points.
+  std::shared_ptr<const ObjectClassInfo> describe_one(const SceneSnapshot& snapshot, std::uint64_t object_id,
+                                                      const ontology::ClassCatalog& classes,
+                                                      const DescribedCallback& on_described);
   /// Forgets every description (Reset clears the known surfaces they made: describe again).
   void clear();
 

@@ -453,4 +453,10 @@ std::vector<std::shared_ptr<const ObjectClassInfo>> WorkingMemory::describe_obje
   return impl_->describer.describe(snapshot, classes, on_described);
 }
 
+std::shared_ptr<const ObjectClassInfo> WorkingMemory::describe_object(const SceneSnapshot& snapshot, std::uint64_t object_id,
+                                                                      const ontology::ClassCatalog& classes,
+                                                                      const DescribedCallback& on_described) {
+  return impl_->describer.describe_one(snapshot, object_id, classes, on_described);
+}
+
 }  // namespace scenewatch::pipeline

@@ -1,10 +1,12 @@
 #include "closed_loop.h"
 
 #include <cmath>
+#include <limits>
 #include <random>
 #include <unordered_map>
 
 #include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/ontology/describe.h"
 #include "scenewatch/sim/simulator.h"
 
 namespace scenewatch::planning::eval {
@@ -66,7 +68,45 @@ void sample_surface(const sim::SceneObject& object, const sim::RenderScene& scen
   }
 }
 
+// What the planner aims at in one step (ClosedLoopSetup::planned_target), from the target's points
+// seen so far; `curve` counts the steps a class fitted.
+struct PlannedBox {
+  Aabb box;
+  std::vector<Eigen::Vector3d> surface;
+};
+
+PlannedBox planned_box(const ClosedLoopSetup& setup, const Aabb& truth, const std::vector<Eigen::Vector3d>& observed,
+                       const Pose& camera, ClosedLoopCurve& curve) {
+  if (setup.planned_target == PlannedTarget::kTruthBox || observed.empty()) return {truth, {}};
+  Aabb seen{observed.front(), observed.front()};
+  for (const auto& p : observed) seen = seen.united(Aabb{p, p});
+  PlannedBox out{seen.grown(setup.resolution_m), {}};
+  if (setup.planned_target != PlannedTarget::kCompletion || setup.classes == nullptr) return out;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();  // the simulator's table is level
+  auto d = ontology::describe(observed, up, *setup.classes, camera.translation());
+  curve.last_class = d ? d->class_name : ontology::kUnknownClass;
+  if (!d || d->completed_points.empty()) return out;
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const auto& p : d->completed_points) lowest = std::min(lowest, p.z());
+  for (const auto& p : d->completed_points) {
+    if (p.z() >= lowest + setup.resolution_m) out.surface.push_back(p);  // not the face it stands on
+  }
+  if (out.surface.empty()) return out;
+  const NextBestViewRequest r = complete_surface_request(seen, out.surface, setup.resolution_m);
+  ++curve.completed_steps;
+  return {r.target_world, r.target_surface_world};
+}
+
 }  // namespace
+
+const char* to_string(PlannedTarget target) {
+  switch (target) {
+    case PlannedTarget::kTruthBox: return "true box";
+    case PlannedTarget::kObservedBox: return "observed box";
+    case PlannedTarget::kCompletion: return "completion";
+  }
+  return "true box";
+}
 
 Result<ClosedLoopCurve> run_closed_loop(const sim::Scenario& scenario_in, const ClosedLoopSetup& setup, std::uint64_t seed) {
   const sim::Scenario scenario = sim::with_resolution(scenario_in, setup.image_width, setup.image_height);
@@ -103,6 +143,15 @@ Result<ClosedLoopCurve> run_closed_loop(const sim::Scenario& scenario_in, const 
   sim::Raycaster raycaster;
   sim::IdealView view;
   HitCells hits(setup.surface_cell_m);
+  // The target's points seen so far, one per 5 mm cell (what a robot knows of it).
+  std::vector<Eigen::Vector3d> observed;
+  std::unordered_map<std::uint64_t, bool> observed_cells;
+  auto keep_observed = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3i c = (p / 0.005).array().floor().cast<int>();
+    const std::uint64_t k = (static_cast<std::uint64_t>(c.x() + (1 << 20)) << 42) |
+                            (static_cast<std::uint64_t>(c.y() + (1 << 20)) << 21) | static_cast<std::uint64_t>(c.z() + (1 << 20));
+    if (observed_cells.emplace(k, true).second) observed.push_back(p);
+  };
   auto observe = [&](const Pose& T_world_camera) {
     raycaster.render(scene, T_world_camera, K, &view);
     Cloud cloud(static_cast<std::uint32_t>(K.width), static_cast<std::uint32_t>(K.height));
@@ -120,7 +169,10 @@ Result<ClosedLoopCurve> run_closed_loop(const sim::Scenario& scenario_in, const 
         q.x = static_cast<float>(p_camera.x());
         q.y = static_cast<float>(p_camera.y());
         q.z = static_cast<float>(p_camera.z());
-        if (std::find(labels.begin(), labels.end(), view.labels[i]) != labels.end()) hits.add(T_world_camera * p_camera);
+        if (std::find(labels.begin(), labels.end(), view.labels[i]) != labels.end()) {
+          hits.add(T_world_camera * p_camera);
+          keep_observed(T_world_camera * p_camera);
+        }
       }
     map.insert(cloud, T_world_camera);
   };
@@ -166,6 +218,9 @@ Result<ClosedLoopCurve> run_closed_loop(const sim::Scenario& scenario_in, const 
     } else {
       if (auto st = map.fill_dense_grid(*region, grid, std::size_t{1} << 26, /*with_uncertain_free=*/true); !st) return st.error();
       request.current_T_world_camera = current;
+      PlannedBox aim = planned_box(setup, target, observed, current, curve);
+      request.target_world = aim.box;
+      request.target_surface_world = std::move(aim.surface);
       auto answer = next_best_views(grid, request);
       if (!answer) return answer.error();
       current = answer->views.front().T_world_camera;

@@ -13,6 +13,14 @@ Status validate(const NextBestViewRequest& r) {
   if (r.n < 1 || r.n > 1000) return invalid_argument("n: must be in [1, 1000], got " + std::to_string(r.n));
   if (!r.intrinsics.valid()) return invalid_argument("intrinsics: focal lengths and image size must be positive");
   if (!(r.motion_cost_per_m >= 0.0 && std::isfinite(r.motion_cost_per_m))) return invalid_argument("motion_cost_per_m: must be >= 0");
+  for (const Eigen::Vector3d& p : r.target_surface_world) {
+    if (!p.allFinite()) return invalid_argument("target surface: a point is not finite");
+  }
+  if (!r.target_surface_world.empty() && std::none_of(r.target_surface_world.begin(), r.target_surface_world.end(),
+                                                      [&](const Eigen::Vector3d& p) { return r.target_world.contains(p); })) {
+    return invalid_argument("target surface: none of its " + std::to_string(r.target_surface_world.size()) +
+                            " points lies in the target box");
+  }
   if (r.current_T_world_camera) {
     if (auto st = validate_rigid(r.current_T_world_camera->matrix()); !st) return invalid_argument("current pose: " + st.error().message);
   }
@@ -35,7 +43,7 @@ Result<NextBestViewAnswer> next_best_views(const background::DenseGrid& grid, co
   if (auto st = validate(r); !st) return st.error();
   auto poses = candidate_poses(r.constraint, r.target_world.center());
   if (!poses) return poses.error();
-  ViewScorer scorer(grid, r.target_world, r.volumetric);
+  ViewScorer scorer(grid, r.target_world, r.volumetric, r.target_surface_world);
   NextBestViewAnswer answer;
   answer.measure = r.measure;
   answer.candidates = poses->size();
@@ -63,6 +71,18 @@ Result<NextBestViewAnswer> next_best_views(const background::DenseGrid& grid, co
   std::stable_sort(views.begin(), views.end(), [](const RankedView& a, const RankedView& b) { return a.score > b.score; });
   views.resize(std::min<std::size_t>(views.size(), static_cast<std::size_t>(r.n)));
   answer.views = std::move(views);
+  // A surface whose voxels no candidate can still learn about (all known, or hidden from every
+  // candidate) leaves every gain 0 and the ranking to the candidates' order: plan for its box.
+  if (!r.target_surface_world.empty() && (answer.views.empty() || answer.views.front().gain.gain <= 0.0)) {
+    NextBestViewRequest box = r;
+    box.target_surface_world.clear();
+    auto for_box = next_best_views(grid, box);
+    if (!for_box) return for_box.error();
+    for_box->surface_voxels = answer.target_voxels;
+    for_box->surface_coverage = answer.coverage_now;
+    for_box->planned_for_box = true;
+    return for_box;
+  }
   return answer;
 }
 
@@ -86,6 +106,16 @@ NextBestViewRequest confirm_event_request(const Aabb& event_box_world, double ma
 
 NextBestViewRequest complete_object_request(const Aabb& object_box_world, double margin_m) {
   return around(object_box_world.grown(margin_m), Measure::kRearSideEntropy);
+}
+
+NextBestViewRequest complete_surface_request(const Aabb& object_box_world, std::vector<Eigen::Vector3d> surface_world,
+                                             double margin_m) {
+  Aabb box = object_box_world;
+  for (const Eigen::Vector3d& p : surface_world) box = box.united(Aabb{p, p});
+  NextBestViewRequest r = around(box.grown(margin_m), Measure::kRearSideEntropy);
+  r.constraint.center_world = object_box_world.center();
+  r.target_surface_world = std::move(surface_world);
+  return r;
 }
 
 }  // namespace scenewatch::planning

@@ -61,7 +61,8 @@ Status validate(const VolumetricConfig& c) {
   return {};
 }
 
-ViewScorer::ViewScorer(const DenseGrid& grid, const Aabb& target, VolumetricConfig config)
+ViewScorer::ViewScorer(const DenseGrid& grid, const Aabb& target, VolumetricConfig config,
+                       const std::vector<Eigen::Vector3d>& surface_world)
     : grid_(grid), config_(config) {
   const long n[3] = {grid.nx, grid.ny, grid.nz};
   for (int a = 0; a < 3; ++a) {
@@ -94,9 +95,25 @@ ViewScorer::ViewScorer(const DenseGrid& grid, const Aabb& target, VolumetricConf
     for (long j = lo_[1] >> kBlockShift; j <= hi_[1] >> kBlockShift; ++j)
       for (long i = lo_[0] >> kBlockShift; i <= hi_[0] >> kBlockShift; ++i)
         block_[static_cast<std::size_t>((k * blocks_[1] + j) * blocks_[0] + i)] = kMixedBlock;
+  if (!surface_world.empty()) {
+    surface_.assign(reached_.size(), 0);
+    for (const Eigen::Vector3d& p : surface_world) {
+      const Eigen::Vector3d g = (p - grid.origin) / grid.resolution;
+      if (!g.allFinite()) continue;
+      long ijk[3];
+      bool inside = true;
+      for (int a = 0; a < 3; ++a) {
+        ijk[a] = static_cast<long>(std::floor(g(a)));
+        inside = inside && ijk[a] >= lo_[a] && ijk[a] <= hi_[a];
+      }
+      if (inside) surface_[static_cast<std::size_t>(mark_of(ijk))] = 1;
+    }
+  }
   for (long k = lo_[2]; k <= hi_[2]; ++k)
     for (long j = lo_[1]; j <= hi_[1]; ++j)
       for (long i = lo_[0]; i <= hi_[0]; ++i) {
+        const long ijk[3] = {i, j, k};
+        if (!surface_.empty() && !surface_[static_cast<std::size_t>(mark_of(ijk))]) continue;
         ++target_voxels_;
         if (grid.state[static_cast<std::size_t>((k * grid.ny + j) * grid.nx + i)] != kUnknown) ++target_known_;
       }
@@ -112,7 +129,22 @@ void ViewScorer::count_surface(long index, double visibility, RaySums& sums) con
   sums.occlusion_aware += visibility * h;
 }
 
+bool ViewScorer::pass_box_voxel(long index, std::uint32_t stamp, RayState& ray, ViewGain& out, RaySums& sums) {
+  const std::uint8_t s = grid_.state[static_cast<std::size_t>(index)];
+  if (s == kOccupied) {
+    if (ray.previous_unknown_target >= 0) count_rear_side(ray.previous_unknown_target, stamp, out, sums);
+    return true;
+  }
+  if (s == kUnknown) {
+    ray.visibility *= 0.5;  // the run of unknown space goes on: a surface after it is still a rear side
+    return false;
+  }
+  ray.previous_unknown_target = -1;
+  return false;
+}
+
 bool ViewScorer::visit_target_voxel(long index, long mark, std::uint32_t stamp, RayState& ray, ViewGain& out, RaySums& sums) {
+  if (!surface_.empty() && !surface_[static_cast<std::size_t>(mark)]) return pass_box_voxel(index, stamp, ray, out, sums);
   const std::uint8_t s = grid_.state[static_cast<std::size_t>(index)];
   const bool first = reached_[mark] != stamp;
   if (first) {

@@ -28,12 +28,13 @@ void record_description(ontology::ClassCatalog& classes, const TrackedObject& ob
   classes.record(instance, handled_free);
 }
 
+pipeline::DescribedCallback recorder(ontology::ClassCatalog& classes) {
+  return [&classes](const TrackedObject& object, const pipeline::ObjectClassInfo& info) { record_description(classes, object, info); };
+}
+
 std::vector<std::shared_ptr<const pipeline::ObjectClassInfo>> describe_and_record(
     pipeline::WorkingMemory& memory, const pipeline::SceneSnapshot& snapshot, ontology::ClassCatalog& classes) {
-  return memory.describe_objects(snapshot, classes,
-                                 [&classes](const TrackedObject& object, const pipeline::ObjectClassInfo& info) {
-                                   record_description(classes, object, info);
-                                 });
+  return memory.describe_objects(snapshot, classes, recorder(classes));
 }
 
 }  // namespace scenewatch::service

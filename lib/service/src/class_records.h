@@ -17,6 +17,9 @@ namespace scenewatch::service {
 void record_description(ontology::ClassCatalog& classes, const TrackedObject& object,
                         const pipeline::ObjectClassInfo& described);
 
+/// A callback that records each new description in `classes` (which must outlive it).
+pipeline::DescribedCallback recorder(ontology::ClassCatalog& classes);
+
 /// WorkingMemory::describe_objects with each new description recorded (record_description).
 std::vector<std::shared_ptr<const pipeline::ObjectClassInfo>> describe_and_record(
     pipeline::WorkingMemory& memory, const pipeline::SceneSnapshot& snapshot, ontology::ClassCatalog& classes);

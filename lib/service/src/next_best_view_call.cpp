@@ -1,9 +1,12 @@
 #include "next_best_view_call.h"
 
 #include <cmath>
+#include <cstdio>
 
+#include "class_records.h"
 #include "proto_convert.h"
 #include "scenewatch/pipeline/covariance_view_request.h"
+#include "scenewatch/pipeline/object_view_request.h"
 #include "scenewatch/planning/covariance_view.h"
 #include "scenewatch/planning/next_best_view.h"
 
@@ -37,48 +40,55 @@ Result<Aabb> pending_box(const pipeline::WorkingMemory& memory, std::uint64_t id
                    "; GetPendingChanges lists those pending now)");
 }
 
-Result<planning::NextBestViewRequest> to_request(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg) {
-  planning::NextBestViewRequest r;
+// The request's target from the message's, and a sentence saying what it is.
+Result<planning::NextBestViewRequest> target_request(pipeline::WorkingMemory& memory, const proto::NextBestView& msg,
+                                                     ontology::ClassCatalog* classes, std::string& description) {
   switch (msg.target_case()) {
     case proto::NextBestView::kObjectId: {
-      const auto snapshot = memory.snapshot();
-      const auto it = std::find_if(snapshot->objects.begin(), snapshot->objects.end(),
-                                   [&](const TrackedObject& o) { return o.id == msg.object_id(); });
-      if (it == snapshot->objects.end()) return not_found("object_id: no tracked object " + std::to_string(msg.object_id()));
-      r = planning::complete_object_request(it->cluster.box.aabb());
-      break;
+      auto r = pipeline::object_view_request(memory, msg.object_id(), classes,
+                                             classes ? recorder(*classes) : pipeline::DescribedCallback{});
+      if (!r) return r.error();
+      description = std::move(r->target_description);
+      return std::move(r->request);
     }
     case proto::NextBestView::kEventId: {
       const auto events = memory.events_since(msg.event_id() == 0 ? 0 : msg.event_id() - 1, 1);
       if (events.empty() || events.front().id != msg.event_id()) {
         return not_found("event_id: no event " + std::to_string(msg.event_id()) + " in the log");
       }
-      r = planning::confirm_event_request(events.front().box_world);
-      break;
+      description = "event " + std::to_string(msg.event_id()) + "'s box, grown by 4 cm";
+      return planning::confirm_event_request(events.front().box_world);
     }
     case proto::NextBestView::kPendingId: {
       auto box = pending_box(memory, msg.pending_id());
       if (!box) return box.error();
-      r = planning::confirm_event_request(*box);
-      break;
+      description = "pending change " + std::to_string(msg.pending_id()) + "'s box, grown by 4 cm";
+      return planning::confirm_event_request(*box);
     }
     case proto::NextBestView::kBox: {
       auto box = convert::decode_box(msg.box(), "box");
       if (!box) return box.error();
-      r = planning::complete_object_request(*box, 0.0);
-      break;
+      description = "the box given";
+      return planning::complete_object_request(*box, 0.0);
     }
     case proto::NextBestView::kWorkspace: {
       const auto snapshot = memory.snapshot();
       if (snapshot->objects.empty()) return not_found("workspace: no tracked objects yet");
       Aabb all = snapshot->objects.front().cluster.box.aabb();
       for (const auto& o : snapshot->objects) all = all.united(o.cluster.box.aabb());
-      r = planning::complete_object_request(all);
-      break;
+      description = "the box of every tracked object";
+      return planning::complete_object_request(all);
     }
-    case proto::NextBestView::TARGET_NOT_SET:
-      return invalid_argument("target: give object_id, box, event_id, pending_id or workspace");
+    case proto::NextBestView::TARGET_NOT_SET: break;
   }
+  return invalid_argument("target: give object_id, box, event_id, pending_id or workspace");
+}
+
+Result<planning::NextBestViewRequest> to_request(pipeline::WorkingMemory& memory, const proto::NextBestView& msg,
+                                                 ontology::ClassCatalog* classes, std::string& description) {
+  auto target = target_request(memory, msg, classes, description);
+  if (!target) return target.error();
+  planning::NextBestViewRequest& r = *target;
   switch (msg.constraint()) {
     case proto::NextBestView::CONSTRAINT_SPHERE: r.constraint.kind = planning::ConstraintKind::kSphere; break;
     case proto::NextBestView::CONSTRAINT_SHELL: r.constraint.kind = planning::ConstraintKind::kShell; break;
@@ -112,7 +122,7 @@ Result<planning::NextBestViewRequest> to_request(const pipeline::WorkingMemory& 
     r.current_T_world_camera = *pose;
     r.motion_cost_per_m = msg.motion_cost_per_m();
   }
-  return r;
+  return target;
 }
 
 // The seed's planner (measure covariance*): one view, on the sphere of radius_m around an object.
@@ -137,6 +147,7 @@ Status covariance_view(const pipeline::WorkingMemory& memory, const proto::NextB
   for (const auto& o : snapshot->objects) {
     if (o.id == msg.object_id()) convert::to_proto(o.cluster.box.aabb(), out->mutable_target());
   }
+  out->set_target_description("the object's points and its box's faces (the seed's planner)");
   out->set_measure(measure);
   out->set_candidates(1);
   auto* v = out->add_views();
@@ -167,10 +178,11 @@ SuggestedViewSet suggested_set(const proto::NextBestView& msg, const proto::Next
   return set;
 }
 
-Status answer_next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg,
+Status answer_next_best_view(pipeline::WorkingMemory& memory, const proto::NextBestView& msg, ontology::ClassCatalog* classes,
                              proto::NextBestViewReply* out) {
   if (const auto rule = planning::parse_covariance_measure(msg.measure())) return covariance_view(memory, msg, *rule, out);
-  auto request = to_request(memory, msg);
+  std::string description;
+  auto request = to_request(memory, msg, classes, description);
   if (!request) return request.error();
   auto region = planning::planning_region(*request);
   if (!region) return region.error();
@@ -179,6 +191,18 @@ Status answer_next_best_view(const pipeline::WorkingMemory& memory, const proto:
   auto answer = planning::next_best_views(*grid, *request);
   if (!answer) return answer.error();
   convert::to_proto(request->target_world, out->mutable_target());
+  if (answer->planned_for_box) {
+    char text[200];
+    if (answer->surface_coverage >= 1.0) {
+      std::snprintf(text, sizeof text, "; every one of its %zu voxels is known, so the views are for its box", answer->surface_voxels);
+    } else {
+      std::snprintf(text, sizeof text,
+                    "; no candidate reaches an unknown voxel of it (%zu voxels, coverage %.3f), so the views are for its box",
+                    answer->surface_voxels, answer->surface_coverage);
+    }
+    description += text;
+  }
+  out->set_target_description(convert::valid_utf8(description));
   out->set_measure(planning::to_string(answer->measure));
   out->set_coverage(answer->coverage_now);
   out->set_target_voxels(answer->target_voxels);
@@ -199,9 +223,9 @@ Status answer_next_best_view(const pipeline::WorkingMemory& memory, const proto:
 
 }  // namespace
 
-Status next_best_view(const pipeline::WorkingMemory& memory, const proto::NextBestView& msg, proto::NextBestViewReply* out,
-                      SuggestedViews* suggested) {
-  Status status = answer_next_best_view(memory, msg, out);
+Status next_best_view(pipeline::WorkingMemory& memory, const proto::NextBestView& msg, ontology::ClassCatalog* classes,
+                      proto::NextBestViewReply* out, SuggestedViews* suggested) {
+  Status status = answer_next_best_view(memory, msg, classes, out);
   if (status && suggested != nullptr) suggested->record(suggested_set(msg, *out));
   return status;
 }

@@ -186,7 +186,7 @@ Status RequestHandler::Impl::dispatch(const proto::Request& request, SessionCont
     case proto::Request::kGetLocalization: return get_localization(request.get_localization(), response);
     case proto::Request::kGetMap: return get_map(response);
     case proto::Request::kNextBestView:
-      return service::next_best_view(memory, request.next_best_view(), response.mutable_next_best_view(),
+      return service::next_best_view(memory, request.next_best_view(), config.classes.get(), response.mutable_next_best_view(),
                                      config.suggested_views.get());
     case proto::Request::CALL_NOT_SET: break;
   }

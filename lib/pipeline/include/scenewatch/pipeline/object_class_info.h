@@ -1,7 +1,8 @@
 #pragma once
 /// What the ontology says about one tracked object (WorkingMemory::describe_objects): its class
-/// with a score, the class's primitive fitted to it and its grasps. What GetObjects puts in
-/// Object.ontology, without the ontology's working (candidates, the fit, the completed surface).
+/// with a score, the class's primitive fitted to it, its grasps and its completed surface.
+/// GetObjects puts all but the surface in Object.ontology (not the ontology's working either: the
+/// candidates, the fit); NextBestView plans to see the surface.
 #include <functional>
 #include <optional>
 #include <string>
@@ -20,6 +21,10 @@ struct ObjectClassInfo {
   /// any (ObjectDescription::primitive); none when the object could not be fitted at all.
   std::optional<ontology::ShapeFit> primitive;
   std::vector<ontology::GraspPose> grasps;  ///< the class's grasps on its primitive (none for unknown)
+  /// The class's primitive's whole surface, its unseen side included (ontology::complete_surface,
+  /// world frame, about completion_spacing_m apart); empty for unknown.
+  std::vector<Eigen::Vector3d> completed_surface_world;
+  double completion_spacing_m = 0;  ///< between the surface's neighbouring points
 };
 
 /// Told of each new description (WorkingMemory::describe_objects), with the object as described.

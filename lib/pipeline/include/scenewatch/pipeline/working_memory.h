@@ -163,6 +163,12 @@ class WorkingMemory {
                                                                        const ontology::ClassCatalog& classes,
                                                                        const DescribedCallback& on_described = {});
 
+  /// describe_objects() for the one object `object_id` of `snapshot` (the same cache); null when
+  /// the snapshot has no such object or it has no points.
+  std::shared_ptr<const ObjectClassInfo> describe_object(const SceneSnapshot& snapshot, std::uint64_t object_id,
+                                                         const ontology::ClassCatalog& classes,
+                                                         const DescribedCallback& on_described = {});
+
   const Config& config() const { return config_; }
 
  private:

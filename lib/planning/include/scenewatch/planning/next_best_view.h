@@ -15,6 +15,9 @@ namespace scenewatch::planning {
 
 struct NextBestViewRequest {
   Aabb target_world;                  ///< what to see (an object's box, an event's box, the workspace)
+  /// Narrows the target to a surface in its box (ViewScorer's surface_world): an object's
+  /// completed primitive, its unseen side included. Empty: every voxel of the box counts.
+  std::vector<Eigen::Vector3d> target_surface_world;
   ViewConstraint constraint;          ///< where the camera may go (centre: usually the target's)
   Measure measure = Measure::kRearSideEntropy;
   int n = 5;                          ///< how many views to return, best first
@@ -42,6 +45,12 @@ struct NextBestViewAnswer {
   std::size_t target_voxels = 0;
   double coverage_now = 0.0;           ///< fraction of the target's voxels known now
   Measure measure = Measure::kRearSideEntropy;
+  /// A target surface no candidate gains anything on (all its voxels known, or the unknown ones
+  /// hidden from every candidate): the views were planned for the box instead, and the fields above
+  /// are the box's. The surface's voxels and coverage then:
+  bool planned_for_box = false;
+  std::size_t surface_voxels = 0;
+  double surface_coverage = 0.0;
 };
 
 /// The box of the map the planner needs: the target and every candidate position, with a margin.
@@ -59,5 +68,11 @@ NextBestViewRequest confirm_event_request(const Aabb& event_box_world, double ma
 /// Attention: the request that completes an object's model: the unseen side of its box, the
 /// measure rear side entropy (unknown space behind the surface seen so far).
 NextBestViewRequest complete_object_request(const Aabb& object_box_world, double margin_m = 0.02);
+
+/// The same for an object whose whole surface is known from its class (the ontology's completed
+/// primitive, `surface_world`, the face it stands on left out): only the voxels of that surface
+/// count, and the target box is the object's box and the surface's, grown by `margin_m`.
+NextBestViewRequest complete_surface_request(const Aabb& object_box_world, std::vector<Eigen::Vector3d> surface_world,
+                                             double margin_m = 0.02);
 
 }  // namespace scenewatch::planning

@@ -51,7 +51,13 @@ struct ViewGain {
 class ViewScorer {
  public:
   /// `grid` should hold the target and every camera position (rays leaving it stop there).
-  ViewScorer(const background::DenseGrid& grid, const Aabb& target_world, VolumetricConfig config = {});
+  /// `surface_world` (optional) narrows the target to a surface: its voxels are those of the box
+  /// holding one of these points (an object's completed primitive, its unseen side included),
+  /// and only they count. The box's other voxels still stop rays (occupied) and dim them
+  /// (unknown), and unknown space between a surface voxel and the occupied voxel that ends the
+  /// ray keeps it a rear side. Points outside the box are ignored. Empty: every voxel of the box.
+  ViewScorer(const background::DenseGrid& grid, const Aabb& target_world, VolumetricConfig config = {},
+             const std::vector<Eigen::Vector3d>& surface_world = {});
   ViewGain score(const Pose& T_world_camera, const Intrinsics& K, Measure measure);
   /// The same gains by the straightforward walk (every voxel up to the clip with the full
   /// bookkeeping): slower, the oracle of score() in the tests.
@@ -99,6 +105,10 @@ class ViewScorer {
     double visibility = 1.0;
     long previous_unknown_target = -1;
   };
+  /// A voxel of the target's box that is not on the target's surface (surface_ given): it stops
+  /// or dims the ray and keeps an unknown run going, and counts nothing itself. True when the
+  /// ray stops there.
+  bool pass_box_voxel(long index, std::uint32_t stamp, RayState& ray, ViewGain& out, RaySums& sums);
   /// A target voxel (grid index, mark slot) on a ray: counts it; true when the ray stops there.
   bool visit_target_voxel(long index, long mark, std::uint32_t stamp, RayState& ray, ViewGain& out, RaySums& sums);
   /// A ray met a surface right after the unknown target voxel in mark slot `previous`: Isler's
@@ -125,6 +135,7 @@ class ViewScorer {
   long blocks_[3] = {0, 0, 0};
   std::vector<std::uint8_t> block_;
   std::vector<std::uint32_t> reached_, rear_;       ///< marks per target voxel (mark_of): == stamp_ when counted in this call
+  std::vector<std::uint8_t> surface_;               ///< per mark slot, 1: on the target's surface; empty: all are
   std::uint32_t stamp_ = 0;
   std::vector<long> ray_unknown_;                   ///< scratch: one ray's unknown target voxels (mark slots)
 };
