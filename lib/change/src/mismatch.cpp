@@ -247,6 +247,11 @@ std::optional<Aabb> comparison_box(const Cloud& cloud, const Pose& T, const Conf
   return box;
 }
 
+bool any_point_in_range(const Cloud& cloud, const Config& config) {
+  return std::any_of(cloud.points.begin(), cloud.points.end(),
+                     [&](const PointT& p) { return is_valid(p) && p.z <= config.max_range_m; });
+}
+
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& cloud, const Pose& T,
                                       const Intrinsics& K, const Config& config, background::DenseGrid* grid_scratch,
                                       const SurfaceWitness* witness, std::uint32_t camera, bool grid_filled) {

@@ -1,7 +1,6 @@
 // The background map's part of a frame: change detection, then insertion (map_stage.h).
 #include "map_stage.h"
 
-#include <future>
 #include <limits>
 
 #include "frame_sampling.h"
@@ -53,13 +52,19 @@ MapStage::MapStage(const Config& c, std::shared_ptr<change::PendingIds> pending_
 // left without change detection.
 ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
                                        const change::Config& config, std::uint32_t camera) {
-  const bool prefilled = prefilled_.valid() && prefilled_.get();
+  const bool prefilled = prefilled_.value_or(false);
+  prefilled_.reset();
   ChangeOutcome out;
   if (!K) return out;
   out.K = *K;
   std::shared_lock<std::shared_mutex> read(mutex_);
   bool grid_filled = false;
-  if (prefilled) {
+  if (prefilled && T.matrix() == prefill_T_.matrix() && frame.cloud->size() == prefill_points_) {
+    // The pose the copy was filled at, and the frame it was filled for, less what the foreground
+    // blanked (the colour registration moves colours, the blanking sets points to NaN, nothing
+    // moves a point): its box holds this frame's, when any point is left in range.
+    grid_filled = change::any_point_in_range(*frame.cloud, config);
+  } else if (prefilled) {
     const auto box = change::comparison_box(*frame.cloud, T, config, map_.resolution());
     const double eps = 1e-6 * map_.resolution();  // as the fill's key range: faces on a voxel boundary
     grid_filled = box && map_grid_.index_of(box->min.array() + eps) >= 0 && map_grid_.index_of(box->max.array() - eps) >= 0;
@@ -80,12 +85,11 @@ ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const 
 }
 
 void MapStage::prefill(const Frame& frame, const Pose& T, const change::Config& config) {
-  if (prefilled_.valid()) prefilled_.wait();  // a fill no update() took (a frame that failed)
-  prefilled_ = std::async(std::launch::async, [this, cloud = frame.cloud, T, config] {
-    std::shared_lock<std::shared_mutex> read(mutex_);
-    const auto box = change::comparison_box(*cloud, T, config, map_.resolution());
-    return box && map_.fill_dense_grid(*box, map_grid_, config.max_grid_voxels).ok();
-  });
+  prefill_T_ = T;
+  prefill_points_ = frame.cloud ? frame.cloud->size() : 0;
+  std::shared_lock<std::shared_mutex> read(mutex_);
+  const auto box = frame.cloud ? change::comparison_box(*frame.cloud, T, config, map_.resolution()) : std::nullopt;
+  prefilled_ = box && map_.fill_dense_grid(*box, map_grid_, config.max_grid_voxels).ok();
 }
 
 ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
@@ -162,8 +166,7 @@ std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d&
 }
 
 void MapStage::reset() {
-  if (prefilled_.valid()) prefilled_.wait();
-  prefilled_ = {};
+  prefilled_.reset();
   {
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_.reset();
@@ -181,8 +184,7 @@ void MapStage::reset() {
 }
 
 void MapStage::replace(background::OccupancyMap map) {
-  if (prefilled_.valid()) prefilled_.wait();
-  prefilled_ = {};
+  prefilled_.reset();
   {
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_.reset();

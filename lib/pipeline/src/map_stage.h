@@ -6,7 +6,6 @@
 // writer lock; read() takes the map's shared lock and may run beside update()'s change detection.
 #include <cstdint>
 #include <functional>
-#include <future>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -48,10 +47,11 @@ class MapStage {
   /// waits for it, later calls do nothing. Before the next update().
   void witness_frame();
 
-  /// Starts filling the change detection's dense copy of the map around `frame` (placed with T)
-  /// on a thread of its own, to run beside the work before update() (the hands). update() waits
-  /// for it, and uses it when its box holds the box of the frame update() is given (the hands'
-  /// pixels blanked out of that frame can only shrink it); otherwise it fills the copy again.
+  /// Fills the change detection's dense copy of the map around `frame` (placed with T) now, on
+  /// the calling thread: the thread that will run update() calls it first, while the frame's other
+  /// thread does the work before update() (the hands). update() uses the copy when its box holds
+  /// the box of the frame update() is given (the hands' pixels blanked out of that frame can only
+  /// shrink it); otherwise it fills the copy again.
   void prefill(const Frame& frame, const Pose& T, const change::Config& config);
 
   /// The share of world points on surfaces the map remembers (occupied, within the change
@@ -99,7 +99,9 @@ class MapStage {
   mutable std::shared_mutex mutex_;
   background::OccupancyMap map_;
   background::DenseGrid map_grid_;  // the change detector's dense copy of the map, its buffers kept between frames
-  std::future<bool> prefilled_;     // prefill()'s fill of map_grid_: true when it succeeded
+  std::optional<bool> prefilled_;   // prefill()'s fill of map_grid_ since the last update(): true when it succeeded
+  Pose prefill_T_ = Pose::Identity();  // the pose prefill() filled map_grid_ at
+  std::size_t prefill_points_ = 0;     // the size of the cloud it filled for
   change::SurfaceWitness witness_;  // which cameras saw each surface of the map (written by witness_frame())
   struct WitnessJob {
     CloudConstPtr cloud;  // the points update() inserted

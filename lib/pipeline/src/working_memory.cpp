@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <functional>
 #include <future>
 #include <optional>
 
@@ -129,6 +130,30 @@ struct WorkingMemory::Impl {
   }
 };
 
+namespace {
+
+// Hands the map's thread its job once: give() does, or, on any other way out of process(), the
+// destructor hands it none, so that the thread ends and its future can be waited for.
+class JobHandover {
+ public:
+  explicit JobHandover(std::promise<std::function<ChangeOutcome()>>& job) : job_(job) {}
+  JobHandover(const JobHandover&) = delete;
+  JobHandover& operator=(const JobHandover&) = delete;
+  ~JobHandover() {
+    if (!given_) job_.set_value({});
+  }
+  void give(std::function<ChangeOutcome()> run) {
+    given_ = true;
+    job_.set_value(std::move(run));
+  }
+
+ private:
+  std::promise<std::function<ChangeOutcome()>>& job_;
+  bool given_ = false;
+};
+
+}  // namespace
+
 WorkingMemory::WorkingMemory(Config config) : config_(with_sensor(std::move(config))), impl_(std::make_unique<Impl>(config_)) {}
 WorkingMemory::~WorkingMemory() = default;
 
@@ -142,18 +167,31 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   result.frame_index = m.frames;
   result.points = *valid_points;
   const std::uint32_t camera_id = m.camera_of(original);
-  // The change detection's copy of the map is filled at the frame's given pose on a thread of
-  // its own, beside the colour registration, the localization and the hand detection, which the
-  // three parts below wait for (kitchen: a 6.4 ms fill against about 5 ms of those). A pose the
-  // localization moves so far that the copy no longer holds the frame's box has it filled again.
+  // The map's part of the frame runs on a second thread, started here. It first fills the change
+  // detection's copy of the map at the frame's given pose, beside the colour registration, the
+  // localization and the hand detection on this thread (kitchen: a 6.4 ms fill against about 5
+  // ms of those); then it waits for the job below. One thread for both: a thread started for the
+  // job while the fill still ran made three share two cores, and the job's start waited up to
+  // 3.5 ms for one (cup_added). A pose the localization moves so far that the copy no longer
+  // holds the frame's box has it filled again.
   const bool detect = config_.change_enabled && m.frames > 0;
-  if (detect && original.T_world_camera && frame_camera(original)) m.map.prefill(original, *original.T_world_camera, config_.change);
+  const bool fill_ahead = detect && original.T_world_camera && frame_camera(original);
+  std::promise<std::function<ChangeOutcome()>> map_job;
+  auto map_part = std::async(std::launch::async, [&, job = map_job.get_future()]() mutable {
+    if (fill_ahead) m.map.prefill(original, *original.T_world_camera, config_.change);
+    const auto run = job.get();
+    return run ? run() : ChangeOutcome{};
+  });
+  // Every way out of this function hands the thread a job (none on the way out early).
+  JobHandover handover(map_job);
   const Frame registered = m.colour.registered(original, camera_id);
   // Where the frame was taken, against the memory; a camera that is lost changes nothing.
   result.localization = m.localizer.localize(
       registered, camera_id, [&](const Pose& p, std::size_t n) { return m.appearance.nearest(p, n); },
       [&] { return m.appearance.all_keyframes(); });
   if (!result.localization.placed()) {
+    handover.give({});
+    map_part.get();
     ++m.frames;
     result.total_ms = ms_since(t0);
     return result;
@@ -186,7 +224,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
     result.surprise_ms = ms_since(t_surprise);
   };
   const auto t_parallel = Clock::now();
-  auto map_update = std::async(std::launch::async, [&] {
+  handover.give([&] {
     ChangeOutcome out = m.map.update(seen, T, camera, config_, detect, result, camera_id);
     image_surprise();
     m.map.witness_frame();
@@ -196,7 +234,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   image_surprise();
   m.map.witness_frame();  // taken here when the map's thread is still inserting
 
-  const ChangeOutcome changed = map_update.get();
+  const ChangeOutcome changed = map_part.get();
   result.parallel_ms = ms_since(t_parallel);
   const auto t_after = Clock::now();
   foreground::ForegroundUpdate fg = m.foreground.update(result.objects, m.tracker.objects(), result);

@@ -161,6 +161,9 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
 std::optional<Aabb> comparison_box(const Cloud& points_camera, const Pose& T_world_camera, const Config& config,
                                    double resolution_m);
 
+/// Whether comparison_box() would find a box: some point is valid and within max_range_m.
+bool any_point_in_range(const Cloud& points_camera, const Config& config);
+
 /// Same-camera pair of organized clouds of equal size (the camera did not move): exact per-pixel
 /// reasoning. A pixel whose AFTER depth is in front of BEFORE by more than the tolerance is added
 /// (BEFORE saw through that space); BEFORE in front of AFTER is removed (AFTER saw through it).
