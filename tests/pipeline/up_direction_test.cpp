@@ -19,15 +19,17 @@ namespace {
 // Also the object list: what stands on the wall (the relief of a whiteboard, posters) is not an
 // object. Two objects stand on the table (a bin and a toy). The most listed in any frame from the
 // fifth on, and at the end, measured: pick_toy_1 2 and 2 (the bin and the toy, in every frame),
-// pick_toy_2 5 and 3. Before what crosses the table's height was left out (stop 54): 5 and 4, 7
+// pick_toy_2 4 and 3. Before the body was taken to go on downward (stop 56: the person's trousers
+// and hips at the table's edge, below the shirt the detector found): 5 and 3. Before what crosses
+// the table's height was left out (stop 54): 5 and 4, 7
 // and 5 (the chair beside the table; its back and seat stand inside the table's hull, which bands
 // of the wall and the chair at the table's height stretch); before the person's body and pieces of
 // listed objects were: 6 and 6, 8 and 8; 7 and 10 while a cluster seen in one frame was listed,
 // tracking.confirm_frames 1; at the end 18 and 25-26 before strips narrower than the sensor
 // resolves, pieces seen in place without a cluster of their own and pieces of hands were dropped;
-// 41 and 60 when the wall's pieces were listed. What remains in pick_toy_2: the person's shirt at
-// the table's edge (listed in frames 4-7 and 14-31), pieces by the person (frames 0-13, 17-18,
-// 29-31) and by the hand (from frame 40).
+// 41 and 60 when the wall's pieces were listed. What remains in pick_toy_2: pieces behind the
+// person, 110-480 points 1.7-1.8 m out (frames 0-13, 17-18, 29-31), by the bin (frames 35-36) and
+// by the hand (from frame 40); from the fifth frame on 2 listed in 19 frames, 3 in 16, 4 in 3 (replay).
 void expect_table_up_on_every_frame(const std::string& name, std::size_t max_objects, std::size_t max_at_end) {
   const std::optional<Config> shipped = test::shipped_pipeline_config();
   ASSERT_TRUE(shipped);
@@ -76,7 +78,7 @@ TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy1AndNothingStandsOnTh
 
 TEST(UpDirection, IsTheTablesNotTheLargerWallsOnHrt1PickToy2AndNothingStandsOnTheWall) {
   SCENEWATCH_REQUIRE_DATA("hrt1/pick_toy_2");
-  expect_table_up_on_every_frame("pick_toy_2", 5, 3);
+  expect_table_up_on_every_frame("pick_toy_2", 4, 3);
 }
 
 }  // namespace

@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <memory>
 
 #include "foreground_stage.h"
@@ -41,8 +43,13 @@ std::vector<TrackerObservation> tracker_observations(const std::vector<ObjectClu
 
 // A box that lies for the most part (half its volume or more) in one of the frame's hands or arms,
 // or in the person's body, each grown by `margin_m`: a finger, a sleeve, a shirt or a leg the
-// detector left out, not an object the hand reaches for.
-bool touches_person(const Aabb& box, const HandsSeen& hands, double margin_m) {
+// detector left out, not an object the hand reaches for. With a level `up` that lies along an axis
+// of the world, the body also goes on downward, as a standing person does: a box that reaches up
+// to the body's underside and lies mostly in the column below it (trousers and hips, which the
+// skin and clothing colours did not take in; hrt1's pick_toy_2 listed them from its first frame
+// to its 31st) is the person too. An object on the table under a reaching arm stops short of the
+// body's underside, and is not taken.
+bool touches_person(const Aabb& box, const HandsSeen& hands, double margin_m, const std::optional<Eigen::Vector3d>& up) {
   const double volume = (box.max - box.min).cwiseMax(1e-6).prod();
   const auto mostly_in = [&](const Aabb& agent) {
     const Eigen::Vector3d lo = (agent.min.array() - margin_m).max(box.min.array());
@@ -51,7 +58,24 @@ bool touches_person(const Aabb& box, const HandsSeen& hands, double margin_m) {
   };
   for (const auto& h : hands.hands)
     if (mostly_in(h.box_world)) return true;
-  return hands.person_box_world && mostly_in(*hands.person_box_world);
+  if (!hands.person_box_world) return false;
+  const Aabb& body = *hands.person_box_world;
+  if (mostly_in(body)) return true;
+  int axis = -1;
+  if (up) up->cwiseAbs().maxCoeff(&axis);
+  if (axis < 0 || std::abs((*up)(axis)) < std::cos(M_PI / 12)) return false;  // no world axis within 15 degrees of up
+  const bool z_up = (*up)(axis) > 0;
+  // The body's underside along up, and whether the box reaches it from below.
+  const double underside = z_up ? body.min(axis) : body.max(axis);
+  const bool reaches = z_up ? box.max(axis) >= underside - margin_m && box.min(axis) < underside
+                            : box.min(axis) <= underside + margin_m && box.max(axis) > underside;
+  if (!reaches) return false;
+  Aabb column = body;
+  if (z_up) column.min(axis) = -std::numeric_limits<double>::infinity();
+  else column.max(axis) = std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d lo = (column.min.array() - margin_m).max(box.min.array());
+  const Eigen::Vector3d hi = (column.max.array() + margin_m).min(box.max.array());
+  return (hi.array() > lo.array()).all() && (hi - lo).prod() >= 0.5 * volume;
 }
 
 // Whether a cluster rests on its plane (support_contact.h), judged in the camera's frame.
@@ -91,12 +115,15 @@ std::vector<TrackerObservation> tracker_input(const FrameResult& result, const C
                                               const HandsSeen& hands, std::uint64_t frame_index, const Config& config) {
   const std::optional<Eigen::Vector3d>& configured_up = config.segmentation.up;
   std::vector<TrackerObservation> observations = tracker_observations(result.objects, cloud, T, claimed);
+  // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
+  const auto up = level_up(configured_up, result.planes, T);
   for (auto& o : observations) {
     o.resolution_m = std::max(config.segmentation.voxel_size_m, 2 * config.sensor.sigma_z(o.range_m));
-    if (hands.frame_index == frame_index) o.touches_person = touches_person(o.cluster.box.aabb(), hands, config.segmentation.cluster_tolerance_m);
+    if (hands.frame_index == frame_index) {
+      o.touches_person = touches_person(o.cluster.box.aabb(), hands, config.segmentation.cluster_tolerance_m, up);
+    }
   }
-  // Only with an up to trust: a largest plane taken for want of a level one may be a wall.
-  if (const auto up = level_up(configured_up, result.planes, T)) keep_on_level_supports(observations, result.planes, *up, T.translation());
+  if (up) keep_on_level_supports(observations, result.planes, *up, T.translation());
   if (K)
     for (auto& o : observations) o.rests = rests_on_its_plane(o.cluster, result.planes, cloud, T, *K, config.segmentation);
   return observations;
