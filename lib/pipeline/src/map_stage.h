@@ -53,6 +53,9 @@ class MapStage {
   /// the box of the frame update() is given (the hands' pixels blanked out of that frame can only
   /// shrink it); otherwise it fills the copy again.
   void prefill(const Frame& frame, const Pose& T, const change::Config& config);
+  /// Forgets a copy prefill() filled for a frame that never reached update() (its camera was
+  /// lost): the map may change before the next frame (ClearBox), and the copy would not.
+  void drop_prefill() { prefilled_.reset(); }
 
   /// The share of world points on surfaces the map remembers (occupied, within the change
   /// detector's tolerance along the ray from `camera`), for the foreground. The tolerance holds,

@@ -192,6 +192,7 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   if (!result.localization.placed()) {
     handover.give({});
     map_part.get();
+    m.map.drop_prefill();
     ++m.frames;
     result.total_ms = ms_since(t0);
     return result;
