@@ -59,7 +59,6 @@ std::shared_ptr<const ObjectClassInfo> ObjectDescriber::describe(const SceneSnap
       info->primitive = std::move(d->primitive);
       info->grasps = std::move(d->grasps);
       info->completed_surface_world = d->completed_points;
-      info->completion_spacing_m = dc.completion_spacing_m;
     }
     cached.info = info;
     cached.points = points->second.get();

@@ -4,8 +4,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <optional>
 #include <memory>
+#include <optional>
 
 #include "foreground_stage.h"
 #include "support_contact.h"
@@ -73,9 +73,7 @@ bool touches_person(const Aabb& box, const HandsSeen& hands, double margin_m, co
   Aabb column = body;
   if (z_up) column.min(axis) = -std::numeric_limits<double>::infinity();
   else column.max(axis) = std::numeric_limits<double>::infinity();
-  const Eigen::Vector3d lo = (column.min.array() - margin_m).max(box.min.array());
-  const Eigen::Vector3d hi = (column.max.array() + margin_m).min(box.max.array());
-  return (hi.array() > lo.array()).all() && (hi - lo).prod() >= 0.5 * volume;
+  return mostly_in(column);
 }
 
 // Whether a cluster rests on its plane (support_contact.h), judged in the camera's frame.

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <limits>
 #include <optional>
 
 namespace scenewatch::pipeline {
@@ -19,19 +18,6 @@ std::optional<Eigen::Vector3d> standing_up(const SceneSnapshot& snapshot, const 
     if (plane.id == object.cluster.plane_id) return plane.normal_towards(snapshot.camera_world);
   }
   return std::nullopt;
-}
-
-// The points of `surface` above its lowest layer of `layer_m` along `up`: the face an object stands
-// on touches its support, and no view reaches it.
-std::vector<Eigen::Vector3d> without_bottom(const std::vector<Eigen::Vector3d>& surface, const Eigen::Vector3d& up, double layer_m) {
-  double lowest = std::numeric_limits<double>::infinity();
-  for (const auto& p : surface) lowest = std::min(lowest, p.dot(up));
-  std::vector<Eigen::Vector3d> kept;
-  kept.reserve(surface.size());
-  for (const auto& p : surface) {
-    if (p.dot(up) >= lowest + layer_m) kept.push_back(p);
-  }
-  return kept;
 }
 
 }  // namespace
@@ -59,9 +45,9 @@ Result<ObjectViewRequest> object_view_request(WorkingMemory& memory, std::uint64
     return out;
   }
   const double voxel = memory.config().background.resolution_m;
-  std::vector<Eigen::Vector3d> surface = info->completed_surface_world;
   const auto up = standing_up(*snapshot, *object);
-  if (up) surface = without_bottom(surface, *up, voxel);
+  std::vector<Eigen::Vector3d> surface =
+      up ? planning::above_lowest_layer(info->completed_surface_world, *up, voxel) : info->completed_surface_world;
   if (surface.empty()) {
     out.target_description = "the object's box: its completed " + info->class_name + " is no taller than a voxel";
     return out;

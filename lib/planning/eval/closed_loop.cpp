@@ -18,7 +18,8 @@ namespace {
 class HitCells {
  public:
   explicit HitCells(double cell) : cell_(cell) {}
-  void add(const Eigen::Vector3d& p) { cells_.emplace(key(cell_of(p)), p.cast<float>()); }
+  /// True when `p` is the first hit of its cell.
+  bool add(const Eigen::Vector3d& p) { return cells_.emplace(key(cell_of(p)), p.cast<float>()).second; }
   bool near(const Eigen::Vector3d& p) const {
     const Eigen::Vector3i c = cell_of(p);
     for (int dz = -1; dz <= 1; ++dz)
@@ -86,13 +87,9 @@ PlannedBox planned_box(const ClosedLoopSetup& setup, const Aabb& truth, const st
   auto d = ontology::describe(observed, up, *setup.classes, camera.translation());
   curve.last_class = d ? d->class_name : ontology::kUnknownClass;
   if (!d || d->completed_points.empty()) return out;
-  double lowest = std::numeric_limits<double>::infinity();
-  for (const auto& p : d->completed_points) lowest = std::min(lowest, p.z());
-  for (const auto& p : d->completed_points) {
-    if (p.z() >= lowest + setup.resolution_m) out.surface.push_back(p);  // not the face it stands on
-  }
-  if (out.surface.empty()) return out;
-  const NextBestViewRequest r = complete_surface_request(seen, out.surface, setup.resolution_m);
+  std::vector<Eigen::Vector3d> surface = above_lowest_layer(d->completed_points, up, setup.resolution_m);
+  if (surface.empty()) return out;
+  const NextBestViewRequest r = complete_surface_request(seen, std::move(surface), setup.resolution_m);
   ++curve.completed_steps;
   return {r.target_world, r.target_surface_world};
 }
@@ -145,12 +142,9 @@ Result<ClosedLoopCurve> run_closed_loop(const sim::Scenario& scenario_in, const 
   HitCells hits(setup.surface_cell_m);
   // The target's points seen so far, one per 5 mm cell (what a robot knows of it).
   std::vector<Eigen::Vector3d> observed;
-  std::unordered_map<std::uint64_t, bool> observed_cells;
+  HitCells observed_cells(0.005);
   auto keep_observed = [&](const Eigen::Vector3d& p) {
-    const Eigen::Vector3i c = (p / 0.005).array().floor().cast<int>();
-    const std::uint64_t k = (static_cast<std::uint64_t>(c.x() + (1 << 20)) << 42) |
-                            (static_cast<std::uint64_t>(c.y() + (1 << 20)) << 21) | static_cast<std::uint64_t>(c.z() + (1 << 20));
-    if (observed_cells.emplace(k, true).second) observed.push_back(p);
+    if (observed_cells.add(p)) observed.push_back(p);
   };
   auto observe = [&](const Pose& T_world_camera) {
     raycaster.render(scene, T_world_camera, K, &view);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace scenewatch::planning {
 
@@ -106,6 +107,18 @@ NextBestViewRequest confirm_event_request(const Aabb& event_box_world, double ma
 
 NextBestViewRequest complete_object_request(const Aabb& object_box_world, double margin_m) {
   return around(object_box_world.grown(margin_m), Measure::kRearSideEntropy);
+}
+
+std::vector<Eigen::Vector3d> above_lowest_layer(const std::vector<Eigen::Vector3d>& surface, const Eigen::Vector3d& up,
+                                                double layer_m) {
+  double lowest = std::numeric_limits<double>::infinity();
+  for (const auto& p : surface) lowest = std::min(lowest, p.dot(up));
+  std::vector<Eigen::Vector3d> kept;
+  kept.reserve(surface.size());
+  for (const auto& p : surface) {
+    if (p.dot(up) >= lowest + layer_m) kept.push_back(p);
+  }
+  return kept;
 }
 
 NextBestViewRequest complete_surface_request(const Aabb& object_box_world, std::vector<Eigen::Vector3d> surface_world,

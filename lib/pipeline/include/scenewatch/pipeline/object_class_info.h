@@ -22,9 +22,8 @@ struct ObjectClassInfo {
   std::optional<ontology::ShapeFit> primitive;
   std::vector<ontology::GraspPose> grasps;  ///< the class's grasps on its primitive (none for unknown)
   /// The class's primitive's whole surface, its unseen side included (ontology::complete_surface,
-  /// world frame, about completion_spacing_m apart); empty for unknown.
+  /// world frame, the describer's completion spacing apart); empty for unknown.
   std::vector<Eigen::Vector3d> completed_surface_world;
-  double completion_spacing_m = 0;  ///< between the surface's neighbouring points
 };
 
 /// Told of each new description (WorkingMemory::describe_objects), with the object as described.

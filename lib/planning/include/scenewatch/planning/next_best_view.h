@@ -69,6 +69,11 @@ NextBestViewRequest confirm_event_request(const Aabb& event_box_world, double ma
 /// measure rear side entropy (unknown space behind the surface seen so far).
 NextBestViewRequest complete_object_request(const Aabb& object_box_world, double margin_m = 0.02);
 
+/// The points of an object's surface above its lowest layer of `layer_m` along `up`: the face it
+/// stands on touches its support, and no view reaches it.
+std::vector<Eigen::Vector3d> above_lowest_layer(const std::vector<Eigen::Vector3d>& surface_world, const Eigen::Vector3d& up,
+                                                double layer_m);
+
 /// The same for an object whose whole surface is known from its class (the ontology's completed
 /// primitive, `surface_world`, the face it stands on left out): only the voxels of that surface
 /// count, and the target box is the object's box and the surface's, grown by `margin_m`.
