@@ -124,6 +124,38 @@ TEST(SurfaceWitness, ACameraClaimsOnlyAgainstWhatItHasSeen) {
   EXPECT_EQ(small.seen(Eigen::Vector3d(0.001, 0, 1.0), 0), SurfaceWitness::Seen::kByNone);
 }
 
+// Voxels are kept in blocks of 4 x 4 x 4: neighbours in one block, and in the next block, are
+// separate surfaces; forgetting one leaves the others, and a block emptied and filled again
+// starts clean.
+TEST(SurfaceWitness, NeighbouringVoxelsAreSeparateSurfaces) {
+  SurfaceWitness witness(0.02);
+  auto cloud = std::make_shared<Cloud>();
+  for (float x : {0.001f, 0.021f, 0.081f}) {  // voxels 0 and 1 (one block), 4 (the next block)
+    PointT p;
+    p.x = x;
+    p.y = 0.001f;
+    p.z = 1.001f;
+    cloud->push_back(p);
+  }
+  witness.witness(*cloud, Pose::Identity(), 1);
+  EXPECT_EQ(witness.size(), 3u);
+  EXPECT_EQ(witness.seen(Eigen::Vector3d(0.041, 0.001, 1.001), 1), SurfaceWitness::Seen::kByNone);
+  witness.forget({Eigen::Vector3d(0.001, 0.001, 1.001)});
+  EXPECT_EQ(witness.size(), 2u);
+  EXPECT_EQ(witness.seen(Eigen::Vector3d(0.001, 0.001, 1.001), 1), SurfaceWitness::Seen::kByNone);
+  EXPECT_EQ(witness.seen(Eigen::Vector3d(0.021, 0.001, 1.001), 1), SurfaceWitness::Seen::kBySelf);
+  EXPECT_EQ(witness.seen(Eigen::Vector3d(0.081, 0.001, 1.001), 1), SurfaceWitness::Seen::kBySelf);
+  witness.forget({Eigen::Vector3d(0.021, 0.001, 1.001), Eigen::Vector3d(0.081, 0.001, 1.001)});
+  EXPECT_EQ(witness.size(), 0u);
+  auto other = std::make_shared<Cloud>();
+  other->push_back(cloud->points[1]);
+  witness.witness(*other, Pose::Identity(), 2);
+  double depth = 0.0;
+  EXPECT_EQ(witness.seen(Eigen::Vector3d(0.021, 0.001, 1.001), 1, &depth), SurfaceWitness::Seen::kByOthersOnly);
+  EXPECT_NEAR(depth, 1.001, 1e-6);
+  EXPECT_EQ(witness.seen(Eigen::Vector3d(0.001, 0.001, 1.001), 2), SurfaceWitness::Seen::kByNone);
+}
+
 // The map's surface lies within the noise of the nearest depth it was seen at: one point of the
 // world, seen from 3 m by one camera and from 1.2 m by another, keeps 1.2 m, whichever came first.
 TEST(SurfaceWitness, KeepsTheNearestDepthEachSurfaceWasSeenAt) {

@@ -62,10 +62,18 @@ Result<std::size_t> validate_frame(const Frame& f, double workspace_radius_m) {
   std::size_t valid = 0, far = 0, outside = 0;
   const PointT* first_far = nullptr;
   Eigen::Vector3d first_outside = Eigen::Vector3d::Zero();
+  // A rigid motion moves a point at most by the camera's distance from the origin: a point nearer
+  // to the camera than the workspace radius less that distance lies inside (with a margin for
+  // rounding), and only the others are moved into the world to be checked.
+  const double camera_m = T.translation().norm();
+  const double inside_m = workspace_radius_m - camera_m;
+  const float surely_inside_squared = inside_m > 0 ? static_cast<float>(inside_m * inside_m * (1.0 - 1e-5)) : -1.0f;
   for (const auto& p : f.cloud->points) {
     if (!is_valid(p)) continue;
     ++valid;
-    if (p.getVector3fMap().squaredNorm() > kMaxPointRangeM * kMaxPointRangeM && far++ == 0) first_far = &p;
+    const float range_squared = p.getVector3fMap().squaredNorm();
+    if (range_squared > kMaxPointRangeM * kMaxPointRangeM && far++ == 0) first_far = &p;
+    if (range_squared < surely_inside_squared) continue;
     const Eigen::Vector3d p_world = T * p.getVector3fMap().cast<double>();
     if (p_world.squaredNorm() > workspace_squared && outside++ == 0) first_outside = p_world;
   }
