@@ -124,7 +124,7 @@ void SurfaceWitness::witness(const Cloud& cloud, const Pose& T, std::uint32_t ca
     Entry& e = block.voxels[m.voxel];
     if (e.cameras == 0) ++live_, ++block.live;
     e.cameras |= bit;
-    e.last_frame = frame_;
+    e.last_frame = static_cast<std::uint32_t>(frame_);
     if (e.nearest_depth_m == 0.0f || m.depth_m < e.nearest_depth_m) e.nearest_depth_m = m.depth_m;
   }
   if (live_ > max_voxels_) prune();
@@ -146,22 +146,26 @@ void SurfaceWitness::forget(const std::vector<Eigen::Vector3d>& points) {
   }
 }
 
-// Keeps the three quarters of the limit seen most recently.
+// Keeps the three quarters of the limit seen most recently. Ages are counted modulo 2^32 frames
+// (a frame number is kept in 32 bits), so they stay right when the count wraps.
 void SurfaceWitness::prune() {
-  std::vector<std::uint64_t> frames;
-  frames.reserve(live_);
+  const auto now = static_cast<std::uint32_t>(frame_);
+  std::vector<std::uint32_t> ages;
+  ages.reserve(live_);
   for (const auto& [key, b] : blocks_by_key_)
     for (const Entry& e : blocks_[b].voxels)
-      if (e.cameras != 0) frames.push_back(e.last_frame);
+      if (e.cameras != 0) ages.push_back(now - e.last_frame);
   const std::size_t keep = max_voxels_ * 3 / 4;
-  std::nth_element(frames.begin(), frames.end() - static_cast<long>(keep), frames.end());
-  const std::uint64_t oldest_kept = *(frames.end() - static_cast<long>(keep));
+  std::nth_element(ages.begin(), ages.begin() + static_cast<long>(keep) - 1, ages.end());
+  const std::uint32_t oldest_kept = ages[keep - 1];
   std::vector<std::uint32_t> live_blocks;
   live_blocks.reserve(blocks_by_key_.size());
   for (const auto& [key, b] : blocks_by_key_) live_blocks.push_back(b);
   for (std::uint32_t b : live_blocks)
-    for (unsigned v = 0; v < kBlockVoxels; ++v)
-      if (blocks_[b].voxels[v].cameras != 0 && blocks_[b].voxels[v].last_frame < oldest_kept) clear(b, v);
+    for (unsigned v = 0; v < kBlockVoxels; ++v) {
+      const Entry& e = blocks_[b].voxels[v];
+      if (e.cameras != 0 && static_cast<std::uint32_t>(now - e.last_frame) > oldest_kept) clear(b, v);
+    }
 }
 
 }  // namespace scenewatch::change

@@ -42,12 +42,13 @@ class SurfaceWitness {
  private:
   // Voxels are kept in blocks of 4 x 4 x 4: a frame's neighbouring pixels mostly mark voxels of
   // one block, which is found once and then written in place (a hash lookup per voxel missed the
-  // cache on most of them: the kitchen spent 55 % of the witness there).
+  // cache on most of them: the kitchen spent 55 % of the witness there). A block takes 1 KiB
+  // (16 bytes a voxel); a surface crossing it fills a quarter of its voxels.
   static constexpr unsigned kBlockBits = 2;
   static constexpr unsigned kBlockVoxels = 1u << (3 * kBlockBits);
   struct Entry {
     std::uint64_t cameras = 0;  ///< bit (camera id mod 64) per camera that saw it; 0: not a surface
-    std::uint64_t last_frame = 0;
+    std::uint32_t last_frame = 0;  ///< the frame count modulo 2^32
     float nearest_depth_m = 0.0f;  ///< the smallest depth (camera z) it was seen at
   };
   struct Block {
