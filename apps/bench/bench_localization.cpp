@@ -127,6 +127,9 @@ int run_simulated() {
   std::printf("\nlocalization: the simulator's clutter table, %zu frames at 640x480 on half a circle, errors against the exact truth\n",
               truth.size());
   score("refine, exact poses given (its correction)", truth, localization::Config{});
+  localization::Config finest_geometric;
+  finest_geometric.alignment.photometric_on_finest_level = false;
+  score("refine, exact poses, finest level geometry only", truth, finest_geometric);
   localization::Config told_noise;
   told_noise.noise_m = 0.005;
   told_noise.noise_deg = 0.25;
@@ -154,6 +157,12 @@ int run_trajectories(const io::Sequence& seq, const std::vector<Pose>& truth) {
     Errors e;
     for (std::size_t i = 0; i < truth.size(); ++i) add_error(e, t.used[i], truth[i]);
     print_errors("refine, the recording's own poses (correction)", e, t);
+    localization::Config finest_geometric;
+    finest_geometric.alignment.photometric_on_finest_level = false;
+    const Trajectory g = run(seq, given, LocalizationMode::kRefine, finest_geometric);
+    Errors eg;
+    for (std::size_t i = 0; i < truth.size(); ++i) add_error(eg, g.used[i], truth[i]);
+    print_errors("  the same, finest level geometry only", eg, g);
   }
   for (unsigned seed : {1u, 2u, 3u}) {
     const auto drifted = localization::with_drift(truth, 0.003, 0.15, seed);
@@ -175,11 +184,14 @@ int run_trajectories(const io::Sequence& seq, const std::vector<Pose>& truth) {
       print_errors(((told ? "refine, drift configured: " : "refine, default drift: ") + label).c_str(), e, t);
     }
   }
-  {
+  for (const bool photometric_finest : {true, false}) {
     std::vector<std::optional<Pose>> none(truth.size());
-    const Trajectory t = run(seq, none, LocalizationMode::kTrack);
+    localization::Config lc;
+    lc.alignment.photometric_on_finest_level = photometric_finest;
+    const Trajectory t = run(seq, none, LocalizationMode::kTrack, lc);
     std::printf("  %-58s RMSE %5.1f mm over %zu frames (both relative to their first pose) | lost %3zu | %5.1f ms/frame\n",
-                "track, no poses, from an empty memory", 1000 * relative_rmse(t.used, truth), truth.size(), t.lost, median(t.ms));
+                photometric_finest ? "track, no poses, from an empty memory" : "  the same, finest level geometry only",
+                1000 * relative_rmse(t.used, truth), truth.size(), t.lost, median(t.ms));
   }
   return 0;
 }
@@ -193,7 +205,7 @@ struct PairResult {
 };
 
 void print_pair(const char* what, const PairResult& r) {
-  std::printf("  %-34s median %5.1f mm %5.2f deg | p95 %6.1f mm %5.2f deg | failed %2zu | median %6.1f ms\n", what,
+  std::printf("  %-44s median %5.1f mm %5.2f deg | p95 %6.1f mm %5.2f deg | failed %2zu | median %6.1f ms\n", what,
               1000 * median(r.errors.m), median(r.errors.deg), 1000 * quantile(r.errors.m, 0.95), quantile(r.errors.deg, 0.95),
               r.failed, median(r.ms));
 }
@@ -233,11 +245,13 @@ int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
   const std::size_t gap = 3;
   std::printf("\nlocalization: frame-to-frame alignment, %zu pairs 0.2 s apart, from the identity, errors against the recording's relative poses\n",
               (seq.frames.size() - gap + 4) / 5);
-  PairResult ours, ours_geometric, opencv, gicp, none;
+  PairResult ours, ours_coarse_photometric, ours_geometric, opencv, gicp, none;
   std::vector<double> reference_ms, current_ms;
   localization::AlignmentConfig geometric;
   geometric.photometric_weight = 0;
   const localization::Config defaults;
+  localization::AlignmentConfig finest_geometric = defaults.alignment;
+  finest_geometric.photometric_on_finest_level = false;
   const SensorModel sensor;
   for (std::size_t i = 0; i + gap < seq.frames.size(); i += 5) {
     auto a = io::load_sequence_frame(seq, i);
@@ -254,6 +268,9 @@ int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
     ours.ms.push_back(current_ms.back() +
                       time_ms([&] { r = localization::align(ref, cur, Pose::Identity(), sensor, defaults.alignment); }));
     add_error(ours.errors, r.T_reference_current, truth_ab);
+    ours_coarse_photometric.ms.push_back(
+        current_ms.back() + time_ms([&] { r = localization::align(ref, cur, Pose::Identity(), sensor, finest_geometric); }));
+    add_error(ours_coarse_photometric.errors, r.T_reference_current, truth_ab);
     ours_geometric.ms.push_back(current_ms.back() +
                                 time_ms([&] { r = localization::align(ref, cur, Pose::Identity(), sensor, geometric); }));
     add_error(ours_geometric.errors, r.T_reference_current, truth_ab);
@@ -293,6 +310,7 @@ int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
   }
   print_pair("no alignment (identity)", none);
   print_pair("scenewatch dense RGB-D (default)", ours);
+  print_pair("scenewatch dense, finest level geometry only", ours_coarse_photometric);
   print_pair("scenewatch dense, geometry only", ours_geometric);
 #ifdef SCENEWATCH_BENCH_HAS_OPENCV_RGBD
   print_pair("OpenCV rgbd::RgbdICPOdometry", opencv);

@@ -68,14 +68,20 @@ TEST(DenseAlignment, RecoversAKnownMotionOfARealFrame) {
   for (const Pose& T_b_a : {motion(0.03, -0.01, 0.02, 2.0, {0.2, 1, 0.1}), motion(-0.05, 0.02, -0.04, 3.0, {1, 0.3, -0.2})}) {
     const Frame b = moved_camera(a, T_b_a);
     const RgbdPyramid cur = build_pyramid(*b.cloud, *b.intrinsics, sensor, config.pyramid, false);
-    const Alignment r = align(ref, cur, Pose::Identity(), sensor, config.alignment);
-    const auto error = background::view_distance(r.T_reference_current, T_b_a.inverse());
-    std::cout << "oracle: " << 1000 * error.translation_m << " mm " << error.rotation_deg << " deg, inliers " << r.inlier_fraction << "\n";
-    // Measured: 0.11 and 0.19 mm, 0.005 and 0.006 degrees (the re-projection rounds to pixels);
-    // 89 and 90 % of the depth pixels inliers.
-    EXPECT_LT(error.translation_m, 0.0004);
-    EXPECT_LT(error.rotation_deg, 0.012);
-    EXPECT_GT(r.inlier_fraction, 0.85);
+    for (const bool photometric_finest : {true, false}) {
+      AlignmentConfig alignment = config.alignment;
+      alignment.photometric_on_finest_level = photometric_finest;
+      const Alignment r = align(ref, cur, Pose::Identity(), sensor, alignment);
+      const auto error = background::view_distance(r.T_reference_current, T_b_a.inverse());
+      std::cout << "oracle" << (photometric_finest ? "" : ", finest level geometry only") << ": " << 1000 * error.translation_m
+                << " mm " << error.rotation_deg << " deg, inliers " << r.inlier_fraction << "\n";
+      // Measured: 0.11 and 0.19 mm, 0.005 and 0.006 degrees (the re-projection rounds to pixels);
+      // 89 and 90 % of the depth pixels inliers. The finest level on geometry alone: 0.11 and
+      // 0.15 mm, 0.003 and 0.005 degrees.
+      EXPECT_LT(error.translation_m, 0.0004);
+      EXPECT_LT(error.rotation_deg, 0.012);
+      EXPECT_GT(r.inlier_fraction, 0.85);
+    }
   }
 }
 
@@ -312,6 +318,9 @@ TEST(LocalizationConfig, AnUnknownModeIsAnErrorNamingTheKey) {
   ASSERT_TRUE(pipeline::read_pipeline_config(YAML::Load("localization: {mode: track, drift_m_per_frame: 0.003}"), ok).ok());
   EXPECT_EQ(ok.localization.mode, LocalizationMode::kTrack);
   EXPECT_DOUBLE_EQ(ok.localization.drift_m_per_frame, 0.003);
+  EXPECT_TRUE(ok.localization.alignment.photometric_on_finest_level);
+  ASSERT_TRUE(pipeline::read_pipeline_config(YAML::Load("localization: {photometric_on_finest_level: false}"), ok).ok());
+  EXPECT_FALSE(ok.localization.alignment.photometric_on_finest_level);
 }
 
 }  // namespace

@@ -228,8 +228,10 @@ Alignment align(const RgbdPyramid& reference, const RgbdPyramid& current, const 
   for (int l = levels - 1; l >= 0; --l) {
     LevelInput in{reference.levels[l], current.levels[l], config.max_correspondence_m * std::pow(0.5, levels - 1 - l), 0.1};
     const int iterations = config.iterations[config.iterations.size() - 1 - l];
+    AlignmentConfig level_config = config;
+    if (l == 0 && !config.photometric_on_finest_level) level_config.photometric_weight = 0;
     for (int it = 0; it < iterations; ++it) {
-      Pass pass = linearise(in, T, sensor, config);
+      Pass pass = linearise(in, T, sensor, level_config);
       ++out.iterations;
       in.photometric_sigma = robust_spread(pass.photometric_abs, in.photometric_sigma);
       if (pass.correspondences < 60) break;

@@ -78,6 +78,7 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
                          [&] { return s.read("max_correspondence_m", l.alignment.max_correspondence_m); },
                          [&] { return s.read("photometric_weight", l.alignment.photometric_weight); },
                          [&] { return s.read("min_gradient", l.alignment.min_gradient); },
+                         [&] { return s.read("photometric_on_finest_level", l.alignment.photometric_on_finest_level); },
                          [&] { return s.read("min_inlier_fraction", l.min_inlier_fraction); },
                          [&] { return s.read("min_conditioning", l.min_conditioning); },
                          [&] { return s.read("max_correction_m", l.max_correction_m); },
