@@ -18,11 +18,6 @@ double nguyen_angle_term_m(double z, double theta) {
 
 }  // namespace
 
-double SensorModel::sigma_z(double z) const {
-  const double d = z - axial_offset_m;
-  return axial_base_m + axial_quad_per_m * d * d;
-}
-
 double SensorModel::sigma_z(double z, double incidence_rad) const {
   const double theta = std::clamp(incidence_rad, 0.0, kMaxIncidenceRad);
   const double head_on = sigma_z(z);

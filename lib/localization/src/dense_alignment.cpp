@@ -75,6 +75,28 @@ struct Bilinear {
   float operator()(const std::vector<float>& img) const {
     return (1 - ay) * ((1 - ax) * img[i] + ax * img[i + 1]) + ay * ((1 - ax) * img[i + width] + ax * img[i + width + 1]);
   }
+  /// The three channels of a shade image at once, each as operator() would sample it.
+  RgbdLevel::Shade operator()(const std::vector<RgbdLevel::Shade>& img) const {
+    const RgbdLevel::Shade &a = img[i], &b = img[i + 1], &c = img[i + width], &d = img[i + width + 1];
+    const auto mix = [&](float RgbdLevel::Shade::*f) {
+      return (1 - ay) * ((1 - ax) * a.*f + ax * b.*f) + ay * ((1 - ax) * c.*f + ax * d.*f);
+    };
+    return {mix(&RgbdLevel::Shade::intensity), mix(&RgbdLevel::Shade::grad_x), mix(&RgbdLevel::Shade::grad_y)};
+  }
+};
+
+// RgbdLevel::point's factors per column and per row, computed once a pass instead of two
+// divisions per pixel: the same values, so the same points.
+struct PixelRays {
+  std::vector<float> x, y;
+  explicit PixelRays(const RgbdLevel& level) : x(static_cast<std::size_t>(level.width)), y(static_cast<std::size_t>(level.height)) {
+    const Intrinsics& K = level.intrinsics;
+    for (int u = 0; u < level.width; ++u) x[static_cast<std::size_t>(u)] = static_cast<float>((u - K.cx) / K.fx);
+    for (int v = 0; v < level.height; ++v) y[static_cast<std::size_t>(v)] = static_cast<float>((v - K.cy) / K.fy);
+  }
+  Eigen::Vector3f point(int u, int v, float z) const {
+    return {x[static_cast<std::size_t>(u)] * z, y[static_cast<std::size_t>(v)] * z, z};
+  }
 };
 
 struct Pass {
@@ -105,13 +127,14 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
   const float cx = static_cast<float>(ref.intrinsics.cx), cy = static_cast<float>(ref.intrinsics.cy);
   const double wphoto = config.photometric_weight;
   const float min_grad = static_cast<float>(config.min_gradient);
+  const PixelRays cur_rays(cur), ref_rays(ref);
   for (int v = 0; v < cur.height; ++v) {
     for (int u = 0; u < cur.width; ++u) {
       const std::size_t ic = static_cast<std::size_t>(v) * cur.width + u;
       const float zc = cur.depth_m[ic];
       if (zc <= 0) continue;
       ++p.valid;
-      const Eigen::Vector3f q = R * cur.point(u, v, zc) + t;
+      const Eigen::Vector3f q = R * cur_rays.point(u, v, zc) + t;
       if (q.z() <= 0) continue;
       const float x = fx * q.x() / q.z() + cx, y = fy * q.y() / q.z() + cy;
       if (!(x >= 0 && y >= 0 && x < ref.width - 1 && y < ref.height - 1)) continue;
@@ -121,7 +144,7 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
       const std::size_t ir = static_cast<std::size_t>(iv) * ref.width + iu;
       const float zr = ref.depth_m[ir];
       if (zr > 0 && std::isfinite(ref.normals[ir].x())) {
-        const Eigen::Vector3f d = q - ref.point(iu, iv, zr);
+        const Eigen::Vector3f d = q - ref_rays.point(iu, iv, zr);
         const double sz_c = sensor.sigma_z(zc), sz_r = sensor.sigma_z(zr);
         const double sigma2 = sz_c * sz_c + sz_r * sz_r, sigma = std::sqrt(sigma2);
         if (d.norm() <= std::max(in.gate_m, kGateSigmas * sigma)) {
@@ -142,11 +165,11 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
       }
       // Photometric: the reference intensity where the point projects, where it has texture.
       if (wphoto <= 0) continue;
-      const float gx = ref.grad_x[ir], gy = ref.grad_y[ir];
-      if (std::abs(gx) < min_grad && std::abs(gy) < min_grad) continue;
-      const Bilinear at(ref.width, x, y);
-      const double r = at(ref.intensity) - cur.intensity[ic];
-      const double bgx = at(ref.grad_x), bgy = at(ref.grad_y);
+      const RgbdLevel::Shade& nearest = ref.shade[ir];
+      if (std::abs(nearest.grad_x) < min_grad && std::abs(nearest.grad_y) < min_grad) continue;
+      const RgbdLevel::Shade at = Bilinear(ref.width, x, y)(ref.shade);
+      const double r = at.intensity - cur.intensity[ic];
+      const double bgx = at.grad_x, bgy = at.grad_y;
       const double iz = 1.0 / qd.z();
       // Gradient through the projection: a = dpi/dq^T grad.
       const Eigen::Vector3d a(bgx * fx * iz, bgy * fy * iz, -(bgx * fx * qd.x() + bgy * fy * qd.y()) * iz * iz);

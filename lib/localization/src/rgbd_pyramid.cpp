@@ -67,13 +67,13 @@ bool near_in_depth(float a, float b) { return b > 0 && std::abs(a - b) <= kMaxRe
 void add_reference_terms(RgbdLevel& l) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   l.normals.assign(l.pixels(), Eigen::Vector3f::Constant(nan));
-  l.grad_x.assign(l.pixels(), 0.0f);
-  l.grad_y.assign(l.pixels(), 0.0f);
+  l.shade.assign(l.pixels(), RgbdLevel::Shade{});
+  for (std::size_t i = 0; i < l.pixels(); ++i) l.shade[i].intensity = l.intensity[i];
   for (int v = 1; v + 1 < l.height; ++v) {
     for (int u = 1; u + 1 < l.width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * l.width + u;
-      l.grad_x[i] = 0.5f * (l.intensity[i + 1] - l.intensity[i - 1]);
-      l.grad_y[i] = 0.5f * (l.intensity[i + l.width] - l.intensity[i - l.width]);
+      l.shade[i].grad_x = 0.5f * (l.intensity[i + 1] - l.intensity[i - 1]);
+      l.shade[i].grad_y = 0.5f * (l.intensity[i + l.width] - l.intensity[i - l.width]);
       const float z = l.depth_m[i];
       if (z <= 0) continue;
       const float zl = l.depth_m[i - 1], zr = l.depth_m[i + 1], zu = l.depth_m[i - l.width], zd = l.depth_m[i + l.width];

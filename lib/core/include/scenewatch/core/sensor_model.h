@@ -57,8 +57,12 @@ struct SensorModel {
   double pose_sigma_m = 0.0;
   double pose_sigma_deg = 0.0;
 
-  /// Axial noise at depth z for a surface seen head-on, metres.
-  double sigma_z(double z_m) const;
+  /// Axial noise at depth z for a surface seen head-on, metres. Inline: the alignment asks it
+  /// twice a pixel.
+  double sigma_z(double z_m) const {
+    const double d = z_m - axial_offset_m;
+    return axial_base_m + axial_quad_per_m * d * d;
+  }
   /// ... and at an incidence angle (radians from the ray) up to 89 degrees: Nguyen's eq. (2),
   /// the angle term scaled to this profile's axial noise.
   double sigma_z(double z_m, double incidence_rad) const;

@@ -20,7 +20,12 @@ struct RgbdLevel {
   std::vector<float> depth_m;
   std::vector<float> intensity;      ///< 0..1, (R + G + B) / 765
   std::vector<Eigen::Vector3f> normals;  ///< camera frame, towards the camera; reference only
-  std::vector<float> grad_x, grad_y; ///< intensity per pixel; reference only
+  /// A pixel's intensity with its gradient (per pixel, central differences), side by side: the
+  /// alignment samples all three at one sub-pixel position. Reference only.
+  struct Shade {
+    float intensity = 0.0f, grad_x = 0.0f, grad_y = 0.0f;
+  };
+  std::vector<Shade> shade;
   std::size_t pixels() const { return static_cast<std::size_t>(width) * height; }
   /// The camera-frame point of a pixel with depth z.
   Eigen::Vector3f point(int u, int v, float z) const {
