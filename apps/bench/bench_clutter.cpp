@@ -124,8 +124,12 @@ int run_clutter_with(const Options& o, const segmentation::Config& cfg, const ch
 }  // namespace
 
 int run_clutter(const Options& o) {
-  // The largest visible piece of a table alone as its support (before the bridge was the default).
-  segmentation::Config largest_piece;
+  // The default without the cut between levels of stacked objects (the default before stop 57).
+  segmentation::Config unstacked;
+  unstacked.split_stacked = false;
+  // The largest visible piece of a table alone as its support (before the bridge was the default),
+  // no cut between levels: the baseline of the boundary cuts' rows, as measured before it.
+  segmentation::Config largest_piece = unstacked;
   largest_piece.bridge_hidden_support = false;
   // Issue 30, item 1: cuts at closed depth steps, then also at closed colour edges (both off by
   // default), measured against the largest-piece rows, timed in the same run.
@@ -134,7 +138,8 @@ int run_clutter(const Options& o) {
   segmentation::Config colour = steps;
   colour.split_colour_edges = true;
   return run_clutter_with(o, segmentation::Config{}, "default config") |
-         run_clutter_with(o, largest_piece, "segmentation.bridge_hidden_support: false") |
+         run_clutter_with(o, unstacked, "segmentation.split_stacked: false") |
+         run_clutter_with(o, largest_piece, "bridge_hidden_support: false, split_stacked: false") |
          run_clutter_with(o, steps, "bridge_hidden_support: false, split_depth_steps: true") |
          run_clutter_with(o, colour, "bridge_hidden_support: false, split_depth_steps + split_colour_edges: true");
 }

@@ -456,8 +456,10 @@ TEST(WorkingMemory, EveryObjectOfAMosdPileIsListed) {
     std::printf("test%d: %zu listed of %zu clusters\n", n, wm.snapshot()->objects.size(), r->objects.size());
   }
   std::printf("test_dev: %zu objects listed of %zu clusters\n", listed, clusters);
-  EXPECT_EQ(clusters, 148u);
-  EXPECT_EQ(listed, 146u);
+  // Since the cut between stacked levels (segmentation.split_stacked): 155 of 157, the same two
+  // left out.
+  EXPECT_EQ(clusters, 157u);
+  EXPECT_EQ(listed, 155u);
 }
 
 }  // namespace

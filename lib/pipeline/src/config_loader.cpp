@@ -145,6 +145,7 @@ Status read_segmentation(const YAML::Node& node, Config& c) {
                          [&] { return s.read("recover_image_grid", g.recover_image_grid); },
                          [&] { return s.read("bridge_hidden_support", g.bridge_hidden_support); },
                          [&] { return s.read("split_depth_steps", g.split_depth_steps); },
+                         [&] { return s.read("split_stacked", g.split_stacked); },
                          [&] { return s.read("split_colour_edges", g.split_colour_edges); });
       !st)
     return st;

@@ -17,6 +17,7 @@
 #include "scenewatch/segmentation/tabletop.h"
 #include "scenewatch/core/plane_fit.h"
 #include "boundary_cut.h"
+#include "terrace_split.h"
 #include "colour_edges.h"
 #include "containers.h"
 #include "convex_parts.h"
@@ -568,6 +569,19 @@ Segmentation segment(const Cloud& cloud, const Config& cfg, const Eigen::Vector3
     else parts.push_back(std::move(cluster.indices));
     if (split && (cfg.split_depth_steps || cfg.split_colour_edges))
       parts = cut_parts_at_boundaries(cloud, std::move(parts), sensor_origin, cfg);
+    if (split && cfg.split_stacked) {
+      TerraceParams tp;
+      tp.sensor = cfg.sensor;
+      tp.min_points = cfg.min_cluster_points;
+      tp.min_size_m = ConvexityParams{}.min_part_size_m;
+      Eigen::Vector3d n = frames[cluster.plane].model.n;
+      double d = frames[cluster.plane].model.d;
+      if (n.dot(sensor_origin) + d < 0) n = -n, d = -d;
+      std::vector<std::vector<int>> cut;
+      for (auto& p : parts)
+        for (auto& piece : split_at_terraces(cloud, std::move(p), n, d, tp)) cut.push_back(std::move(piece));
+      parts = std::move(cut);
+    }
     for (auto& indices : parts) {
       const int n = static_cast<int>(indices.size());
       if (n >= cfg.min_cluster_points && n <= cfg.max_cluster_points) pieces.push_back({std::move(indices), cluster.plane});

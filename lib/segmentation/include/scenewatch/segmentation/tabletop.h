@@ -67,8 +67,14 @@ struct Config {
   /// noise of the plane hide nothing. A floor that is the largest plane is bridged too: YCB's
   /// frames list chairs on the floor (docs/clutter.md).
   bool bridge_hidden_support = true;
+  /// Organized views (and unorganized ones through their recovered image): cut a convex part whose
+  /// faces parallel to the support lie at levels farther apart than the sensor's noise (3 sigma of
+  /// two depths): objects stacked flat, a book on a book, a box on a book. Each level is an
+  /// object's top; the part's other points go first to the level whose band of heights they lie
+  /// in, then to the nearest (segmentation/src/terrace_split.h, docs/clutter.md).
+  bool split_stacked = true;
   /// The depth camera (the pipeline's `sensor` section): its noise at each range and incidence
-  /// decides what is a depth step (split_depth_steps).
+  /// decides what is a depth step (split_depth_steps) and a level apart (split_stacked).
   SensorModel sensor;
   /// Organized clouds (and unorganized ones through their recovered image): cut the convex parts
   /// at closed depth steps, a book lying on a book, a thin box on a box (1-3 cm). A step is a jump

@@ -1,0 +1,195 @@
+#include "terrace_split.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+#include <Eigen/Eigenvalues>
+
+namespace scenewatch::segmentation {
+namespace {
+
+struct Window {
+  int u0 = 0, v0 = 0, w = 0, h = 0;
+  std::vector<int> index;  ///< cloud index per window pixel, -1 outside the part
+  int at(int u, int v) const { return (u < 0 || v < 0 || u >= w || v >= h) ? -1 : index[static_cast<std::size_t>(v) * w + u]; }
+};
+
+struct Face {
+  std::vector<int> pixels;  ///< window pixels
+  double low = 0.0, high = 0.0, depth = 0.0;  ///< its heights' 10th and 90th percentiles, median depth
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  ///< least-squares plane
+};
+
+// Calls f(q) for each 4-neighbour q of window pixel p inside the window.
+template <typename F>
+void for_each_neighbour(const Window& win, std::size_t p, F&& f) {
+  const int u = static_cast<int>(p % static_cast<std::size_t>(win.w)), v = static_cast<int>(p / static_cast<std::size_t>(win.w));
+  const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
+  for (int e = 0; e < 4; ++e) {
+    const int uu = u + du[e], vv = v + dv[e];
+    if (uu >= 0 && vv >= 0 && uu < win.w && vv < win.h) f(static_cast<std::size_t>(vv) * win.w + uu);
+  }
+}
+
+double quantile(std::vector<double> v, double q) {
+  const auto k = static_cast<long>(q * static_cast<double>(v.size() - 1));
+  std::nth_element(v.begin(), v.begin() + k, v.end());
+  return v[static_cast<std::size_t>(k)];
+}
+
+}  // namespace
+
+std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<int> part, const Eigen::Vector3d& n, double d,
+                                                const TerraceParams& params) {
+  std::vector<std::vector<int>> unchanged;
+  unchanged.push_back(part);
+  if (cloud.height <= 1 || static_cast<int>(part.size()) < 2 * params.min_points) return unchanged;
+  const int width = static_cast<int>(cloud.width);
+  Window win;
+  int u1 = -1, v1 = -1;
+  win.u0 = width, win.v0 = static_cast<int>(cloud.height);
+  for (int i : part) {
+    win.u0 = std::min(win.u0, i % width), u1 = std::max(u1, i % width);
+    win.v0 = std::min(win.v0, i / width), v1 = std::max(v1, i / width);
+  }
+  win.w = u1 - win.u0 + 1, win.h = v1 - win.v0 + 1;
+  const std::size_t m = static_cast<std::size_t>(win.w) * win.h;
+  win.index.assign(m, -1);
+  for (int i : part) win.index[static_cast<std::size_t>(i / width - win.v0) * win.w + (i % width - win.u0)] = i;
+
+  const auto point = [&](int i) { return cloud.points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>(); };
+  const auto gap = [&](double z) { return params.sigma_factor * std::sqrt(2.0) * params.sensor.sigma_z(z); };
+  std::vector<float> height(m, 0.0f), depth(m, 0.0f);
+  std::vector<char> level(m, 0);
+  const double cos_tilt = std::cos(params.max_tilt_deg * M_PI / 180.0);
+  constexpr int k = 2;  // normals from neighbours two pixels away
+  for (int v = 0; v < win.h; ++v)
+    for (int u = 0; u < win.w; ++u) {
+      const std::size_t p = static_cast<std::size_t>(v) * win.w + u;
+      const int i = win.index[p];
+      if (i < 0) continue;
+      const Eigen::Vector3d q = point(i);
+      height[p] = static_cast<float>(n.dot(q) + d);
+      depth[p] = cloud.points[static_cast<std::size_t>(i)].z;
+      const int l = win.at(u - k, v), r = win.at(u + k, v), t = win.at(u, v - k), b = win.at(u, v + k);
+      if (l < 0 || r < 0 || t < 0 || b < 0) continue;
+      const Eigen::Vector3d normal = (point(r) - point(l)).cross(point(b) - point(t));
+      const double norm = normal.norm();
+      if (norm > 0 && std::abs(normal.dot(n)) >= cos_tilt * norm) level[p] = 1;
+    }
+
+  // Level faces: 4-connected level pixels whose heights agree within the noise.
+  std::vector<int> face_of(m, -1);
+  std::vector<Face> faces;
+  for (std::size_t s = 0; s < m; ++s) {
+    if (!level[s] || face_of[s] >= 0) continue;
+    Face f;
+    std::deque<std::size_t> queue{s};
+    face_of[s] = static_cast<int>(faces.size());
+    while (!queue.empty()) {
+      const std::size_t p = queue.front();
+      queue.pop_front();
+      f.pixels.push_back(static_cast<int>(p));
+      for_each_neighbour(win, p, [&](std::size_t q) {
+        if (!level[q] || face_of[q] >= 0 || std::abs(height[q] - height[p]) > gap(depth[p])) return;
+        face_of[q] = face_of[s];
+        queue.push_back(q);
+      });
+    }
+    faces.push_back(std::move(f));
+  }
+  // Object-sized faces become seeds.
+  std::vector<Face> seeds;
+  for (Face& f : faces) {
+    if (static_cast<int>(f.pixels.size()) < params.min_points) continue;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+    std::vector<double> hs, zs;
+    for (int p : f.pixels) {
+      const Eigen::Vector3d q = point(win.index[static_cast<std::size_t>(p)]);
+      lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+      hs.push_back(height[static_cast<std::size_t>(p)]);
+      zs.push_back(depth[static_cast<std::size_t>(p)]);
+    }
+    if ((hi - lo).norm() < params.min_size_m) continue;
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    for (int p : f.pixels) c += point(win.index[static_cast<std::size_t>(p)]);
+    c /= static_cast<double>(f.pixels.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int p : f.pixels) {
+      const Eigen::Vector3d e = point(win.index[static_cast<std::size_t>(p)]) - c;
+      cov += e * e.transpose();
+    }
+    f.centroid = c;
+    f.normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+    f.low = quantile(hs, 0.1);
+    f.high = quantile(hs, 0.9);
+    f.depth = quantile(zs, 0.5);
+    seeds.push_back(std::move(f));
+  }
+  // Faces whose heights overlap within the noise are one level (one surface, or surfaces the sensor
+  // cannot tell apart): merged until no two overlap.
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (std::size_t a = 0; a < seeds.size() && !merged; ++a)
+      for (std::size_t b = a + 1; b < seeds.size() && !merged; ++b) {
+        const double g = gap(std::max(seeds[a].depth, seeds[b].depth));
+        // Apart in height, and not one plane seen in two pieces (a tilted face around something
+        // standing on it): the median distance of each face's points from the other's plane.
+        const auto off_plane = [&](const Face& from, const Face& to) {
+          std::vector<double> dist;
+          for (int p : to.pixels) dist.push_back(std::abs(from.normal.dot(point(win.index[static_cast<std::size_t>(p)]) - from.centroid)));
+          return quantile(dist, 0.5);
+        };
+        const bool apart_in_height = seeds[a].low > seeds[b].high + g || seeds[b].low > seeds[a].high + g;
+        if (apart_in_height && (off_plane(seeds[a], seeds[b]) > g || off_plane(seeds[b], seeds[a]) > g)) continue;
+        Face& f = seeds[a];
+        f.pixels.insert(f.pixels.end(), seeds[b].pixels.begin(), seeds[b].pixels.end());
+        f.low = std::min(f.low, seeds[b].low), f.high = std::max(f.high, seeds[b].high);
+        f.depth = std::max(f.depth, seeds[b].depth);
+        seeds.erase(seeds.begin() + static_cast<long>(b));
+        merged = true;
+      }
+  }
+  if (seeds.size() < 2) return unchanged;
+  // Each level first takes its own band of heights: from above the next lower level to its top.
+  std::sort(seeds.begin(), seeds.end(), [](const Face& a, const Face& b) { return a.high < b.high; });
+  std::vector<double> band_low(seeds.size(), -1e9);
+  for (std::size_t j = 1; j < seeds.size(); ++j) band_low[j] = seeds[j - 1].high + gap(seeds[j - 1].depth);
+
+  // Every pixel goes to the level whose band it lies in, spreading through the image from that
+  // level's face (nearest first); what no level reaches so, to the nearest level. (A merged
+  // level keeps the plane of its first face.)
+  std::vector<int> owner(m, -1);
+  for (int pass = 0; pass < 2; ++pass) {
+    std::deque<std::size_t> queue;
+    for (std::size_t p = 0; p < m; ++p)
+      if (owner[p] >= 0) queue.push_back(p);
+    if (pass == 0)
+      for (std::size_t s = 0; s < seeds.size(); ++s)
+        for (int p : seeds[s].pixels) owner[static_cast<std::size_t>(p)] = static_cast<int>(s), queue.push_back(static_cast<std::size_t>(p));
+    while (!queue.empty()) {
+      const std::size_t p = queue.front();
+      queue.pop_front();
+      const Face& f = seeds[static_cast<std::size_t>(owner[p])];
+      for_each_neighbour(win, p, [&](std::size_t q) {
+        if (win.index[q] < 0 || owner[q] >= 0) return;
+        if (pass == 0 && (height[q] > f.high + gap(depth[q]) || height[q] <= band_low[static_cast<std::size_t>(owner[p])])) return;
+        owner[q] = owner[p];
+        queue.push_back(q);
+      });
+    }
+  }
+  std::vector<std::vector<int>> pieces(seeds.size());
+  std::vector<int> stray;
+  for (std::size_t p = 0; p < m; ++p) {
+    if (win.index[p] < 0) continue;
+    (owner[p] >= 0 ? pieces[static_cast<std::size_t>(owner[p])] : stray).push_back(win.index[p]);
+  }
+  for (const auto& piece : pieces)
+    if (static_cast<int>(piece.size()) < params.min_points) return unchanged;
+  if (!stray.empty()) pieces.push_back(std::move(stray));  // parts of the part no face reaches in the image
+  return pieces;
+}
+
+}  // namespace scenewatch::segmentation
