@@ -72,10 +72,7 @@ struct Bilinear {
     ay = y - y0;
     i = static_cast<std::size_t>(y0) * width + x0;
   }
-  float operator()(const std::vector<float>& img) const {
-    return (1 - ay) * ((1 - ax) * img[i] + ax * img[i + 1]) + ay * ((1 - ax) * img[i + width] + ax * img[i + width + 1]);
-  }
-  /// The three channels of a shade image at once, each as operator() would sample it.
+  /// The three channels of a shade image, each sampled alike.
   RgbdLevel::Shade operator()(const std::vector<RgbdLevel::Shade>& img) const {
     const RgbdLevel::Shade &a = img[i], &b = img[i + 1], &c = img[i + width], &d = img[i + width + 1];
     const auto mix = [&](float RgbdLevel::Shade::*f) {
@@ -85,14 +82,13 @@ struct Bilinear {
   }
 };
 
-// RgbdLevel::point's factors per column and per row, computed once a pass instead of two
-// divisions per pixel: the same values, so the same points.
+// RgbdLevel::point's factors (ray_x, ray_y) per column and per row, computed once a pass instead
+// of two divisions per pixel: the same values, so the same points.
 struct PixelRays {
   std::vector<float> x, y;
   explicit PixelRays(const RgbdLevel& level) : x(static_cast<std::size_t>(level.width)), y(static_cast<std::size_t>(level.height)) {
-    const Intrinsics& K = level.intrinsics;
-    for (int u = 0; u < level.width; ++u) x[static_cast<std::size_t>(u)] = static_cast<float>((u - K.cx) / K.fx);
-    for (int v = 0; v < level.height; ++v) y[static_cast<std::size_t>(v)] = static_cast<float>((v - K.cy) / K.fy);
+    for (int u = 0; u < level.width; ++u) x[static_cast<std::size_t>(u)] = level.ray_x(u);
+    for (int v = 0; v < level.height; ++v) y[static_cast<std::size_t>(v)] = level.ray_y(v);
   }
   Eigen::Vector3f point(int u, int v, float z) const {
     return {x[static_cast<std::size_t>(u)] * z, y[static_cast<std::size_t>(v)] * z, z};

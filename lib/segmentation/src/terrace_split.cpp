@@ -6,29 +6,25 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "part_image.h"
+
 namespace scenewatch::segmentation {
 namespace {
 
-struct Window {
-  int u0 = 0, v0 = 0, w = 0, h = 0;
-  std::vector<int> index;  ///< cloud index per window pixel, -1 outside the part
-  int at(int u, int v) const { return (u < 0 || v < 0 || u >= w || v >= h) ? -1 : index[static_cast<std::size_t>(v) * w + u]; }
-};
-
 struct Face {
-  std::vector<int> pixels;  ///< window pixels
+  std::vector<int> pixels;  ///< box pixels (indices into PartImage::local)
   double low = 0.0, high = 0.0, depth = 0.0;  ///< its heights' 10th and 90th percentiles, median depth
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  ///< least-squares plane
 };
 
-// Calls f(q) for each 4-neighbour q of window pixel p inside the window.
+// Calls f(q) for each 4-neighbour q of box pixel p (an index into image.local) inside the box.
 template <typename F>
-void for_each_neighbour(const Window& win, std::size_t p, F&& f) {
-  const int u = static_cast<int>(p % static_cast<std::size_t>(win.w)), v = static_cast<int>(p / static_cast<std::size_t>(win.w));
+void for_each_neighbour(const PartImage& image, std::size_t p, F&& f) {
+  const int u = static_cast<int>(p % static_cast<std::size_t>(image.bw)), v = static_cast<int>(p / static_cast<std::size_t>(image.bw));
   const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
   for (int e = 0; e < 4; ++e) {
     const int uu = u + du[e], vv = v + dv[e];
-    if (uu >= 0 && vv >= 0 && uu < win.w && vv < win.h) f(static_cast<std::size_t>(vv) * win.w + uu);
+    if (uu >= 0 && vv >= 0 && uu < image.bw && vv < image.bh) f(static_cast<std::size_t>(vv) * image.bw + uu);
   }
 }
 
@@ -45,18 +41,14 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
   std::vector<std::vector<int>> unchanged;
   unchanged.push_back(part);
   if (cloud.height <= 1 || static_cast<int>(part.size()) < 2 * params.min_points) return unchanged;
-  const int width = static_cast<int>(cloud.width);
-  Window win;
-  int u1 = -1, v1 = -1;
-  win.u0 = width, win.v0 = static_cast<int>(cloud.height);
-  for (int i : part) {
-    win.u0 = std::min(win.u0, i % width), u1 = std::max(u1, i % width);
-    win.v0 = std::min(win.v0, i / width), v1 = std::max(v1, i / width);
-  }
-  win.w = u1 - win.u0 + 1, win.h = v1 - win.v0 + 1;
-  const std::size_t m = static_cast<std::size_t>(win.w) * win.h;
-  win.index.assign(m, -1);
-  for (int i : part) win.index[static_cast<std::size_t>(i / width - win.v0) * win.w + (i % width - win.u0)] = i;
+  const PartImage image(cloud, part);
+  const std::size_t m = image.local.size();
+  // The cloud index of a box pixel, -1 outside the part.
+  const auto cloud_at = [&](std::size_t p) { return image.local[p] < 0 ? -1 : part[static_cast<std::size_t>(image.local[p])]; };
+  const auto cloud_near = [&](int u, int v) {  // the same at box pixel (u, v), -1 outside the box
+    const int k = image.find(image.u0 + u, image.v0 + v);
+    return k < 0 ? -1 : part[static_cast<std::size_t>(k)];
+  };
 
   const auto point = [&](int i) { return cloud.points[static_cast<std::size_t>(i)].getVector3fMap().cast<double>(); };
   const auto gap = [&](double z) { return params.sigma_factor * std::sqrt(2.0) * params.sensor.sigma_z(z); };
@@ -64,15 +56,15 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
   std::vector<char> level(m, 0);
   const double cos_tilt = std::cos(params.max_tilt_deg * M_PI / 180.0);
   constexpr int k = 2;  // normals from neighbours two pixels away
-  for (int v = 0; v < win.h; ++v)
-    for (int u = 0; u < win.w; ++u) {
-      const std::size_t p = static_cast<std::size_t>(v) * win.w + u;
-      const int i = win.index[p];
+  for (int v = 0; v < image.bh; ++v)
+    for (int u = 0; u < image.bw; ++u) {
+      const std::size_t p = static_cast<std::size_t>(v) * image.bw + u;
+      const int i = cloud_at(p);
       if (i < 0) continue;
       const Eigen::Vector3d q = point(i);
       height[p] = static_cast<float>(n.dot(q) + d);
       depth[p] = cloud.points[static_cast<std::size_t>(i)].z;
-      const int l = win.at(u - k, v), r = win.at(u + k, v), t = win.at(u, v - k), b = win.at(u, v + k);
+      const int l = cloud_near(u - k, v), r = cloud_near(u + k, v), t = cloud_near(u, v - k), b = cloud_near(u, v + k);
       if (l < 0 || r < 0 || t < 0 || b < 0) continue;
       const Eigen::Vector3d normal = (point(r) - point(l)).cross(point(b) - point(t));
       const double norm = normal.norm();
@@ -91,7 +83,7 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
       const std::size_t p = queue.front();
       queue.pop_front();
       f.pixels.push_back(static_cast<int>(p));
-      for_each_neighbour(win, p, [&](std::size_t q) {
+      for_each_neighbour(image, p, [&](std::size_t q) {
         if (!level[q] || face_of[q] >= 0 || std::abs(height[q] - height[p]) > gap(depth[p])) return;
         face_of[q] = face_of[s];
         queue.push_back(q);
@@ -106,18 +98,18 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
     Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
     std::vector<double> hs, zs;
     for (int p : f.pixels) {
-      const Eigen::Vector3d q = point(win.index[static_cast<std::size_t>(p)]);
+      const Eigen::Vector3d q = point(cloud_at(static_cast<std::size_t>(p)));
       lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
       hs.push_back(height[static_cast<std::size_t>(p)]);
       zs.push_back(depth[static_cast<std::size_t>(p)]);
     }
     if ((hi - lo).norm() < params.min_size_m) continue;
     Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (int p : f.pixels) c += point(win.index[static_cast<std::size_t>(p)]);
+    for (int p : f.pixels) c += point(cloud_at(static_cast<std::size_t>(p)));
     c /= static_cast<double>(f.pixels.size());
     Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
     for (int p : f.pixels) {
-      const Eigen::Vector3d e = point(win.index[static_cast<std::size_t>(p)]) - c;
+      const Eigen::Vector3d e = point(cloud_at(static_cast<std::size_t>(p))) - c;
       cov += e * e.transpose();
     }
     f.centroid = c;
@@ -138,7 +130,7 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
         // standing on it): the median distance of each face's points from the other's plane.
         const auto off_plane = [&](const Face& from, const Face& to) {
           std::vector<double> dist;
-          for (int p : to.pixels) dist.push_back(std::abs(from.normal.dot(point(win.index[static_cast<std::size_t>(p)]) - from.centroid)));
+          for (int p : to.pixels) dist.push_back(std::abs(from.normal.dot(point(cloud_at(static_cast<std::size_t>(p))) - from.centroid)));
           return quantile(dist, 0.5);
         };
         const bool apart_in_height = seeds[a].low > seeds[b].high + g || seeds[b].low > seeds[a].high + g;
@@ -172,8 +164,8 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
       const std::size_t p = queue.front();
       queue.pop_front();
       const Face& f = seeds[static_cast<std::size_t>(owner[p])];
-      for_each_neighbour(win, p, [&](std::size_t q) {
-        if (win.index[q] < 0 || owner[q] >= 0) return;
+      for_each_neighbour(image, p, [&](std::size_t q) {
+        if (image.local[q] < 0 || owner[q] >= 0) return;
         if (pass == 0 && (height[q] > f.high + gap(depth[q]) || height[q] <= band_low[static_cast<std::size_t>(owner[p])])) return;
         owner[q] = owner[p];
         queue.push_back(q);
@@ -183,8 +175,8 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
   std::vector<std::vector<int>> pieces(seeds.size());
   std::vector<int> stray;
   for (std::size_t p = 0; p < m; ++p) {
-    if (win.index[p] < 0) continue;
-    (owner[p] >= 0 ? pieces[static_cast<std::size_t>(owner[p])] : stray).push_back(win.index[p]);
+    if (image.local[p] < 0) continue;
+    (owner[p] >= 0 ? pieces[static_cast<std::size_t>(owner[p])] : stray).push_back(cloud_at(p));
   }
   for (const auto& piece : pieces)
     if (static_cast<int>(piece.size()) < params.min_points) return unchanged;

@@ -28,10 +28,10 @@ struct RgbdLevel {
   std::vector<Shade> shade;
   std::size_t pixels() const { return static_cast<std::size_t>(width) * height; }
   /// The camera-frame point of a pixel with depth z.
-  Eigen::Vector3f point(int u, int v, float z) const {
-    return {static_cast<float>((u - intrinsics.cx) / intrinsics.fx) * z,
-            static_cast<float>((v - intrinsics.cy) / intrinsics.fy) * z, z};
-  }
+  Eigen::Vector3f point(int u, int v, float z) const { return {ray_x(u) * z, ray_y(v) * z, z}; }
+  /// The factors point() scales z by: x / z of column u, y / z of row v.
+  float ray_x(int u) const { return static_cast<float>((u - intrinsics.cx) / intrinsics.fx); }
+  float ray_y(int v) const { return static_cast<float>((v - intrinsics.cy) / intrinsics.fy); }
 };
 
 /// Level 0 is the finest (the input, or the input halved `finest_halvings` times); each further
