@@ -37,8 +37,8 @@ class VoxelColumns {
       ahead.clear();
       for (int dx = 0; dx <= reach; ++dx)
         for (int dy = dx == 0 ? 1 : -reach; dy <= reach; ++dy) {
-          const auto it = columns_.find(pack(xy_[c][0] + dx, xy_[c][1] + dy));
-          if (it != columns_.end()) ahead.push_back({entries_.data() + offsets_[it->second], entries_.data() + offsets_[it->second + 1]});
+          const int col = column_at(xy_[c][0] + dx, xy_[c][1] + dy);
+          if (col >= 0) ahead.push_back({entries_.data() + offsets_[col], entries_.data() + offsets_[col + 1]});
         }
       for (const Entry* e = first; e != last; ++e) {
         if (!keep(e->voxel)) continue;
@@ -62,7 +62,22 @@ class VoxelColumns {
   static std::uint64_t pack(int x, int y) {
     return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(x)) << 32) | static_cast<std::uint32_t>(y);
   }
-  tsl::robin_map<std::uint64_t, int, MixHash64> columns_;  ///< (x, y) -> column
+  /// The column at (x, y), or -1.
+  int column_at(int x, int y) const {
+    if (dense_.empty()) {
+      const auto it = columns_.find(pack(x, y));
+      return it == columns_.end() ? -1 : it->second;
+    }
+    const unsigned dx = static_cast<unsigned>(x - x0_), dy = static_cast<unsigned>(y - y0_);  // wraps below the corner
+    return dx < nx_ && dy < ny_ ? dense_[static_cast<std::size_t>(dx) * ny_ + dy] : -1;
+  }
+  // (x, y) -> column: a dense table over the columns' bounding rectangle when it is not much
+  // larger than the voxels (a hash lookup per neighbouring column missed the cache: 14 % of the
+  // clustering's time on the kitchen), else a hash map.
+  std::vector<int> dense_;
+  int x0_ = 0, y0_ = 0;
+  unsigned nx_ = 0, ny_ = 0;
+  tsl::robin_map<std::uint64_t, int, MixHash64> columns_;
   std::vector<std::array<int, 2>> xy_;                     ///< per column: its (x, y)
   std::vector<int> offsets_;                               ///< CSR: entries of column c are [offsets_[c], offsets_[c + 1])
   std::vector<Entry> entries_;                             ///< within a column, by z (then voxel)
