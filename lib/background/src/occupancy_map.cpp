@@ -283,6 +283,10 @@ struct GridFill {
   }
 
   void fill(const octomap::ColorOcTreeNode& node, const std::array<unsigned, 3>& base, unsigned span) {
+    if (span == 1) {  // most leaves are single voxels (visit() has checked that this one is in the box)
+      fill_voxel(node, (static_cast<std::size_t>(base[2] - lo[2]) * grid.ny + (base[1] - lo[1])) * grid.nx + (base[0] - lo[0]));
+      return;
+    }
     long first[3], last[3];
     for (int i = 0; i < 3; ++i) {
       first[i] = std::max<long>(base[i], lo[i]) - lo[i];
@@ -303,16 +307,8 @@ struct GridFill {
       rows([](std::size_t) {});
       return;
     }
-    // OctoMap clamps a belief exactly at the bound (and set_voxels writes the bound itself).
-    std::vector<DenseGrid::Surface>* listed =
-        occupied ? &grid.occupied
-                 : (uncertain_free && node.getLogOdds() > tree.getClampingThresMinLog() ? &grid.uncertain_free : nullptr);
     DenseGrid::Surface surface;
-    if (listed != nullptr) surface.probability = static_cast<std::uint8_t>(std::lround(255.0 * node.getOccupancy()));
-    if (occupied) {
-      const octomap::ColorOcTreeNode::Color col = node.getColor();
-      surface.rgb = (std::uint32_t{col.r} << 16) | (std::uint32_t{col.g} << 8) | col.b;
-    }
+    std::vector<DenseGrid::Surface>* listed = list_for(node, occupied, surface);
     rows([&](std::size_t row) {
       if (listed == nullptr) return;
       for (long x = first[0]; x <= last[0]; ++x) {
@@ -320,6 +316,32 @@ struct GridFill {
         listed->push_back(surface);
       }
     });
+  }
+
+  // fill() for one voxel, at its index in the grid.
+  void fill_voxel(const octomap::ColorOcTreeNode& node, std::size_t index) {
+    const bool occupied = tree.isNodeOccupied(node);
+    grid.state[index] = static_cast<std::uint8_t>(occupied ? Occupancy::kOccupied : Occupancy::kFree);
+    if (!occupied && !uncertain_free) return;
+    DenseGrid::Surface surface;
+    if (std::vector<DenseGrid::Surface>* listed = list_for(node, occupied, surface)) {
+      surface.index = index;
+      listed->push_back(surface);
+    }
+  }
+
+  // The list a leaf's voxels go in (nullptr: none), and their entry there but for the index.
+  std::vector<DenseGrid::Surface>* list_for(const octomap::ColorOcTreeNode& node, bool occupied, DenseGrid::Surface& surface) const {
+    // OctoMap clamps a belief exactly at the bound (and set_voxels writes the bound itself).
+    std::vector<DenseGrid::Surface>* listed =
+        occupied ? &grid.occupied
+                 : (uncertain_free && node.getLogOdds() > tree.getClampingThresMinLog() ? &grid.uncertain_free : nullptr);
+    if (listed != nullptr) surface.probability = static_cast<std::uint8_t>(std::lround(255.0 * node.getOccupancy()));
+    if (occupied) {
+      const octomap::ColorOcTreeNode::Color col = node.getColor();
+      surface.rgb = (std::uint32_t{col.r} << 16) | (std::uint32_t{col.g} << 8) | col.b;
+    }
+    return listed;
   }
 };
 
