@@ -69,13 +69,30 @@ TEST(ObjectTracker, TheFirstFrameListsAtFirstSightLaterFramesNeedConfirming) {
   EXPECT_EQ(restored.objects().size(), 1u) << "a restored list goes on: the new cluster waits";
 }
 
+// What the first frame listed at first sight must be seen again, as any other object: a fragment
+// that frame showed once leaves after confirm_frames frames without it, occluded or not; one seen
+// again stays through an occlusion.
+TEST(ObjectTracker, WhatTheFirstFrameListedLeavesUnlessSeenAgain) {
+  ObjectTracker tracker(TrackingConfig{});  // confirm_frames 2
+  tracker.update({seen_at(0, 0), seen_at(0.3, 0), seen_at(0.6, 0)}, 1, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 3u) << "the first frame: listed at first sight";
+  tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, 2, kOccluded);
+  EXPECT_EQ(tracker.objects().size(), 3u) << "one frame without it: it stays";
+  tracker.update({seen_at(0.3, 0)}, 3, kOccluded);
+  ASSERT_EQ(tracker.objects().size(), 2u) << "two frames without it, never seen again: it leaves";
+  EXPECT_NEAR(tracker.objects()[0].cluster.centroid.x(), 0.0, 1e-9) << "the one seen again stays, though unseen now";
+  for (int i = 4; i < 10; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded);
+  EXPECT_EQ(tracker.objects().size(), 2u) << "confirmed, then occluded: it keeps its place";
+}
+
 TEST(ObjectTracker, LeavesOnlyWhenItsSpaceIsSeenFreeInGoneFrames) {
   TrackingConfig config;
   config.gone_frames = 2;
   ObjectTracker tracker(config);
   tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, 1, kOccluded);
   ASSERT_EQ(tracker.objects().size(), 2u) << "the first frame: listed at first sight";
-  for (int i = 2; i < 10; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded);
+  tracker.update({seen_at(0, 0), seen_at(0.3, 0)}, 2, kOccluded);  // and confirmed
+  for (int i = 3; i < 10; ++i) tracker.update({seen_at(0.3, 0)}, i, kOccluded);
   EXPECT_EQ(tracker.objects().size(), 2u) << "unseen but occluded: it keeps its place";
   tracker.update({seen_at(0.3, 0)}, 10, kSeenFree);
   EXPECT_EQ(tracker.objects().size(), 2u) << "one frame of free space is not enough";

@@ -134,6 +134,8 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     if (t.not_resting >= config_.gone_frames) continue;  // seen crossing its support's height
     if (!hit[i]) {
       ++t.misses;
+      // Listed at first sight and not seen again: as a tentative object missed as often.
+      if (t.at_first_sight && t.object.observations < config_.confirm_frames && t.misses >= config_.confirm_frames) continue;
       const bool person = on_person && on_person(t.samples) >= config_.gone_free_fraction;
       t.on_person = person ? t.on_person + 1 : 0;
       if (t.on_person >= config_.gone_frames) continue;
@@ -156,6 +158,7 @@ void ObjectTracker::update(std::vector<TrackerObservation> observations, double 
     if (t.object.observations >= confirm && t.not_resting == 0) {
       t.object.id = next_id_++;
       t.misses = 0;
+      t.at_first_sight = t.object.observations < config_.confirm_frames;
       kept.push_back(std::move(t));
     } else if (t.misses < config_.confirm_frames) {
       still_tentative.push_back(std::move(t));

@@ -4,7 +4,9 @@
 ///  - it was seen in `confirm_frames` frames (2 by default: a fragment, a piece of an arm or a
 ///    noise cluster seen in one frame of a stream is not listed), except in the first frame the
 ///    tracker gets (after a start or a reset), whose objects are listed at first sight: a single
-///    cloud sent once lists its objects;
+///    cloud sent once lists its objects. When frames follow, such an object is held to the same
+///    rule: missed in `confirm_frames` frames in a row before its `confirm_frames`th sighting, it
+///    leaves, as a tentative one would (a fragment the first frame showed once);
 ///  - it is as wide as the sensor can resolve at its range: both horizontal extents span at least
 ///    `min_extent_cells` cells of max(segmentation voxel, 2 sigma_z(range)) (a strip one voxel
 ///    wide along a rim or an edge is a fragment: its width was never measured, only quantized);
@@ -120,6 +122,7 @@ class ObjectTracker {
     int seen_unmatched = 0;  ///< consecutive frames unmatched with its surface seen in place
     int on_person = 0;       ///< consecutive frames unmatched with its place seen on a person
     int not_resting = 0;     ///< consecutive sightings crossing its support's height
+    bool at_first_sight = false;  ///< listed in the tracker's first frame, unconfirmed
     /// Centroid of the observation it stood on in its last frame (a box on a box), if any.
     std::optional<Eigen::Vector3d> support_centroid;
     /// Its fullest view's points and their count: a piece of it seen again is no new object.
