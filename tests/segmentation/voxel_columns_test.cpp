@@ -41,10 +41,11 @@ std::set<std::pair<int, int>> all_pairs(const VoxelIndex& grid, int reach, bool 
   return out;
 }
 
-void expect_every_pair_once(double spread_m) {
+void expect_every_pair_once(double spread_m, bool table) {
   const Cloud cloud = blobs(spread_m, 7);
   const VoxelIndex grid(cloud, 0.01);
   const VoxelColumns columns(grid);
+  ASSERT_EQ(columns.uses_table(), table) << "spread " << spread_m << " m";
   bool (*keep_all)(int) = [](int) { return true; };
   bool (*keep_even)(int) = [](int v) { return v % 2 == 0; };
   for (auto keep : {keep_all, keep_even})
@@ -58,9 +59,9 @@ void expect_every_pair_once(double spread_m) {
     }
 }
 
-TEST(VoxelColumns, EveryPairWithinReachOnceWithTheDenseTable) { expect_every_pair_once(0.5); }
+TEST(VoxelColumns, EveryPairWithinReachOnceWithTheDenseTable) { expect_every_pair_once(0.5, true); }
 
-TEST(VoxelColumns, EveryPairWithinReachOnceWithTheHashMap) { expect_every_pair_once(20.0); }
+TEST(VoxelColumns, EveryPairWithinReachOnceWithTheHashMap) { expect_every_pair_once(20.0, false); }
 
 }  // namespace
 }  // namespace scenewatch::segmentation

@@ -7,11 +7,11 @@ namespace scenewatch::segmentation {
 VoxelColumns::VoxelColumns(const VoxelIndex& grid) {
   const std::size_t n = grid.coords.size();
   std::vector<int> column_of(n);
-  int x1 = 0, y1 = 0;
-  for (std::size_t v = 0; v < n; ++v) {
-    const auto& c = grid.coords[v];
-    x0_ = v == 0 ? c[0] : std::min(x0_, c[0]), x1 = v == 0 ? c[0] : std::max(x1, c[0]);
-    y0_ = v == 0 ? c[1] : std::min(y0_, c[1]), y1 = v == 0 ? c[1] : std::max(y1, c[1]);
+  int x1 = n == 0 ? 0 : grid.coords[0][0], y1 = n == 0 ? 0 : grid.coords[0][1];
+  x0_ = x1, y0_ = y1;
+  for (const auto& c : grid.coords) {
+    x0_ = std::min(x0_, c[0]), x1 = std::max(x1, c[0]);
+    y0_ = std::min(y0_, c[1]), y1 = std::max(y1, c[1]);
   }
   const std::size_t cells = n == 0 ? 0 : (static_cast<std::size_t>(x1 - x0_) + 1) * (static_cast<std::size_t>(y1 - y0_) + 1);
   if (n > 0 && cells <= std::max<std::size_t>(std::size_t{1} << 20, 8 * n)) {

@@ -23,6 +23,9 @@ class VoxelColumns {
 
   /// Calls f(a, b) once for every unordered pair of distinct voxels a, b with keep(a) and keep(b)
   /// and |dx|, |dy|, |dz| <= reach between them. The order of the pairs is unspecified.
+  /// True when columns are found through the dense table, false through the hash map.
+  bool uses_table() const { return !dense_.empty(); }
+
   template <typename Keep, typename F>
   void for_each_pair(int reach, Keep&& keep, F&& f) const {
     struct Window {
