@@ -15,6 +15,7 @@ struct Face {
   std::vector<int> pixels;  ///< box pixels (indices into PartImage::local)
   double low = 0.0, high = 0.0, depth = 0.0;  ///< its heights' 10th and 90th percentiles, median depth
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero(), normal = Eigen::Vector3d::UnitZ();  ///< least-squares plane
+  double width = 0.0;  ///< the spread across its narrower in-plane axis (m, one sigma)
 };
 
 // Calls f(q) for each 4-neighbour q of box pixel p (an index into image.local) inside the box.
@@ -113,7 +114,9 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
       cov += e * e.transpose();
     }
     f.centroid = c;
-    f.normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    f.normal = eig.eigenvectors().col(0);
+    f.width = std::sqrt(std::max(0.0, eig.eigenvalues()(1)) / static_cast<double>(f.pixels.size()));
     f.low = quantile(hs, 0.1);
     f.high = quantile(hs, 0.9);
     f.depth = quantile(zs, 0.5);
@@ -127,18 +130,23 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
       for (std::size_t b = a + 1; b < seeds.size() && !merged; ++b) {
         const double g = gap(std::max(seeds[a].depth, seeds[b].depth));
         // Apart in height, and not one plane seen in two pieces (a tilted face around something
-        // standing on it): the median distance of each face's points from the other's plane.
+        // standing on it): the median distance of one face's points from the other's plane. The
+        // plane is the wider face's: a strip's plane is ill-determined across it, so extended
+        // over the other face it can miss by more than the noise (a leaning box's lid in pieces
+        // around the box on it).
         const auto off_plane = [&](const Face& from, const Face& to) {
           std::vector<double> dist;
           for (int p : to.pixels) dist.push_back(std::abs(from.normal.dot(point(cloud_at(static_cast<std::size_t>(p))) - from.centroid)));
           return quantile(dist, 0.5);
         };
         const bool apart_in_height = seeds[a].low > seeds[b].high + g || seeds[b].low > seeds[a].high + g;
-        if (apart_in_height && (off_plane(seeds[a], seeds[b]) > g || off_plane(seeds[b], seeds[a]) > g)) continue;
+        const bool a_wider = seeds[a].width >= seeds[b].width;
+        if (apart_in_height && (a_wider ? off_plane(seeds[a], seeds[b]) : off_plane(seeds[b], seeds[a])) > g) continue;
         Face& f = seeds[a];
         f.pixels.insert(f.pixels.end(), seeds[b].pixels.begin(), seeds[b].pixels.end());
         f.low = std::min(f.low, seeds[b].low), f.high = std::max(f.high, seeds[b].high);
         f.depth = std::max(f.depth, seeds[b].depth);
+        if (!a_wider) f.centroid = seeds[b].centroid, f.normal = seeds[b].normal, f.width = seeds[b].width;
         seeds.erase(seeds.begin() + static_cast<long>(b));
         merged = true;
       }
@@ -151,7 +159,7 @@ std::vector<std::vector<int>> split_at_terraces(const Cloud& cloud, std::vector<
 
   // Every pixel goes to the level whose band it lies in, spreading through the image from that
   // level's face (nearest first); what no level reaches so, to the nearest level. (A merged
-  // level keeps the plane of its first face.)
+  // level keeps the plane of its widest face.)
   std::vector<int> owner(m, -1);
   for (int pass = 0; pass < 2; ++pass) {
     std::deque<std::size_t> queue;
