@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 
 namespace scenewatch::segmentation {
@@ -68,15 +69,17 @@ bool hidden_continuation(const Cloud& cloud, const std::vector<int>& owner, int 
     if (o != kNone) ++occluder;
   }
   if (occluder == 0) return false;
-  // One straight depth profile through both pieces along the walk: a least-squares line over
-  // each piece's run of pixels next to the gap (up to kRunPixels a side). Fitted over both runs,
-  // its slope rests on a baseline as long as the gap it spans; a slope from a few pixels of one
-  // side, carried across a gap ten times as wide, would carry ten times its depth noise.
+  // One plane's profile through both pieces along the walk: a least-squares line in inverse depth
+  // (a plane's 1/z is affine in the image, so along an image line it is straight; z itself bends,
+  // the more the longer the gap and the more oblique the surface) over each piece's run of pixels
+  // next to the gap (up to kRunPixels a side). Fitted over both runs, its slope rests on a
+  // baseline as long as the gap it spans; a slope from a few pixels of one side, carried across a
+  // gap ten times as wide, would carry ten times its depth noise.
   double sk = 0, sz = 0, skk = 0, skz = 0, m = 0;
   auto take = [&](int k, int piece) {
     if (owner[line[k]] != piece || !is_valid(cloud[line[k]])) return;
-    const double z = cloud[line[k]].z;
-    sk += k, sz += z, skk += static_cast<double>(k) * k, skz += k * z, m += 1;
+    const double w = 1.0 / cloud[line[k]].z;
+    sk += k, sz += w, skk += static_cast<double>(k) * k, skz += k * w, m += 1;
   };
   const int a_from = std::max(0, last_a - kRunPixels + 1), b_to = std::min(steps, first_b + kRunPixels - 1);
   for (int k = a_from; k <= last_a; ++k) take(k, a);
@@ -87,7 +90,12 @@ bool hidden_continuation(const Cloud& cloud, const std::vector<int>& owner, int 
   const double den = m * skk - sk * sk;
   const double slope = std::abs(den) < 1e-9 ? 0.0 : (m * skz - sk * sz) / den;
   const double offset = (sz - slope * sk) / m;
-  const auto depth_at = [&](int k) { return offset + slope * k; };
+  // Between the two runs' positive inverse depths the line stays positive; beyond them a line
+  // that reaches zero has left the plane's visible side.
+  const auto depth_at = [&](int k) {
+    const double w = offset + slope * k;
+    return w > 1e-6 ? 1.0 / w : std::numeric_limits<double>::infinity();
+  };
   // Each run lies on that line: two surfaces at different angles (two objects side by side) give
   // a line that fits neither.
   const auto rms_about_line = [&](int from, int to, int piece) {
