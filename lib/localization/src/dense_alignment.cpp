@@ -142,17 +142,21 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
       if (zr > 0 && std::isfinite(ref.normals[ir].x())) {
         const Eigen::Vector3f d = q - ref_rays.point(iu, iv, zr);
         const double sz_c = sensor.sigma_z(zc), sz_r = sensor.sigma_z(zr);
-        const double sigma2 = sz_c * sz_c + sz_r * sz_r, sigma = std::sqrt(sigma2);
-        if (d.norm() <= std::max(in.gate_m, kGateSigmas * sigma)) {
+        // Compared in squares: the square root (a long-latency instruction in the loop's chain)
+        // is taken only for a residual beyond Huber's corner, which needs sigma itself.
+        const double sigma2 = sz_c * sz_c + sz_r * sz_r;
+        const double gate2 = std::max(in.gate_m * in.gate_m, kGateSigmas * kGateSigmas * sigma2);
+        if (static_cast<double>(d.squaredNorm()) <= gate2) {
           const Eigen::Vector3d n = ref.normals[ir].cast<double>();
           const double r = n.dot(d.cast<double>());
           double J[6];
           point_jacobian(qd, n, J);
           const double info = 1.0 / sigma2;
-          p.system.add(J, r, info * huber_weight(r / sigma));
+          const double r2 = r * r;
+          p.system.add(J, r, r2 <= kHuber * kHuber * sigma2 ? info : info * kHuber * std::sqrt(sigma2) / std::abs(r));
           ++p.correspondences;
           p.depth_sum += zr;
-          if (std::abs(r) <= kInlierSigmas * sigma) {
+          if (r2 <= kInlierSigmas * kInlierSigmas * sigma2) {
             ++p.inliers;
             p.inlier_sq += r * r;
             if (keep_information) p.information.add_information(J, info);
