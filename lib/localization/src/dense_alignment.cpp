@@ -23,6 +23,13 @@ double huber_weight(double e) {
   return a <= kHuber ? 1.0 : kHuber / a;
 }
 
+// The same weight for a residual r of variance sigma2, compared in squares: the square root (a
+// long-latency instruction in the pass's chain) is taken only beyond Huber's corner, where the
+// weight needs sigma itself.
+double huber_weight(double r, double sigma2) {
+  return r * r <= kHuber * kHuber * sigma2 ? 1.0 : kHuber * std::sqrt(sigma2) / std::abs(r);
+}
+
 // The normal equations of a least-squares pass: the upper triangle of H = sum w J J^T, row by
 // row, and b = sum w r J. A pass adds one term per pixel, so the 21 distinct entries of the
 // symmetric H are summed rather than all 36 of an Eigen outer product.
@@ -142,8 +149,7 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
       if (zr > 0 && std::isfinite(ref.normals[ir].x())) {
         const Eigen::Vector3f d = q - ref_rays.point(iu, iv, zr);
         const double sz_c = sensor.sigma_z(zc), sz_r = sensor.sigma_z(zr);
-        // Compared in squares: the square root (a long-latency instruction in the loop's chain)
-        // is taken only for a residual beyond Huber's corner, which needs sigma itself.
+        // Compared in squares, as huber_weight(r, sigma2): no square root on this path.
         const double sigma2 = sz_c * sz_c + sz_r * sz_r;
         const double gate2 = std::max(in.gate_m * in.gate_m, kGateSigmas * kGateSigmas * sigma2);
         if (static_cast<double>(d.squaredNorm()) <= gate2) {
@@ -152,13 +158,13 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
           double J[6];
           point_jacobian(qd, n, J);
           const double info = 1.0 / sigma2;
-          const double r2 = r * r;
-          p.system.add(J, r, r2 <= kHuber * kHuber * sigma2 ? info : info * kHuber * std::sqrt(sigma2) / std::abs(r));
+          p.system.add(J, r, info * huber_weight(r, sigma2));
           ++p.correspondences;
           p.depth_sum += zr;
+          const double r2 = r * r;
           if (r2 <= kInlierSigmas * kInlierSigmas * sigma2) {
             ++p.inliers;
-            p.inlier_sq += r * r;
+            p.inlier_sq += r2;
             if (keep_information) p.information.add_information(J, info);
           }
         }

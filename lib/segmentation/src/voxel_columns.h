@@ -21,11 +21,11 @@ class VoxelColumns {
  public:
   explicit VoxelColumns(const VoxelIndex& grid);
 
-  /// Calls f(a, b) once for every unordered pair of distinct voxels a, b with keep(a) and keep(b)
-  /// and |dx|, |dy|, |dz| <= reach between them. The order of the pairs is unspecified.
   /// True when columns are found through the dense table, false through the hash map.
   bool uses_table() const { return !dense_.empty(); }
 
+  /// Calls f(a, b) once for every unordered pair of distinct voxels a, b with keep(a) and keep(b)
+  /// and |dx|, |dy|, |dz| <= reach between them. The order of the pairs is unspecified.
   template <typename Keep, typename F>
   void for_each_pair(int reach, Keep&& keep, F&& f) const {
     struct Window {
