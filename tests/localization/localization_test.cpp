@@ -321,6 +321,13 @@ TEST(LocalizationConfig, AnUnknownModeIsAnErrorNamingTheKey) {
   EXPECT_TRUE(ok.localization.alignment.photometric_on_finest_level);
   ASSERT_TRUE(pipeline::read_pipeline_config(YAML::Load("localization: {photometric_on_finest_level: false}"), ok).ok());
   EXPECT_FALSE(ok.localization.alignment.photometric_on_finest_level);
+  EXPECT_EQ(ok.localization.alignment.finest_level_stride, 2);
+  ASSERT_TRUE(pipeline::read_pipeline_config(YAML::Load("localization: {finest_level_stride: 1}"), ok).ok());
+  EXPECT_EQ(ok.localization.alignment.finest_level_stride, 1);
+  pipeline::Config none;
+  const auto stride = pipeline::read_pipeline_config(YAML::Load("localization: {finest_level_stride: 0}"), none);
+  ASSERT_FALSE(stride.ok());
+  EXPECT_NE(stride.error().message.find("localization.finest_level_stride"), std::string::npos) << stride.error().message;
 }
 
 }  // namespace

@@ -117,9 +117,10 @@ struct LevelInput {
   double photometric_sigma;
 };
 
-// One pass over the current level's pixels at the pose T_rc.
+// One pass over the current level's pixels at the pose T_rc: every `stride`-th pixel of a row,
+// the first one shifted by the row's number (so the rows' samples interleave).
 Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor, const AlignmentConfig& config,
-               bool keep_information = false) {
+               bool keep_information = false, int stride = 1) {
   Pass p;
   if (config.photometric_weight > 0) p.photometric_abs.reserve(in.cur.pixels() / 2);
   const RgbdLevel& ref = in.ref;
@@ -132,7 +133,7 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
   const float min_grad = static_cast<float>(config.min_gradient);
   const PixelRays cur_rays(cur), ref_rays(ref);
   for (int v = 0; v < cur.height; ++v) {
-    for (int u = 0; u < cur.width; ++u) {
+    for (int u = v % stride; u < cur.width; u += stride) {
       const std::size_t ic = static_cast<std::size_t>(v) * cur.width + u;
       const float zc = cur.depth_m[ic];
       if (zc <= 0) continue;
@@ -241,6 +242,9 @@ Status validate(const AlignmentConfig& c) {
   if (!(c.photometric_weight >= 0 && c.photometric_weight <= 100))
     return invalid_argument("localization.photometric_weight: must be in [0, 100]");
   if (!(c.min_gradient >= 0 && c.min_gradient < 1)) return invalid_argument("localization.min_gradient: must be in [0, 1)");
+  if (c.finest_level_stride < 1 || c.finest_level_stride > 4)
+    return invalid_argument("localization.finest_level_stride: 1 to 4 (every pixel to every fourth), got " +
+                            std::to_string(c.finest_level_stride));
   if (!(c.converged_m > 0) || !(c.converged_deg > 0))
     return invalid_argument("localization.converged_m / converged_deg: must be > 0");
   return {};
@@ -259,8 +263,9 @@ Alignment align(const RgbdPyramid& reference, const RgbdPyramid& current, const 
     const int iterations = config.iterations[config.iterations.size() - 1 - l];
     AlignmentConfig level_config = config;
     if (l == 0 && !config.photometric_on_finest_level) level_config.photometric_weight = 0;
+    const int stride = l == 0 ? config.finest_level_stride : 1;
     for (int it = 0; it < iterations; ++it) {
-      Pass pass = linearise(in, T, sensor, level_config);
+      Pass pass = linearise(in, T, sensor, level_config, false, stride);
       ++out.iterations;
       in.photometric_sigma = robust_spread(pass.photometric_abs, in.photometric_sigma);
       if (pass.correspondences < 60) break;

@@ -79,6 +79,7 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
                          [&] { return s.read("photometric_weight", l.alignment.photometric_weight); },
                          [&] { return s.read("min_gradient", l.alignment.min_gradient); },
                          [&] { return s.read("photometric_on_finest_level", l.alignment.photometric_on_finest_level); },
+                         [&] { return s.read("finest_level_stride", l.alignment.finest_level_stride); },
                          [&] { return s.read("min_inlier_fraction", l.min_inlier_fraction); },
                          [&] { return s.read("min_conditioning", l.min_conditioning); },
                          [&] { return s.read("max_correction_m", l.max_correction_m); },
