@@ -23,10 +23,12 @@ struct Recording {
   bool z_up = false;  ///< the simulator's world has z up
 };
 
-std::optional<Recording> simulated(const std::string& scenario, int width, int height) {
+/// A simulator scenario; `frames` > 0: that many frames per phase along the same paths.
+std::optional<Recording> simulated(const std::string& scenario, int width, int height, int frames = 0) {
   auto loaded = sim::load_scenario(std::filesystem::path(SCENEWATCH_SOURCE_DIR) / "sample_clouds/scenarios" / (scenario + ".yaml"));
   if (!loaded) return std::nullopt;
-  const sim::Scenario sc = sim::with_resolution(*loaded, width, height);
+  sim::Scenario sc = sim::with_resolution(*loaded, width, height);
+  if (frames > 0) sc = sim::with_frames(sc, frames);
   auto simulator = sim::Simulator::create(sc);
   if (!simulator) return std::nullopt;
   auto shared = std::make_shared<sim::Simulator>(std::move(*simulator));
@@ -34,7 +36,9 @@ std::optional<Recording> simulated(const std::string& scenario, int width, int h
   for (std::size_t p = 0; p < shared->phase_count(); ++p)
     for (int f = 0; f < shared->frame_count(p); ++f) index.emplace_back(p, f);
   const Intrinsics K = sc.intrinsics;
-  Recording r{"sim " + scenario + " " + std::to_string(width) + "x" + std::to_string(height), index.size(),
+  Recording r{"sim " + scenario + " " + std::to_string(width) + "x" + std::to_string(height) +
+                  (frames > 0 ? ", " + std::to_string(frames) + " a phase" : std::string()),
+              index.size(),
               [shared, index, K](std::size_t i) -> std::optional<Frame> {
                 auto frame = sim::as_frame(shared->render(index[i].first, index[i].second), K, i / 30.0);
                 if (!frame) return std::nullopt;
@@ -160,12 +164,14 @@ int run_sensor_model(const Options& o) {
       {"no per-camera witness", [](pipeline::Config& c) { c.change.witness_per_camera = false; }},
       {"head-on noise only", [](pipeline::Config& c) { c.change.incidence_aware = false; }},
       {"colour not registered", [](pipeline::Config& c) { c.sensor.fit_colour_registration = false; }},
+      {"no dark space", [](pipeline::Config& c) { c.change.see_through_dark = false; }},
       {"none of these", [](pipeline::Config& c) {
          c.change.measure_pose = false;
          c.change.trusted_pixels_only = false;
          c.change.witness_per_camera = false;
          c.change.incidence_aware = false;
          c.sensor.fit_colour_registration = false;
+         c.change.see_through_dark = false;
        }},
   });
   return 0;
@@ -178,7 +184,8 @@ int run_stream(const Options& o) {
                  reordered(o, "redkitchen forth and back (views revisited)", "redkitchen", every_frame(true)),
                  reordered(o, "hrt1 pick_toy_1 (a person picks a toy)", "hrt1/pick_toy_1", every_frame()),
                  reordered(o, "hrt1 pick_toy_2 (the person stays in view)", "hrt1/pick_toy_2", every_frame()),
-                 simulated("clutter", 320, 240), simulated("cup_added", 320, 240), simulated("object_moved", 320, 240)}) {
+                 simulated("clutter", 320, 240), simulated("cup_added", 320, 240), simulated("object_moved", 320, 240),
+                 simulated("glasses_removed", 320, 240, 71)}) {
     if (r) recordings.push_back(std::move(*r));
   }
   const std::vector<Variant> variants = {
@@ -187,6 +194,7 @@ int run_stream(const Options& o) {
       {"no photometric correction", [](pipeline::Config& c) { c.surprise.robust.photometric = false; }},
       {"no familiar-view gate", [](pipeline::Config& c) { c.surprise.familiar_after_frames = 0; }},
       {"no appearance persistence", [](pipeline::Config& c) { c.fusion.persistence_frames = 1; }},
+      {"no dark space", [](pipeline::Config& c) { c.change.see_through_dark = false; }},
       {"none of these (every region)", [](pipeline::Config& c) {
          c.surprise.robust.align_radius_px = 0;
          c.surprise.robust.photometric = false;

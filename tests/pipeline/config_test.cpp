@@ -137,6 +137,7 @@ TEST_F(ConfigTest, ShippedConfigIsValid) {
   EXPECT_EQ(c.change.measure_pose, d.change.measure_pose);
   EXPECT_EQ(c.change.witness_per_camera, d.change.witness_per_camera);
   EXPECT_EQ(c.change.incidence_aware, d.change.incidence_aware);
+  EXPECT_EQ(c.change.see_through_dark, d.change.see_through_dark);
 }
 
 TEST_F(ConfigTest, StreamKeysAreChecked) {

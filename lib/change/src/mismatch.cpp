@@ -2,6 +2,8 @@
 // same-camera pairs.
 #include "scenewatch/change/mismatch.h"
 
+#include "scenewatch/change/dark_space.h"
+
 #include "scenewatch/core/depth_validity.h"
 #include "scenewatch/core/surface_incidence.h"
 #include "scenewatch/io/rgbd.h"
@@ -180,12 +182,47 @@ bool footprint_behind(const DepthView& depth, const TrustedAt& trusted_at, doubl
   return true;
 }
 
-// Removed: occupied voxels whose whole projected footprint shows depth behind them by more than the
-// tolerance. A footprint pixel at or in front of the voxel (the surface is still there, or
-// something occludes it) vetoes; so does one without depth (a hole at a grazing edge may be the
-// surface itself) or one the sensor model does not trust. The footprint is the voxel's, grown by
-// the pose's uncertainty at that range: wherever the voxel may really project, the frame must see
-// behind it.
+// Whether the frame sees through the voxel centred at c: its whole projected footprint shows
+// trusted depth behind it by more than the tolerance. A footprint pixel at or in front of the
+// voxel (the surface is still there, or something occludes it) vetoes; so does one without depth
+// (a hole at a grazing edge may be the surface itself) or one the sensor model does not trust.
+// The footprint is the voxel's, grown by the pose's uncertainty at that range: wherever the voxel
+// may really project, the frame must see behind it. `seen_depth_m`: the nearest depth a camera
+// saw the surface there at (0: unknown); the map's surface lies within that depth's noise.
+template <typename TrustedAt>
+std::optional<MissingVoxel> seen_through(const Eigen::Vector3d& c, const Eigen::Isometry3d& T_camera_world, const Intrinsics& K,
+                                         const Config& config, const DepthView& depth, const TrustedAt& trusted_at,
+                                         const PoseAgreement& measured_pose, double res, const SurfaceWitness* witness,
+                                         std::uint32_t camera) {
+  const Eigen::Vector3d q = T_camera_world * c;
+  if (q.z() <= res || q.z() > config.max_range_m) return std::nullopt;
+  const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
+  const double shift = measured_pose.shift_at(c);
+  const double half_px = K.fx * (kHalfDiagonal * res + config.sigma_factor * config.sensor.pose_sigma_at(q.z()) + shift) / q.z();
+  if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) return std::nullopt;
+  // A gap is measured between two noisy surfaces: the frame's at this depth, and the map's,
+  // which lies within the noise of the nearest depth it was seen at (when this session saw it).
+  // Most surfaces in view are still there and the frame's noise alone vetoes them; the witness
+  // (a hash lookup) is asked only about the rest, whose limit its depth can only widen.
+  const double frame_sigma = config.sensor.sigma_z(q.z());
+  auto limit_for = [&](double sigma) { return q.z() + kHalfDiagonal * res + map_tolerance_from_sigma(config, sigma, q.z(), shift); };
+  float nearest = 0.0f;
+  if (!footprint_behind(depth, trusted_at, uc, vc, half_px, limit_for(frame_sigma), nearest)) return std::nullopt;
+  if (witness != nullptr) {
+    double seen_depth = 0.0;
+    if (witness->seen(c, camera, &seen_depth) == SurfaceWitness::Seen::kByOthersOnly) return std::nullopt;
+    // The whole footprint lies behind the frame's limit; the wider one holds when its nearest does.
+    if (seen_depth > 0 && !(nearest > limit_for(std::hypot(frame_sigma, config.sensor.sigma_z(seen_depth))))) return std::nullopt;
+  }
+  MissingVoxel m;
+  m.center_world = c;
+  m.u = static_cast<int>(std::lround(uc));
+  m.v = static_cast<int>(std::lround(vc));
+  m.depth_gap_m = static_cast<float>(nearest - q.z());
+  return m;
+}
+
+// Removed: occupied voxels the frame sees through (seen_through()).
 template <typename TrustedAt>
 std::vector<MissingVoxel> missing_surfaces(const background::DenseGrid& grid, const Pose& T, const Intrinsics& K,
                                            const Config& config, const DepthView& depth, const TrustedAt& trusted_at,
@@ -197,35 +234,30 @@ std::vector<MissingVoxel> missing_surfaces(const background::DenseGrid& grid, co
   for (const background::DenseGrid::Surface& surface : grid.occupied) {
     if (surface.probability < min_probability) continue;
     const Eigen::Vector3d c = grid.center(static_cast<long>(surface.index));
-    const Eigen::Vector3d q = T_camera_world * c;
-    if (q.z() <= res || q.z() > config.max_range_m) continue;
-    const double uc = K.fx * q.x() / q.z() + K.cx, vc = K.fy * q.y() / q.z() + K.cy;
-    const double shift = measured_pose.shift_at(c);
-    const double half_px = K.fx * (kHalfDiagonal * res + config.sigma_factor * config.sensor.pose_sigma_at(q.z()) + shift) / q.z();
-    if (uc - half_px < 0 || vc - half_px < 0 || uc + half_px > K.width - 1 || vc + half_px > K.height - 1) continue;
-    // A gap is measured between two noisy surfaces: the frame's at this depth, and the map's,
-    // which lies within the noise of the nearest depth it was seen at (when this session saw it).
-    // Most surfaces in view are still there and the frame's noise alone vetoes them; the witness
-    // (a hash lookup) is asked only about the rest, whose limit its depth can only widen.
-    const double frame_sigma = config.sensor.sigma_z(q.z());
-    auto limit_for = [&](double sigma) { return q.z() + kHalfDiagonal * res + map_tolerance_from_sigma(config, sigma, q.z(), shift); };
-    float nearest = 0.0f;
-    if (!footprint_behind(depth, trusted_at, uc, vc, half_px, limit_for(frame_sigma), nearest)) continue;
-    if (witness != nullptr) {
-      double seen_depth = 0.0;
-      if (witness->seen(c, camera, &seen_depth) == SurfaceWitness::Seen::kByOthersOnly) continue;
-      // The whole footprint lies behind the frame's limit; the wider one holds when its nearest does.
-      if (seen_depth > 0 && !(nearest > limit_for(std::hypot(frame_sigma, config.sensor.sigma_z(seen_depth))))) continue;
-    }
-    MissingVoxel m;
-    m.center_world = c;
-    m.rgb = surface.rgb;
-    m.u = static_cast<int>(std::lround(uc));
-    m.v = static_cast<int>(std::lround(vc));
-    m.depth_gap_m = static_cast<float>(nearest - q.z());
-    missing.push_back(m);
+    auto m = seen_through(c, T_camera_world, K, config, depth, trusted_at, measured_pose, res, witness, camera);
+    if (!m) continue;
+    m->rgb = surface.rgb;
+    missing.push_back(*m);
   }
   return missing;
+}
+
+// Removed, unseen: dark voxels (dark_space.h) the frame sees through. Every recorded voxel the
+// frame sees through is told so (one that goes dark again was never filled); the dark ones are
+// evidence. No witness: a dark voxel is dark to the camera that asks (DarkSpace::in_grid).
+template <typename TrustedAt>
+void missing_dark(const background::DenseGrid& grid, const Pose& T, const Intrinsics& K, const Config& config,
+                  const DepthView& depth, const TrustedAt& trusted_at, const PoseAgreement& measured_pose, DarkSpace& dark,
+                  std::uint32_t camera, std::vector<MissingVoxel>& missing) {
+  const Eigen::Isometry3d T_camera_world = T.inverse();
+  for (const DarkSpace::Voxel& d : dark.in_grid(grid, camera, config.persistence_frames)) {
+    auto m = seen_through(d.center_world, T_camera_world, K, config, depth, trusted_at, measured_pose, grid.resolution, nullptr, camera);
+    if (!m) continue;
+    dark.seen_through(d.key);
+    if (!d.dark) continue;
+    m->dark = true;
+    missing.push_back(*m);
+  }
 }
 }  // namespace
 
@@ -254,7 +286,8 @@ bool any_point_in_range(const Cloud& cloud, const Config& config) {
 
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& cloud, const Pose& T,
                                       const Intrinsics& K, const Config& config, background::DenseGrid* grid_scratch,
-                                      const SurfaceWitness* witness, std::uint32_t camera, bool grid_filled) {
+                                      const SurfaceWitness* witness, std::uint32_t camera, bool grid_filled,
+                                      DarkSpace* dark) {
   if (!K.valid()) return invalid_argument("mismatch: intrinsics are invalid");
   Mismatch out;
   out.voxel_m = map.resolution();
@@ -340,6 +373,9 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
   // 3. Removed (missing_surfaces).
   const auto t2 = Clock::now();
   out.missing = missing_surfaces(grid, T, K, config, depth, trusted_at, measured_pose, witness, camera, res);
+  if (dark != nullptr && config.see_through_dark) {
+    missing_dark(grid, T, K, config, depth, trusted_at, measured_pose, *dark, camera, out.missing);
+  }
   out.missing_ms = ms_since(t2);
   return out;
 }

@@ -161,9 +161,13 @@ std::vector<ChangeCluster> cluster_mismatch(const Mismatch& mm, const ClusterInp
     out.insert(out.end(), removed.begin(), removed.end());
   }
   // Removed side, map path: voxels the rays passed through; BEFORE's points in them, when known.
-  if (!mm.missing.empty()) {
+  // A map voxel holds a surface patch of many points, so a cluster of them needs an eighth of
+  // min_cluster_points; dark space (dark_space.h) is volume without a surface, so a cluster of it
+  // needs min_cluster_points voxels, as the key says of removed voxels.
+  for (const bool dark : {false, true}) {
     Evidence ev;
     for (const auto& m : mm.missing) {
+      if (m.dark != dark) continue;
       ev.points.push_back(m.center_world);
       ev.rgb.push_back(Eigen::Vector3d((m.rgb >> 16) & 0xff, (m.rgb >> 8) & 0xff, m.rgb & 0xff));
       ev.pixel.push_back({m.u, m.v});
@@ -171,10 +175,11 @@ std::vector<ChangeCluster> cluster_mismatch(const Mismatch& mm, const ClusterInp
       ev.gap.push_back(m.depth_gap_m);
       ev.area.push_back(static_cast<float>(mm.voxel_m * mm.voxel_m));
     }
+    if (ev.points.empty()) continue;
     // Voxel centres one map voxel apart must connect: cluster on the coarser of the two grids.
     const double cell = std::max(config.cluster_voxel_m, mm.voxel_m * 1.01);
     Config voxel_config = config;
-    voxel_config.min_cluster_points = std::max<std::size_t>(2, config.min_cluster_points / 8);
+    if (!dark) voxel_config.min_cluster_points = std::max<std::size_t>(2, config.min_cluster_points / 8);
     auto removed = group(ev, ChangeKind::kRemoved, cell, voxel_config);
     if (in.before_camera != nullptr && mm.voxel_m > 0) {
       tsl::robin_map<std::uint64_t, int, MixHash64> voxel_cluster;

@@ -199,7 +199,8 @@ Status read_change(const YAML::Node& node, Config& c) {
                          [&] { return s.read("trusted_pixels_only", g.trusted_pixels_only); },
                          [&] { return s.read("measure_pose", g.measure_pose); },
                          [&] { return s.read("witness_per_camera", g.witness_per_camera); },
-                         [&] { return s.read("incidence_aware", g.incidence_aware); });
+                         [&] { return s.read("incidence_aware", g.incidence_aware); },
+                         [&] { return s.read("see_through_dark", g.see_through_dark); });
       !st)
     return st;
   return s.finish();

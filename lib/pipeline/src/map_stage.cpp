@@ -43,7 +43,8 @@ CloudConstPtr without_pending(const Cloud& cloud, const std::vector<change::Chan
 }  // namespace
 
 MapStage::MapStage(const Config& c, std::shared_ptr<change::PendingIds> pending_ids)
-    : map_(c.background), witness_(c.background.resolution_m), changes_(c.change, std::move(pending_ids)) {}
+    : map_(c.background), witness_(c.background.resolution_m), dark_(c.background.resolution_m),
+      changes_(c.change, std::move(pending_ids)) {}
 
 // Geometric change detection against the map as it stands before this frame. Candidates stay
 // out of the map until the persistence filter confirms them, so the comparison keeps being made
@@ -51,7 +52,7 @@ MapStage::MapStage(const Config& c, std::shared_ptr<change::PendingIds> pending_
 // a removed one, within a few frames). A frame whose region is too large for a dense grid is
 // left without change detection.
 ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
-                                       const change::Config& config, std::uint32_t camera) {
+                                       const change::Config& config, std::uint32_t camera, bool record_dark) {
   const bool prefilled = prefilled_.value_or(false);
   prefilled_.reset();
   ChangeOutcome out;
@@ -70,8 +71,10 @@ ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const 
     grid_filled = box && map_grid_.index_of(box->min.array() + eps) >= 0 && map_grid_.index_of(box->max.array() - eps) >= 0;
   }
   auto mismatch = change::mismatch_against_map(map_, *frame.cloud, T, *K, config, &map_grid_,
-                                               config.witness_per_camera ? &witness_ : nullptr, camera, grid_filled);
+                                               config.witness_per_camera ? &witness_ : nullptr, camera, grid_filled, &dark_);
   if (!mismatch) return out;
+  // The frame's own holes, against the same map: what it looked into and got nothing back from.
+  if (record_dark && config.see_through_dark) dark_.record(map_grid_, change::depth_view(*frame.cloud, *K), T, config, camera);
   {
     std::lock_guard<std::mutex> lock(pose_mutex_);
     last_pose_[camera] = mismatch->pose;
@@ -93,11 +96,11 @@ void MapStage::prefill(const Frame& frame, const Pose& T, const change::Config& 
 }
 
 ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
-                               bool detect, FrameResult& result, std::uint32_t camera) {
+                               bool detect, FrameResult& result, std::uint32_t camera, bool record_dark) {
   ChangeOutcome changed;
   if (detect) {
     const auto t_change = Clock::now();
-    changed = detect_changes(frame, T, K, config.change, camera);
+    changed = detect_changes(frame, T, K, config.change, camera, record_dark);
     result.change_ms = ms_since(t_change);
     result.change_candidates = changes_.candidates();
   }
@@ -112,7 +115,10 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
   {
     WitnessJob job{to_insert, T, camera, stride, config.change.witness_per_camera, {}};
     for (const auto& c : changed.confirmed)
-      if (c.before) job.forget.push_back(c.before->points_world);
+      if (c.before) {
+        job.forget.push_back(c.before->points_world);
+        dark_.forget(c.before->points_world);
+      }
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_ = std::move(job);
   }
@@ -175,6 +181,7 @@ void MapStage::reset() {
     std::unique_lock<std::shared_mutex> write(mutex_);
     map_.reset();
     witness_.reset();
+    dark_.reset();
   }
   {
     std::lock_guard<std::mutex> lock(pose_mutex_);
@@ -193,6 +200,7 @@ void MapStage::replace(background::OccupancyMap map) {
     std::unique_lock<std::shared_mutex> write(mutex_);
     map_ = std::move(map);
     witness_ = change::SurfaceWitness(map_.resolution());  // the loaded surfaces: seen by none of this session
+    dark_ = change::DarkSpace(map_.resolution());
   }
   {
     std::lock_guard<std::mutex> lock(pose_mutex_);

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "scenewatch/background/occupancy_map.h"
+#include "scenewatch/change/dark_space.h"
 #include "scenewatch/change/mismatch.h"
 #include "scenewatch/change/persistence.h"
 #include "scenewatch/core/frame.h"
@@ -37,9 +38,11 @@ class MapStage {
 
   /// Change detection (when `detect`) against the map as it stands before this frame, then the
   /// frame into the map; fills the result's change and insertion figures. Runs beside the
-  /// segmentation and the image surprise, which do not read the map.
+  /// segmentation and the image surprise, which do not read the map. `record_dark`: the frame's
+  /// pixels without depth are the sensor's own (nothing was blanked out of it, as a person is),
+  /// and go into the dark space (change/dark_space.h).
   ChangeOutcome update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
-                       bool detect, FrameResult& result, std::uint32_t camera);
+                       bool detect, FrameResult& result, std::uint32_t camera, bool record_dark = true);
 
   /// Records the surfaces of the frame update() last took in the surface witness (which cameras
   /// saw each surface), and forgets those of the removals it confirmed. update() leaves this to
@@ -95,7 +98,7 @@ class MapStage {
 
  private:
   ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
-                               const change::Config& config, std::uint32_t camera);
+                               const change::Config& config, std::uint32_t camera, bool record_dark);
 
   // Guards `map_` between writers and concurrent occupancy readers. `witness_` is read by the change
   // detection and written by witness_frame(), one after the other within a frame.
@@ -106,6 +109,7 @@ class MapStage {
   Pose prefill_T_ = Pose::Identity();  // the pose prefill() filled map_grid_ at
   std::size_t prefill_points_ = 0;     // the size of the cloud it filled for
   change::SurfaceWitness witness_;  // which cameras saw each surface of the map (written by witness_frame())
+  change::DarkSpace dark_;          // space rays without a return crossed (written by detect_changes())
   struct WitnessJob {
     CloudConstPtr cloud;  // the points update() inserted
     Pose T;

@@ -226,7 +226,10 @@ Result<FrameResult> WorkingMemory::process(const Frame& original) {
   };
   const auto t_parallel = Clock::now();
   handover.give([&] {
-    ChangeOutcome out = m.map.update(seen, T, camera, config_, detect, result, camera_id);
+    // A frame with a person blanked out of it has holes that are no sensor's (nor is black hair
+    // beside the blanked face): its holes are not recorded as space the sensor got nothing from.
+    const bool own_holes = seen.cloud == frame.cloud;
+    ChangeOutcome out = m.map.update(seen, T, camera, config_, detect, result, camera_id, own_holes);
     image_surprise();
     m.map.witness_frame();
     return out;

@@ -19,6 +19,8 @@
 
 namespace scenewatch::change {
 
+class DarkSpace;
+
 struct Config {
   /// The depth camera and the pose source every piece of evidence is measured against (in the
   /// working memory: its `sensor:` section, copied in by WorkingMemory).
@@ -45,6 +47,10 @@ struct Config {
   /// angle (a cupboard's side, a standing magazine) is placed only coarsely along the ray, and the
   /// space in front of it was carved by rays running along it. false: the head-on noise alone.
   bool incidence_aware = true;
+  /// Against a map with a DarkSpace (dark_space.h): space the sensor got no return from, in front
+  /// of a known surface, from persistence_frames frames and two directions (a clear glass), is
+  /// removed when a frame sees through it. false: only the map's surfaces can be removed.
+  bool see_through_dark = true;
   /// Only voxels the map holds occupied with at least this probability can be claimed removed:
   /// a surface seen once (a flying pixel at a silhouette) is no evidence of an object. A map
   /// built from one frame holds prob_hit (0.7); diff() lowers the threshold to it.
@@ -124,6 +130,8 @@ struct MissingVoxel {
   std::uint32_t rgb = 0;  ///< the model's colour there, 0xRRGGBB
   int u = 0, v = 0;       ///< pixel of its centre
   float depth_gap_m = 0;  ///< observed depth minus the voxel's
+  /// Dark space (dark_space.h), not a surface of the map: volume, without colour.
+  bool dark = false;
 };
 
 /// Raw mismatch of one observation.
@@ -147,13 +155,17 @@ struct Mismatch {
 /// claims nothing against a surface only other cameras have seen: a point in free space whose ray
 /// meets such a surface behind it, a voxel only they saw (surface_witness.h).
 ///
+/// With `dark` (and config.see_through_dark), the dark voxels (dark_space.h) the frame sees
+/// through are removed voxels too, of colour 0; every recorded voxel the frame sees through is
+/// marked so in `dark`.
+///
 /// `grid_filled`: `grid_scratch` already holds the map around comparison_box() of this
 /// observation or a larger box (filled ahead, beside other work), and that box was found (some
 /// point is within range); the grid is used as it is.
 Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const Cloud& points_camera,
                                       const Pose& T_world_camera, const Intrinsics& K, const Config& config,
                                       background::DenseGrid* grid_scratch = nullptr, const SurfaceWitness* witness = nullptr,
-                                      std::uint32_t camera = 0, bool grid_filled = false);
+                                      std::uint32_t camera = 0, bool grid_filled = false, DarkSpace* dark = nullptr);
 
 /// The box of the map mismatch_against_map() compares an observation with: its points within
 /// max_range_m, placed in the world, widened by two voxels of `resolution_m`. Nullopt when no
