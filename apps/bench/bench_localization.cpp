@@ -82,17 +82,6 @@ void print_errors(const char* what, const Errors& e, const Trajectory& t) {
               1000 * quantile(e.m, 1.0), t.lost, median(t.ms));
 }
 
-// Both trajectories relative to their own first pose; RMS of the translation differences.
-double relative_rmse(const std::vector<Pose>& estimate, const std::vector<Pose>& truth) {
-  double sum = 0;
-  for (std::size_t i = 0; i < truth.size(); ++i) {
-    const Pose e = estimate.front().inverse() * estimate[i];
-    const Pose g = truth.front().inverse() * truth[i];
-    sum += (e.translation() - g.translation()).squaredNorm();
-  }
-  return std::sqrt(sum / truth.size());
-}
-
 Trajectory run(const io::Sequence& seq, const std::vector<std::optional<Pose>>& given, LocalizationMode mode,
                localization::Config lc = {}) {
   return run([&](std::size_t i) { return io::load_sequence_frame(seq, i); }, given, mode, std::move(lc));
@@ -204,7 +193,7 @@ int run_trajectories(const io::Sequence& seq, const std::vector<Pose>& truth) {
     lc.alignment.finest_level_stride = c.finest_stride;
     const Trajectory t = run(seq, none, LocalizationMode::kTrack, lc);
     std::printf("  %-58s RMSE %5.1f mm over %zu frames (both relative to their first pose) | lost %3zu | %5.1f ms/frame\n",
-                c.label, 1000 * relative_rmse(t.used, truth), truth.size(), t.lost, median(t.ms));
+                c.label, 1000 * localization::trajectory_rmse_m(t.used, truth), truth.size(), t.lost, median(t.ms));
   }
   return 0;
 }

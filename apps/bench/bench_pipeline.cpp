@@ -136,11 +136,12 @@ void offline_side_by_side(const Sequence& s) {
   no_sensor_remedies.change.witness_per_camera = false;
   no_sensor_remedies.change.incidence_aware = false;
   no_sensor_remedies.sensor.fit_colour_registration = false;
+  no_sensor_remedies.change.see_through_dark = false;
   const auto before = offline(s, every_pixel, false);
   const auto without = offline(s, no_sensor_remedies, false);
   const auto now = offline(s, config, true);
   if (!before || !now || !without) return;
-  std::printf("   without the sensor model's remedies (measured pose, trusted pixels, per-camera witness, incidence, colour registration), same run: "
+  std::printf("   without the sensor model's remedies (measured pose, trusted pixels, per-camera witness, incidence, colour registration, dark space), same run: "
               "frame median %.1f ms (p90 %.1f), CPU %.1f ms per frame, %zu events; the defaults take %.2fx its time "
               "(median), %.2fx its CPU\n",
               without->median_frame_ms, without->p90_frame_ms, without->cpu_per_frame_ms, without->events,

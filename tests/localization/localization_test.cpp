@@ -11,6 +11,7 @@
 #include "scenewatch/background/appearance.h"
 #include "scenewatch/io/sequence.h"
 #include "scenewatch/localization/localizer.h"
+#include "scenewatch/localization/pose_error.h"
 #include "scenewatch/pipeline/config_loader.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "kitchen_data.h"
@@ -209,32 +210,30 @@ TEST(Localizer, TrackModeFollowsTheKitchenWithoutPoses) {
   Config config;
   config.mode = LocalizationMode::kTrack;
   Localizer localizer(config);
-  double sum_sq = 0, worst_rigidity = 0;
+  double worst_rigidity = 0;
   std::size_t lost = 0;
-  Pose first_truth = Pose::Identity(), first = Pose::Identity();
+  std::vector<Pose> placed, truths;  // the frames placed, and their true poses
   const std::size_t n = seq.frames.size();  // 250: every second frame of 16.6 s of the recording
   for (std::size_t i = 0; i < n; ++i) {
     Frame f = load(seq, i);
     const Pose truth = *f.T_world_camera;
     f.T_world_camera.reset();
     const auto r = localizer.localize(f, 0, [&](const Pose& p, std::size_t k) { return memory.nearest(p, k); });
-    if (i == 0) {
-      EXPECT_EQ(r.state, State::kStarting);
-      first_truth = truth;
-      first = r.T_world_camera;
-    }
+    if (i == 0) EXPECT_EQ(r.state, State::kStarting);
     if (!r.placed()) {
       ++lost;
       continue;
     }
-    sum_sq += ((first.inverse() * r.T_world_camera).translation() - (first_truth.inverse() * truth).translation()).squaredNorm();
+    placed.push_back(r.T_world_camera);
+    truths.push_back(truth);
     worst_rigidity = std::max(worst_rigidity, rigidity_error(r.T_world_camera));
     f.T_world_camera = r.T_world_camera;
     auto kf = background::keyframe_from_frame(f);
     ASSERT_TRUE(kf.ok());
     ASSERT_TRUE(memory.consider(std::move(*kf)).ok());
   }
-  std::cout << "track, " << n << " frames: RMSE " << 1000 * std::sqrt(sum_sq / n) << " mm, lost " << lost
+  const double rmse = trajectory_rmse_m(placed, truths);
+  std::cout << "track, " << n << " frames: RMSE " << 1000 * rmse << " mm, lost " << lost
             << ", worst |R^T R - I| " << worst_rigidity << "\n";
   EXPECT_EQ(lost, 0u);
   // Every pose rigid: rounding error compounded from frame to frame to |R^T R - I| = 0.012 by frame 50.
@@ -242,7 +241,7 @@ TEST(Localizer, TrackModeFollowsTheKitchenWithoutPoses) {
   // Measured: 88.8 mm RMS over the 250 frames, none lost (frame-to-frame steps; before them, 529 mm
   // with 161 frames lost: the track left the keyframes' basin at frame 33 and diverged; 85.5 mm
   // while the poses' rotations were allowed to bend, see Localizer::accept).
-  EXPECT_LT(std::sqrt(sum_sq / n), 0.092);
+  EXPECT_LT(rmse, 0.092);
 }
 
 TEST(Localizer, TrackModeStepsFrameToFrameWithoutKeyframes) {
@@ -254,30 +253,29 @@ TEST(Localizer, TrackModeStepsFrameToFrameWithoutKeyframes) {
   config.mode = LocalizationMode::kTrack;
   Localizer localizer(config);
   const auto none = [](const Pose&, std::size_t) { return std::vector<std::shared_ptr<const background::Keyframe>>{}; };
-  double sum_sq = 0;
   std::size_t lost = 0;
-  Pose first_truth = Pose::Identity(), first = Pose::Identity();
+  std::vector<Pose> estimates, truths;  // every frame's, lost or not
   const std::size_t n = 60;
   for (std::size_t i = 0; i < n; ++i) {
     Frame f = load(seq, i);
     const Pose truth = *f.T_world_camera;
     f.T_world_camera.reset();
     const auto r = localizer.localize(f, 0, none);
+    estimates.push_back(r.T_world_camera);
+    truths.push_back(truth);
     if (i == 0) {
       EXPECT_EQ(r.state, State::kStarting);
-      first_truth = truth;
-      first = r.T_world_camera;
       continue;
     }
     EXPECT_EQ(r.state, State::kTracking) << "frame " << i << ": " << r.reason;
     EXPECT_EQ(r.reference_keyframe, 0u);
     if (!r.placed()) ++lost;
-    sum_sq += ((first.inverse() * r.T_world_camera).translation() - (first_truth.inverse() * truth).translation()).squaredNorm();
   }
-  std::cout << "track without keyframes, " << n << " frames: RMSE " << 1000 * std::sqrt(sum_sq / n) << " mm, lost " << lost << "\n";
+  const double rmse = trajectory_rmse_m(estimates, truths);
+  std::cout << "track without keyframes, " << n << " frames: RMSE " << 1000 * rmse << " mm, lost " << lost << "\n";
   EXPECT_EQ(lost, 0u);
   // Measured: 21.7 mm RMS over these 60 frames (4 s of the recording).
-  EXPECT_LT(std::sqrt(sum_sq / n), 0.025);
+  EXPECT_LT(rmse, 0.025);
 }
 
 TEST(WorkingMemoryLocalization, ALostFrameChangesNothingAndRaisesNoEvent) {

@@ -12,6 +12,7 @@
 #include <cstdio>
 
 #include "scenewatch/io/sequence.h"
+#include "scenewatch/localization/pose_error.h"
 #include "scenewatch/pipeline/working_memory.h"
 #include "scenewatch/sim/scenario_yaml.h"
 #include "scenewatch/sim/simulator.h"
@@ -30,13 +31,9 @@ struct SequenceRun {
   std::vector<StreamEvent> events;
   std::vector<sim::ChangeTruth> truth;
   std::size_t frames = 0;
-  /// With hidden poses: each placed frame's position error, both trajectories tied at the first frame.
-  std::vector<Eigen::Vector3d> pose_errors_m;
-  double rmse_m() const {
-    double sum = 0;
-    for (const auto& e : pose_errors_m) sum += e.squaredNorm();
-    return pose_errors_m.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(pose_errors_m.size()));
-  }
+  /// With hidden poses: each placed frame's pose in the memory's world, and its true pose.
+  std::vector<Pose> placed, truths;
+  double rmse_m() const { return localization::trajectory_rmse_m(placed, truths); }
 };
 
 void print_event(const std::string& name, const StreamEvent& s) {
@@ -96,8 +93,11 @@ SequenceRun run_scenario(const std::string& name, int frames, int width, int hei
       EXPECT_TRUE(result.ok());
       if (!result.ok()) return run;
       const localization::Localization& where = result->localization;
-      if (run.frames++ == 0) T_world_memory = truth * where.T_world_camera.inverse();
-      if (hide_poses && where.placed()) run.pose_errors_m.push_back((T_world_memory * where.T_world_camera).translation() - truth.translation());
+      if (run.frames++ == 0 && hide_poses) T_world_memory = truth * where.T_world_camera.inverse();
+      if (hide_poses && where.placed()) {
+        run.placed.push_back(where.T_world_camera);
+        run.truths.push_back(truth);
+      }
       for (const auto& e : result->events) {
         run.events.push_back({e, phase, f});
         if (hide_poses) run.events.back().event.centroid_world = T_world_memory * e.centroid_world;
@@ -254,9 +254,9 @@ TEST(Stream, TrackModeWithoutPosesFollowsTheSimulatorsTruth) {
     const SequenceRun run = run_scenario(c.name, c.frames, 640, 480, track);
     const Score s = score(run);
     print(std::string(c.name) + " tracked without poses", s, run);
-    std::printf("  trajectory: RMSE %.1f mm over %zu placed frames of %zu\n", 1000 * run.rmse_m(), run.pose_errors_m.size(),
+    std::printf("  trajectory: RMSE %.1f mm over %zu placed frames of %zu\n", 1000 * run.rmse_m(), run.placed.size(),
                 run.frames);
-    EXPECT_EQ(run.pose_errors_m.size(), run.frames) << c.name << ": no frame lost";
+    EXPECT_EQ(run.placed.size(), run.frames) << c.name << ": no frame lost";
     EXPECT_LT(run.rmse_m(), c.max_rmse_m) << c.name;
     EXPECT_EQ(s.found, s.truths) << c.name;
     EXPECT_EQ(s.events, s.truths) << c.name << ": as calm as with the poses given";

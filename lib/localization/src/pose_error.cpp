@@ -1,6 +1,7 @@
 // Drifting and noisy pose sources, for measuring localization.
 #include "scenewatch/localization/pose_error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -36,6 +37,15 @@ std::vector<Pose> with_noise(const std::vector<Pose>& truth, double sigma_m, dou
   std::vector<Pose> out;
   for (const Pose& p : truth) out.push_back(Pose(p * noise.draw()));
   return out;
+}
+
+double trajectory_rmse_m(const std::vector<Pose>& estimate, const std::vector<Pose>& truth) {
+  const std::size_t n = std::min(estimate.size(), truth.size());
+  if (n == 0) return 0.0;
+  const Pose e0 = estimate.front().inverse(), g0 = truth.front().inverse();
+  double sum = 0;
+  for (std::size_t i = 0; i < n; ++i) sum += ((e0 * estimate[i]).translation() - (g0 * truth[i]).translation()).squaredNorm();
+  return std::sqrt(sum / static_cast<double>(n));
 }
 
 }  // namespace scenewatch::localization

@@ -1,6 +1,6 @@
 #pragma once
 /// Pose sources as a robot has them, for measuring localization against a recording's poses:
-/// odometry that drifts, and poses with independent noise. Both draw each error as a twist with
+/// odometry that drifts, and poses with independent noise; and the error of a trajectory. Both draw each error as a twist with
 /// translation N(0, s_t^2 / 3) per axis (so its RMS is s_t) and rotation likewise, from `seed`.
 #include <vector>
 
@@ -15,5 +15,10 @@ std::vector<Pose> with_drift(const std::vector<Pose>& truth, double step_m, doub
 /// Each true pose with its own random error of RMS `sigma_m` and `sigma_deg`, independent from
 /// frame to frame (a motion-capture marker's jitter, a pose estimate's scatter).
 std::vector<Pose> with_noise(const std::vector<Pose>& truth, double sigma_m, double sigma_deg, unsigned seed);
+
+/// How far an estimated trajectory is from the true one: both taken relative to their own first
+/// pose (tied at the first frame, as a tracker that starts at the identity must be scored), the
+/// RMS of the differences of their positions. Equal lengths, frame by frame; 0 when empty.
+double trajectory_rmse_m(const std::vector<Pose>& estimate, const std::vector<Pose>& truth);
 
 }  // namespace scenewatch::localization
