@@ -120,6 +120,27 @@ TEST(DarkSpace, SeenThroughThenDarkAgainIsNeverDark) {
   EXPECT_LT(dark.dark_voxels(config.persistence_frames), dark_count(before));
 }
 
+TEST(DarkSpace, OnlyTheVoxelsInsideTheGridAsked) {
+  const Config config;
+  const background::DenseGrid grid = room(true);
+  const DarkSpace dark = recorded_from_two_views(grid, config);
+  const auto all = dark.in_grid(grid, 0, config.persistence_frames);
+  ASSERT_FALSE(all.empty());
+  // The same room's left half (x < 0): the voxels there, and no others.
+  background::DenseGrid left = grid;
+  left.nx = 25;
+  left.state.assign(static_cast<std::size_t>(left.nx) * left.ny * left.nz, static_cast<std::uint8_t>(background::Occupancy::kUnknown));
+  const auto half = dark.in_grid(left, 0, config.persistence_frames);
+  const auto in_left = std::count_if(all.begin(), all.end(), [](const auto& v) { return v.center_world.x() < 0; });
+  EXPECT_EQ(static_cast<long>(half.size()), in_left);
+  EXPECT_GT(in_left, 0);
+  for (const auto& v : half) EXPECT_LT(v.center_world.x(), 0.0);
+  // A grid a metre away holds none of them.
+  background::DenseGrid away = grid;
+  away.origin.x() += 1.0;
+  EXPECT_TRUE(dark.in_grid(away, 0, config.persistence_frames).empty());
+}
+
 TEST(DarkSpace, ForgetAndReset) {
   const Config config;
   const background::DenseGrid grid = room(true);

@@ -19,6 +19,7 @@ constexpr double kSampleStep = 8.0;
 // Half the diagonal of a unit cube (as in mismatch.cpp).
 constexpr double kHalfDiagonal = 0.8660254;
 constexpr std::uint64_t kAxisMask = 0x1fffff;  // 21 bits per axis around the origin
+constexpr unsigned kBlockBits = 3;             // blocks of 8 x 8 x 8 voxels (16 cm at 2 cm)
 
 std::uint64_t axis(double x, double per_m) {
   return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x * per_m)) + (1 << 20)) & kAxisMask;
@@ -94,7 +95,10 @@ void DarkSpace::record(const background::DenseGrid& grid, const DepthView& depth
       const double front = surface_t - (map_tolerance_m(config, z_surface) + 2 * kHalfDiagonal * res) * per_z;
       for (const auto& [idx, t] : crossed) {
         if (t > front) continue;
-        Entry& e = voxels_[key(grid.center(idx))];
+        const std::uint64_t k = key(grid.center(idx));
+        auto [it, added] = voxels_.try_emplace(k);
+        if (added) blocks_[block_of(k)].push_back(k);
+        Entry& e = it.value();
         e.cameras |= bit;
         if (e.seen_through) e.mixed = true;
         if (e.frames > 0 && e.last_frame == frame_) continue;
@@ -124,20 +128,55 @@ void DarkSpace::prune() {
     else ++it;
   }
   if (voxels_.size() > max_voxels_) voxels_.clear();  // every entry as old as the rest
+  blocks_.clear();
+  for (const auto& [k, e] : voxels_) blocks_[block_of(k)].push_back(k);
+}
+
+std::uint64_t DarkSpace::block_of(std::uint64_t k) {
+  constexpr std::uint64_t kBlockMask = kAxisMask >> kBlockBits;
+  const std::uint64_t x = (k >> 42) >> kBlockBits, y = ((k >> 21) & kAxisMask) >> kBlockBits, z = (k & kAxisMask) >> kBlockBits;
+  return ((x & kBlockMask) << 36) | ((y & kBlockMask) << 18) | (z & kBlockMask);
+}
+
+void DarkSpace::erase(std::uint64_t k) {
+  if (voxels_.erase(k) == 0) return;
+  auto block = blocks_.find(block_of(k));
+  if (block == blocks_.end()) return;
+  auto& keys = block.value();
+  const auto at = std::find(keys.begin(), keys.end(), k);
+  if (at != keys.end()) {
+    *at = keys.back();
+    keys.pop_back();
+  }
+  if (keys.empty()) blocks_.erase(block);
 }
 
 std::vector<DarkSpace::Voxel> DarkSpace::in_grid(const background::DenseGrid& grid, std::uint32_t camera, int min_frames) const {
   std::vector<Voxel> out;
   if (grid.size() == 0) return out;
   const std::uint64_t bit = std::uint64_t{1} << (camera % 64);
-  for (const auto& [k, e] : voxels_) {
-    if (e.mixed) continue;
-    const Eigen::Vector3d c(unaxis((k >> 42) & kAxisMask, per_m_), unaxis((k >> 21) & kAxisMask, per_m_),
-                            unaxis(k & kAxisMask, per_m_));
-    const long idx = grid.index_of(c);
-    if (idx < 0 || grid.at(idx) == background::Occupancy::kOccupied) continue;
-    out.push_back({k, grid.center(idx), e.two_views && e.frames >= min_frames && (e.cameras & bit) != 0});
-  }
+  // Only the blocks the grid overlaps: a daemon that has run for hours holds many more.
+  const Eigen::Vector3d lo = grid.origin.array() + 0.5 * grid.resolution;
+  const Eigen::Vector3d hi = grid.origin + grid.resolution * Eigen::Vector3d(grid.nx - 0.5, grid.ny - 0.5, grid.nz - 0.5);
+  const std::uint64_t k_lo = key(lo), k_hi = key(hi);
+  const std::uint64_t x0 = (k_lo >> 42) >> kBlockBits, x1 = (k_hi >> 42) >> kBlockBits;
+  const std::uint64_t y0 = ((k_lo >> 21) & kAxisMask) >> kBlockBits, y1 = ((k_hi >> 21) & kAxisMask) >> kBlockBits;
+  const std::uint64_t z0 = (k_lo & kAxisMask) >> kBlockBits, z1 = (k_hi & kAxisMask) >> kBlockBits;
+  for (std::uint64_t x = x0; x <= x1; ++x)
+    for (std::uint64_t y = y0; y <= y1; ++y)
+      for (std::uint64_t z = z0; z <= z1; ++z) {
+        const auto block = blocks_.find((x << 36) | (y << 18) | z);
+        if (block == blocks_.end()) continue;
+        for (const std::uint64_t k : block->second) {
+          const Entry& e = voxels_.find(k)->second;
+          if (e.mixed) continue;
+          const Eigen::Vector3d c(unaxis((k >> 42) & kAxisMask, per_m_), unaxis((k >> 21) & kAxisMask, per_m_),
+                                  unaxis(k & kAxisMask, per_m_));
+          const long idx = grid.index_of(c);
+          if (idx < 0 || grid.at(idx) == background::Occupancy::kOccupied) continue;
+          out.push_back({k, grid.center(idx), e.two_views && e.frames >= min_frames && (e.cameras & bit) != 0});
+        }
+      }
   return out;
 }
 
@@ -147,7 +186,7 @@ void DarkSpace::seen_through(std::uint64_t k) {
 }
 
 void DarkSpace::forget(const std::vector<Eigen::Vector3d>& points_world) {
-  for (const auto& p : points_world) voxels_.erase(key(p));
+  for (const auto& p : points_world) erase(key(p));
 }
 
 std::size_t DarkSpace::dark_voxels(int min_frames) const {
@@ -158,6 +197,7 @@ std::size_t DarkSpace::dark_voxels(int min_frames) const {
 
 void DarkSpace::reset() {
   voxels_.clear();
+  blocks_.clear();
   ranges_.clear();
   frame_ = 0;
 }

@@ -81,6 +81,8 @@ class DarkSpace {
     float first_dir[3] = {0, 0, 0};  ///< the direction of the first ray that crossed it
   };
   std::uint64_t key(const Eigen::Vector3d& p) const;
+  static std::uint64_t block_of(std::uint64_t voxel_key);  ///< its block of 8 x 8 x 8 voxels
+  void erase(std::uint64_t voxel_key);
   void prune();
 
   struct Range {  ///< the nearest and farthest depth a camera has returned
@@ -92,6 +94,7 @@ class DarkSpace {
   std::size_t max_voxels_;
   std::uint32_t frame_ = 0;
   tsl::robin_map<std::uint64_t, Entry, MixHash64> voxels_;
+  tsl::robin_map<std::uint64_t, std::vector<std::uint64_t>, MixHash64> blocks_;  ///< voxel keys by block
 };
 
 }  // namespace scenewatch::change
