@@ -187,8 +187,8 @@ bool footprint_behind(const DepthView& depth, const TrustedAt& trusted_at, doubl
 // voxel (the surface is still there, or something occludes it) vetoes; so does one without depth
 // (a hole at a grazing edge may be the surface itself) or one the sensor model does not trust.
 // The footprint is the voxel's, grown by the pose's uncertainty at that range: wherever the voxel
-// may really project, the frame must see behind it. `seen_depth_m`: the nearest depth a camera
-// saw the surface there at (0: unknown); the map's surface lies within that depth's noise.
+// may really project, the frame must see behind it. With `witness`, a surface only other cameras
+// saw is not claimed, and one this session saw is placed within the noise of its nearest sighting.
 template <typename TrustedAt>
 std::optional<MissingVoxel> seen_through(const Eigen::Vector3d& c, const Eigen::Isometry3d& T_camera_world, const Intrinsics& K,
                                          const Config& config, const DepthView& depth, const TrustedAt& trusted_at,
