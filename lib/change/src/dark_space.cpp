@@ -2,9 +2,11 @@
 #include "scenewatch/change/dark_space.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "scenewatch/change/mismatch.h"
+#include "voxel_axis.h"
 
 namespace scenewatch::change {
 namespace {
@@ -18,14 +20,14 @@ constexpr double kDistinctViewDeg = 10.0;
 constexpr double kSampleStep = 8.0;
 // Half the diagonal of a unit cube (as in mismatch.cpp).
 constexpr double kHalfDiagonal = 0.8660254;
-constexpr std::uint64_t kAxisMask = 0x1fffff;  // 21 bits per axis around the origin
-constexpr unsigned kBlockBits = 3;             // blocks of 8 x 8 x 8 voxels (16 cm at 2 cm)
+constexpr unsigned kBlockBits = 3;  // blocks of 8 x 8 x 8 voxels (16 cm at 2 cm)
+constexpr std::uint64_t kBlockAxisMask = kVoxelAxisMask >> kBlockBits;
 
-std::uint64_t axis(double x, double per_m) {
-  return static_cast<std::uint64_t>(static_cast<std::int64_t>(std::floor(x * per_m)) + (1 << 20)) & kAxisMask;
-}
-double unaxis(std::uint64_t a, double per_m) {
-  return (static_cast<double>(static_cast<std::int64_t>(a) - (1 << 20)) + 0.5) / per_m;
+// A voxel key's three axis indices (x, y, z).
+std::array<std::uint64_t, 3> axes(std::uint64_t key) { return {key >> 42, (key >> 21) & kVoxelAxisMask, key & kVoxelAxisMask}; }
+// The key of the block holding the voxel at these axis indices.
+std::uint64_t block_key(std::uint64_t bx, std::uint64_t by, std::uint64_t bz) {
+  return ((bx & kBlockAxisMask) << 36) | ((by & kBlockAxisMask) << 18) | (bz & kBlockAxisMask);
 }
 
 }  // namespace
@@ -33,7 +35,7 @@ double unaxis(std::uint64_t a, double per_m) {
 DarkSpace::DarkSpace(double voxel_m, std::size_t max_voxels) : per_m_(1.0 / voxel_m), max_voxels_(max_voxels) {}
 
 std::uint64_t DarkSpace::key(const Eigen::Vector3d& p) const {
-  return (axis(p.x(), per_m_) << 42) | (axis(p.y(), per_m_) << 21) | axis(p.z(), per_m_);
+  return (voxel_axis(p.x(), per_m_) << 42) | (voxel_axis(p.y(), per_m_) << 21) | voxel_axis(p.z(), per_m_);
 }
 
 void DarkSpace::record(const background::DenseGrid& grid, const DepthView& depth, const Pose& T, const Config& config,
@@ -44,6 +46,7 @@ void DarkSpace::record(const background::DenseGrid& grid, const DepthView& depth
   const double res = grid.resolution;
   if (std::abs(res * per_m_ - 1.0) > 1e-6) {  // the map was replaced by one of another resolution
     voxels_.clear();
+    blocks_.clear();
     per_m_ = 1.0 / res;
   }
   const int step = std::max(1, static_cast<int>(std::lround(kSampleStep * K.width / 640.0)));
@@ -133,9 +136,8 @@ void DarkSpace::prune() {
 }
 
 std::uint64_t DarkSpace::block_of(std::uint64_t k) {
-  constexpr std::uint64_t kBlockMask = kAxisMask >> kBlockBits;
-  const std::uint64_t x = (k >> 42) >> kBlockBits, y = ((k >> 21) & kAxisMask) >> kBlockBits, z = (k & kAxisMask) >> kBlockBits;
-  return ((x & kBlockMask) << 36) | ((y & kBlockMask) << 18) | (z & kBlockMask);
+  const auto a = axes(k);
+  return block_key(a[0] >> kBlockBits, a[1] >> kBlockBits, a[2] >> kBlockBits);
 }
 
 void DarkSpace::erase(std::uint64_t k) {
@@ -158,20 +160,17 @@ std::vector<DarkSpace::Voxel> DarkSpace::in_grid(const background::DenseGrid& gr
   // Only the blocks the grid overlaps: a daemon that has run for hours holds many more.
   const Eigen::Vector3d lo = grid.origin.array() + 0.5 * grid.resolution;
   const Eigen::Vector3d hi = grid.origin + grid.resolution * Eigen::Vector3d(grid.nx - 0.5, grid.ny - 0.5, grid.nz - 0.5);
-  const std::uint64_t k_lo = key(lo), k_hi = key(hi);
-  const std::uint64_t x0 = (k_lo >> 42) >> kBlockBits, x1 = (k_hi >> 42) >> kBlockBits;
-  const std::uint64_t y0 = ((k_lo >> 21) & kAxisMask) >> kBlockBits, y1 = ((k_hi >> 21) & kAxisMask) >> kBlockBits;
-  const std::uint64_t z0 = (k_lo & kAxisMask) >> kBlockBits, z1 = (k_hi & kAxisMask) >> kBlockBits;
-  for (std::uint64_t x = x0; x <= x1; ++x)
-    for (std::uint64_t y = y0; y <= y1; ++y)
-      for (std::uint64_t z = z0; z <= z1; ++z) {
-        const auto block = blocks_.find((x << 36) | (y << 18) | z);
+  const auto a0 = axes(key(lo)), a1 = axes(key(hi));
+  for (std::uint64_t x = a0[0] >> kBlockBits; x <= a1[0] >> kBlockBits; ++x)
+    for (std::uint64_t y = a0[1] >> kBlockBits; y <= a1[1] >> kBlockBits; ++y)
+      for (std::uint64_t z = a0[2] >> kBlockBits; z <= a1[2] >> kBlockBits; ++z) {
+        const auto block = blocks_.find(block_key(x, y, z));
         if (block == blocks_.end()) continue;
         for (const std::uint64_t k : block->second) {
           const Entry& e = voxels_.find(k)->second;
           if (e.mixed) continue;
-          const Eigen::Vector3d c(unaxis((k >> 42) & kAxisMask, per_m_), unaxis((k >> 21) & kAxisMask, per_m_),
-                                  unaxis(k & kAxisMask, per_m_));
+          const auto a = axes(k);
+          const Eigen::Vector3d c(voxel_axis_center(a[0], per_m_), voxel_axis_center(a[1], per_m_), voxel_axis_center(a[2], per_m_));
           const long idx = grid.index_of(c);
           if (idx < 0 || grid.at(idx) == background::Occupancy::kOccupied) continue;
           out.push_back({k, grid.center(idx), e.two_views && e.frames >= min_frames && (e.cameras & bit) != 0});

@@ -4,30 +4,14 @@
 #include <cmath>
 #include <vector>
 
+#include "voxel_axis.h"
+
 namespace scenewatch::change {
 
 SurfaceWitness::SurfaceWitness(double voxel_m, std::size_t max_voxels) : per_m_(1.0 / voxel_m), max_voxels_(max_voxels) {}
 
-namespace {
-// 21 bits per axis around the origin: +-20 km at 2 cm.
-constexpr std::uint64_t kAxisMask = 0x1fffff;
-// floor() written out: without SSE4.1 in an x86-64 baseline build std::floor is a libm call,
-// three per point (as in background/frame_trace.cpp).
-std::uint64_t axis(double x, double per_m) {
-  const double a = x * per_m;
-  std::int64_t f;
-  if (a > -4e18 && a < 4e18) {
-    f = static_cast<std::int64_t>(a);  // towards zero
-    if (a < static_cast<double>(f)) --f;
-  } else {
-    f = static_cast<std::int64_t>(std::floor(a));
-  }
-  return static_cast<std::uint64_t>(f + (1 << 20)) & kAxisMask;
-}
-}  // namespace
-
 SurfaceWitness::Where SurfaceWitness::where(const Eigen::Vector3d& p) const {
-  const std::uint64_t x = axis(p.x(), per_m_), y = axis(p.y(), per_m_), z = axis(p.z(), per_m_);
+  const std::uint64_t x = voxel_axis(p.x(), per_m_), y = voxel_axis(p.y(), per_m_), z = voxel_axis(p.z(), per_m_);
   constexpr std::uint64_t low = (1u << kBlockBits) - 1;
   Where w;
   constexpr unsigned kBits = 21 - kBlockBits;  // per axis of a block key
