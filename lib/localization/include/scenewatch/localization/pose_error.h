@@ -1,7 +1,8 @@
 #pragma once
-/// Pose sources as a robot has them, for measuring localization against a recording's poses:
-/// odometry that drifts, and poses with independent noise; and the error of a trajectory. Both draw each error as a twist with
+/// Measuring localization against a recording's poses. Pose sources as a robot has them:
+/// odometry that drifts, and poses with independent noise; both draw each error as a twist with
 /// translation N(0, s_t^2 / 3) per axis (so its RMS is s_t) and rotation likewise, from `seed`.
+/// And the error of an estimated trajectory against the true one.
 #include <vector>
 
 #include "scenewatch/core/geometry.h"
