@@ -80,46 +80,66 @@ double cpu_ms() {
 struct OfflineRun {
   double median_frame_ms = 0, p90_frame_ms = 0, cpu_per_frame_ms = 0;
   std::size_t events = 0;
+  double cores_busy = 0;
+  std::map<std::string, std::vector<double>> stage_ms;  // by stage, ordered by its numbered name
 };
 
-// The frames through one working memory; prints the stages when `print`.
-std::optional<OfflineRun> offline(const Sequence& s, const pipeline::Config& config, bool print) {
-  pipeline::WorkingMemory memory(config);
-  std::map<std::string, std::vector<double>> ms;
-  std::size_t events = 0;
-  double wall_ms = 0;
-  const double cpu0 = cpu_ms();
-  for (const auto& f : s.frames) {
-    auto r = memory.process(f);
-    if (!r) {
-      std::printf("  %s: %s\n", s.name.c_str(), r.error().message.c_str());
-      return std::nullopt;
+// The frames through one working memory per configuration, interleaved frame by frame: frame i
+// goes through every memory before frame i+1 goes through any, so that what the machine does
+// meanwhile (another process, the clock, the caches) falls on every configuration alike. Run one
+// after the other, the same configuration had differed by up to 1.2x between two runs (hrt1).
+std::optional<std::vector<OfflineRun>> offline(const Sequence& s, const std::vector<pipeline::Config>& configs) {
+  std::vector<std::unique_ptr<pipeline::WorkingMemory>> memories;
+  for (const auto& c : configs) memories.push_back(std::make_unique<pipeline::WorkingMemory>(c));
+  std::vector<OfflineRun> runs(configs.size());
+  std::vector<double> wall_ms(configs.size(), 0.0), cpu(configs.size(), 0.0);
+  for (const auto& f : s.frames)
+    for (std::size_t c = 0; c < configs.size(); ++c) {
+      const double cpu0 = cpu_ms();
+      auto r = memories[c]->process(f);
+      cpu[c] += cpu_ms() - cpu0;
+      if (!r) {
+        std::printf("  %s: %s\n", s.name.c_str(), r.error().message.c_str());
+        return std::nullopt;
+      }
+      auto& ms = runs[c].stage_ms;
+      ms["1 segmentation"].push_back(r->segment_ms);
+      ms["2 image surprise + keyframes"].push_back(r->surprise_ms);
+      ms["3 change detection"].push_back(r->change_ms);
+      ms["4 map insertion"].push_back(r->insert_ms);
+      ms["0 hands (before the others)"].push_back(r->hands_ms);
+      ms["5 foreground (registration, promotion)"].push_back(r->foreground_ms);
+      ms["6 the three parts side by side"].push_back(r->parallel_ms);
+      ms["7 after (foreground, fusion, tracker, publish)"].push_back(r->after_ms);
+      ms["9 frame (process)"].push_back(r->total_ms);
+      wall_ms[c] += r->total_ms;
+      runs[c].events += r->events.size();
     }
-    ms["1 segmentation"].push_back(r->segment_ms);
-    ms["2 image surprise + keyframes"].push_back(r->surprise_ms);
-    ms["3 change detection"].push_back(r->change_ms);
-    ms["4 map insertion"].push_back(r->insert_ms);
-    ms["0 hands (before the others)"].push_back(r->hands_ms);
-    ms["5 foreground (registration, promotion)"].push_back(r->foreground_ms);
-    ms["6 the three parts side by side"].push_back(r->parallel_ms);
-    ms["7 after (foreground, fusion, tracker, publish)"].push_back(r->after_ms);
-    ms["9 frame (process)"].push_back(r->total_ms);
-    wall_ms += r->total_ms;
-    events += r->events.size();
+  for (std::size_t c = 0; c < configs.size(); ++c) {
+    auto& run = runs[c];
+    const auto& frame_ms = run.stage_ms["9 frame (process)"];
+    run.median_frame_ms = median(frame_ms);
+    run.p90_frame_ms = quantile(frame_ms, 0.9);
+    run.cpu_per_frame_ms = cpu[c] / static_cast<double>(s.frames.size());
+    run.cores_busy = wall_ms[c] > 0 ? cpu[c] / wall_ms[c] : 0.0;
   }
-  const double cpu_per_frame = (cpu_ms() - cpu0) / static_cast<double>(s.frames.size());
-  OfflineRun run{median(ms["9 frame (process)"]), quantile(ms["9 frame (process)"], 0.9), cpu_per_frame, events};
-  if (!print) return run;
+  return runs;
+}
+
+// The defaults' stages, with the median of each without the sensor model's remedies beside them.
+void print_stages(const Sequence& s, const OfflineRun& now, const OfflineRun& without) {
   std::printf("-- %s: %zu frames, %zu events; decoding (PNG + cloud, before process) median %.1f ms\n", s.name.c_str(),
-              s.frames.size(), events, median(s.decode_ms));
-  std::printf("   %-46s %10s %10s\n", "stage", "median ms", "p90 ms");
-  for (const auto& [stage, v] : ms)
-    std::printf("   %-46s %10.1f %10.1f\n", stage.substr(2).c_str(), median(v), quantile(v, 0.9));
-  const double m = run.median_frame_ms;
+              s.frames.size(), now.events, median(s.decode_ms));
+  std::printf("   %-46s %10s %10s %14s\n", "stage", "median ms", "p90 ms", "remedies off");
+  for (const auto& [stage, v] : now.stage_ms) {
+    const auto off = without.stage_ms.find(stage);
+    std::printf("   %-46s %10.1f %10.1f %14.1f\n", stage.substr(2).c_str(), median(v), quantile(v, 0.9),
+                off != without.stage_ms.end() ? median(off->second) : 0.0);
+  }
+  const double m = now.median_frame_ms;
   std::printf("   => %.1f frames/s offline (median frame); target 15 (66 ms), goal 30 (33 ms)\n", m > 0 ? 1000.0 / m : 0.0);
-  std::printf("   CPU per frame, all threads: %.1f ms (mean), %.2f cores busy during process()\n", cpu_per_frame,
-              wall_ms > 0 ? cpu_per_frame * s.frames.size() / wall_ms : 0.0);
-  return run;
+  std::printf("   CPU per frame, all threads: %.1f ms (mean), %.2f cores busy during process()\n", now.cpu_per_frame_ms,
+              now.cores_busy);
 }
 
 // The defaults, after the same frames with every pixel segmented and inserted (the strides of
@@ -137,10 +157,12 @@ void offline_side_by_side(const Sequence& s) {
   no_sensor_remedies.change.incidence_aware = false;
   no_sensor_remedies.sensor.fit_colour_registration = false;
   no_sensor_remedies.change.see_through_dark = false;
-  const auto before = offline(s, every_pixel, false);
-  const auto without = offline(s, no_sensor_remedies, false);
-  const auto now = offline(s, config, true);
-  if (!before || !now || !without) return;
+  const auto runs = offline(s, {config, no_sensor_remedies, every_pixel});
+  if (!runs) return;
+  const OfflineRun* now = &(*runs)[0];
+  const OfflineRun* without = &(*runs)[1];
+  const OfflineRun* before = &(*runs)[2];
+  print_stages(s, *now, *without);
   std::printf("   without the sensor model's remedies (measured pose, trusted pixels, per-camera witness, incidence, colour registration, dark space), same run: "
               "frame median %.1f ms (p90 %.1f), CPU %.1f ms per frame, %zu events; the defaults take %.2fx its time "
               "(median), %.2fx its CPU\n",
@@ -221,7 +243,7 @@ void over_tcp(const Sequence&) { std::printf("   over TCP: built without the ser
 
 int run_pipeline(const Options& o) {
   std::printf("\n== The whole frame: posed VGA RGB-D through WorkingMemory::process, then over TCP\n");
-  for (auto s : {real_sequence(o, "7-Scenes redkitchen (50 frames, hand-held)", "redkitchen"), simulated_sequence("cup_added"),
+  for (const auto& s : {real_sequence(o, "7-Scenes redkitchen (50 frames, hand-held)", "redkitchen"), simulated_sequence("cup_added"),
                  real_sequence(o, "hrt1 pick_toy_1 (40 frames, a person picks a toy)", "hrt1/pick_toy_1")}) {
     if (!s) {
       std::printf("  (a sequence could not be loaded; skipped)\n");
