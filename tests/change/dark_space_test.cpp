@@ -34,6 +34,8 @@ DepthView holes(float nearest_m = 0.3f) {
   d.z.assign(64 * 48, std::numeric_limits<float>::quiet_NaN());
   d.z[0] = nearest_m;
   d.z[1] = 2.0f;
+  d.min_z = nearest_m;
+  d.max_z = 2.0f;
   return d;
 }
 

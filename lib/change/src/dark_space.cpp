@@ -55,10 +55,9 @@ void DarkSpace::record(const background::DenseGrid& grid, const DepthView& depth
   // than any of them is the sensor's range, not something in front (a Kinect v1 in its default
   // mode returns nothing under 0.8 m, whatever its profile's working range says).
   Range& measured = ranges_[camera];
-  for (const float z : depth.z) {
-    if (!(z > 0)) continue;
-    measured.min_m = std::min(measured.min_m, static_cast<double>(z));
-    measured.max_m = std::max(measured.max_m, static_cast<double>(z));
+  if (depth.min_z > 0) {  // NaN when the frame has no depth at all
+    measured.min_m = std::min(measured.min_m, static_cast<double>(depth.min_z));
+    measured.max_m = std::max(measured.max_m, static_cast<double>(depth.max_z));
   }
   if (!(measured.min_m < measured.max_m)) return;
   const Eigen::Matrix3d R = T.linear();

@@ -146,20 +146,27 @@ DepthView depth_view(const Cloud& cloud, const Intrinsics& K) {
   DepthView view;
   view.K = K;
   view.z.assign(static_cast<std::size_t>(K.width) * K.height, kNaN);
+  float lo = std::numeric_limits<float>::infinity(), hi = 0.0f;
   if (cloud.height > 1 && static_cast<int>(cloud.width) == K.width && static_cast<int>(cloud.height) == K.height) {
     for (std::size_t i = 0; i < cloud.size(); ++i) {
       const PointT& p = cloud.points[i];
-      if (is_valid(p) && p.z > 0) view.z[i] = p.z;
+      if (!is_valid(p) || !(p.z > 0)) continue;
+      view.z[i] = p.z;
+      lo = std::min(lo, p.z);
+      hi = std::max(hi, p.z);
     }
-    return view;
+  } else {
+    for (const auto& p : cloud.points) {
+      if (!is_valid(p) || p.z <= 0) continue;
+      const long u = std::lround(K.fx * p.x / p.z + K.cx), v = std::lround(K.fy * p.y / p.z + K.cy);
+      if (u < 0 || v < 0 || u >= K.width || v >= K.height) continue;
+      float& z = view.z[static_cast<std::size_t>(v) * K.width + u];
+      if (!(z <= p.z)) z = p.z;  // NaN or farther: the nearer point wins
+      lo = std::min(lo, p.z);
+      hi = std::max(hi, p.z);
+    }
   }
-  for (const auto& p : cloud.points) {
-    if (!is_valid(p) || p.z <= 0) continue;
-    const long u = std::lround(K.fx * p.x / p.z + K.cx), v = std::lround(K.fy * p.y / p.z + K.cy);
-    if (u < 0 || v < 0 || u >= K.width || v >= K.height) continue;
-    float& z = view.z[static_cast<std::size_t>(v) * K.width + u];
-    if (!(z <= p.z)) z = p.z;  // NaN or farther: the nearer point wins
-  }
+  if (hi > 0) view.min_z = lo, view.max_z = hi;
   return view;
 }
 
@@ -306,7 +313,8 @@ Result<Mismatch> mismatch_against_map(const background::OccupancyMap& map, const
 
   // What the sensor model makes of each pixel (in range, off the border, away from depth edges and
   // holes; core/depth_validity.h).
-  const DepthView depth = depth_view(cloud, K);
+  out.depth = std::make_shared<const DepthView>(depth_view(cloud, K));
+  const DepthView& depth = *out.depth;
   const DepthValidity trusted = depth_validity(depth.z, K.width, K.height, std::min(K.fx, K.fy), config.sensor, config.sigma_factor);
   out.trusted_pixels = trusted.trusted;
   // How far this frame's pose is off the map: every tolerance below grows with it.

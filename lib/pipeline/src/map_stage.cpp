@@ -73,8 +73,10 @@ ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const 
   auto mismatch = change::mismatch_against_map(map_, *frame.cloud, T, *K, config, &map_grid_,
                                                config.witness_per_camera ? &witness_ : nullptr, camera, grid_filled, &dark_);
   if (!mismatch) return out;
-  // The frame's own holes, against the same map: what it looked into and got nothing back from.
-  if (record_dark && config.see_through_dark) dark_.record(map_grid_, change::depth_view(*frame.cloud, *K), T, config, camera);
+  // The frame's own holes, against the same map (the copy stays as it is until the next frame's
+  // fill): what it looked into and got nothing back from. Recorded with the witness, by whichever
+  // thread is free first.
+  if (record_dark && config.see_through_dark) dark_depth_ = mismatch->depth;
   {
     std::lock_guard<std::mutex> lock(pose_mutex_);
     last_pose_[camera] = mismatch->pose;
@@ -113,12 +115,10 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
   // is free first (witness_frame()), while the insertion runs or after it. Then the surfaces of
   // confirmed removals are forgotten, as they were after the witness before.
   {
-    WitnessJob job{to_insert, T, camera, stride, config.change.witness_per_camera, {}};
+    WitnessJob job{to_insert, T, camera, stride, config.change.witness_per_camera, {}, std::move(dark_depth_), &config.change};
+    dark_depth_.reset();
     for (const auto& c : changed.confirmed)
-      if (c.before) {
-        job.forget.push_back(c.before->points_world);
-        dark_.forget(c.before->points_world);
-      }
+      if (c.before) job.forget.push_back(c.before->points_world);
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_ = std::move(job);
   }
@@ -142,7 +142,11 @@ void MapStage::witness_frame() {
   const WitnessJob job = std::move(*witness_job_);
   witness_job_.reset();
   if (job.record) witness_.witness(*job.cloud, job.T, job.camera, job.stride);
-  for (const auto& points : job.forget) witness_.forget(points);
+  if (job.dark_depth) dark_.record(map_grid_, *job.dark_depth, job.T, *job.change_config, job.camera);
+  for (const auto& points : job.forget) {
+    witness_.forget(points);
+    dark_.forget(points);
+  }
 }
 
 std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d&)> MapStage::occupied_fraction(
@@ -173,6 +177,7 @@ std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d&
 
 void MapStage::reset() {
   prefilled_.reset();
+  dark_depth_.reset();
   {
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_.reset();
@@ -192,6 +197,7 @@ void MapStage::reset() {
 
 void MapStage::replace(background::OccupancyMap map) {
   prefilled_.reset();
+  dark_depth_.reset();
   {
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_.reset();

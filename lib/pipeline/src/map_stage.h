@@ -45,9 +45,10 @@ class MapStage {
                        bool detect, FrameResult& result, std::uint32_t camera, bool record_dark = true);
 
   /// Records the surfaces of the frame update() last took in the surface witness (which cameras
-  /// saw each surface), and forgets those of the removals it confirmed. update() leaves this to
-  /// whichever of the frame's threads is free first: the first call does it, a call during it
-  /// waits for it, later calls do nothing. Before the next update().
+  /// saw each surface) and its pixels without depth in the dark space, and forgets the surfaces
+  /// of the removals it confirmed in both. update() leaves this to whichever of the frame's
+  /// threads is free first: the first call does it, a call during it waits for it, later calls
+  /// do nothing. Before the next update() or prefill().
   void witness_frame();
 
   /// Fills the change detection's dense copy of the map around `frame` (placed with T) now, on
@@ -100,8 +101,8 @@ class MapStage {
   ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
                                const change::Config& config, std::uint32_t camera, bool record_dark);
 
-  // Guards `map_` between writers and concurrent occupancy readers. `witness_` is read by the change
-  // detection and written by witness_frame(), one after the other within a frame.
+  // Guards `map_` between writers and concurrent occupancy readers. `witness_` and `dark_` are read
+  // by the change detection and written by witness_frame(), one after the other within a frame.
   mutable std::shared_mutex mutex_;
   background::OccupancyMap map_;
   background::DenseGrid map_grid_;  // the change detector's dense copy of the map, its buffers kept between frames
@@ -109,7 +110,9 @@ class MapStage {
   Pose prefill_T_ = Pose::Identity();  // the pose prefill() filled map_grid_ at
   std::size_t prefill_points_ = 0;     // the size of the cloud it filled for
   change::SurfaceWitness witness_;  // which cameras saw each surface of the map (written by witness_frame())
-  change::DarkSpace dark_;          // space rays without a return crossed (written by detect_changes())
+  change::DarkSpace dark_;          // space rays without a return crossed (written by witness_frame())
+  // The depth image detect_changes() compared, for the dark space; update() hands it on.
+  std::shared_ptr<const change::DepthView> dark_depth_;
   struct WitnessJob {
     CloudConstPtr cloud;  // the points update() inserted
     Pose T;
@@ -117,8 +120,12 @@ class MapStage {
     int stride = 1;
     bool record = false;                               // change.witness_per_camera
     std::vector<std::vector<Eigen::Vector3d>> forget;  // the surfaces of confirmed removals
+    // The frame's depth as the change detection read it, recorded in the dark space against
+    // map_grid_ (null: not recorded); the configuration update() was given, alive until the job is done.
+    std::shared_ptr<const change::DepthView> dark_depth;
+    const change::Config* change_config = nullptr;
   };
-  std::mutex witness_mutex_;                // witness_job_, and witness_ while a job runs
+  std::mutex witness_mutex_;                // witness_job_, and witness_ and dark_ while a job runs
   std::optional<WitnessJob> witness_job_;   // the last update()'s, until witness_frame() takes it
   change::PersistenceFilter changes_;  // owned by the writer
   // The pose agreement the change detector last measured, per camera.

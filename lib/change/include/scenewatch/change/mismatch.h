@@ -6,6 +6,8 @@
 /// front of the observed depth at its pixel by more than the tolerance, so this frame's ray passed
 /// through it. Unknown space, occluded surfaces and pixels without depth claim nothing.
 #include <cstdint>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -113,6 +115,9 @@ double map_tolerance_from_sigma(const Config& config, double sensor_sigma_m, dou
 struct DepthView {
   Intrinsics K;
   std::vector<float> z;  ///< row-major, K.width * K.height
+  /// The smallest and largest depth in `z` (both NaN when it holds none): depth_view() finds them
+  /// as it fills `z`; a view filled by hand sets them too.
+  float min_z = std::numeric_limits<float>::quiet_NaN(), max_z = std::numeric_limits<float>::quiet_NaN();
   float at(int u, int v) const { return z[static_cast<std::size_t>(v) * K.width + u]; }
 };
 
@@ -142,6 +147,9 @@ struct Mismatch {
   double voxel_m = 0.0;               ///< the map's voxel edge (map path)
   PoseAgreement pose;                 ///< map path: how well the frame's pose agrees with the map
   std::size_t trusted_pixels = 0;     ///< map path: pixels the sensor model trusts
+  /// Map path: the observation's depth image as the comparison read it (DarkSpace::record reads
+  /// it again rather than building it a second time).
+  std::shared_ptr<const DepthView> depth;
   /// Removed side given as points of an earlier organized observation (same-camera pairs); its
   /// indices index that observation. Empty for the map path.
   std::vector<int> removed_points;
