@@ -52,7 +52,8 @@ MapStage::MapStage(const Config& c, std::shared_ptr<change::PendingIds> pending_
 // a removed one, within a few frames). A frame whose region is too large for a dense grid is
 // left without change detection.
 ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
-                                       const change::Config& config, std::uint32_t camera, bool record_dark) {
+                                       const change::Config& config, std::uint32_t camera,
+                                       std::shared_ptr<const change::DepthView>* dark_depth) {
   const bool prefilled = prefilled_.value_or(false);
   prefilled_.reset();
   ChangeOutcome out;
@@ -76,7 +77,7 @@ ChangeOutcome MapStage::detect_changes(const Frame& frame, const Pose& T, const 
   // The frame's own holes, against the same map (the copy stays as it is until the next frame's
   // fill): what it looked into and got nothing back from. Recorded with the witness, by whichever
   // thread is free first.
-  if (record_dark && config.see_through_dark) dark_depth_ = mismatch->depth;
+  if (dark_depth != nullptr && config.see_through_dark) *dark_depth = mismatch->depth;
   {
     std::lock_guard<std::mutex> lock(pose_mutex_);
     last_pose_[camera] = mismatch->pose;
@@ -100,9 +101,10 @@ void MapStage::prefill(const Frame& frame, const Pose& T, const change::Config& 
 ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K, const Config& config,
                                bool detect, FrameResult& result, std::uint32_t camera, bool record_dark) {
   ChangeOutcome changed;
+  std::shared_ptr<const change::DepthView> dark_depth;  // the frame's depth, for the dark space
   if (detect) {
     const auto t_change = Clock::now();
-    changed = detect_changes(frame, T, K, config.change, camera, record_dark);
+    changed = detect_changes(frame, T, K, config.change, camera, record_dark ? &dark_depth : nullptr);
     result.change_ms = ms_since(t_change);
     result.change_candidates = changes_.candidates();
   }
@@ -115,8 +117,7 @@ ChangeOutcome MapStage::update(const Frame& frame, const Pose& T, const std::opt
   // is free first (witness_frame()), while the insertion runs or after it. Then the surfaces of
   // confirmed removals are forgotten, as they were after the witness before.
   {
-    WitnessJob job{to_insert, T, camera, stride, config.change.witness_per_camera, {}, std::move(dark_depth_), &config.change};
-    dark_depth_.reset();
+    WitnessJob job{to_insert, T, camera, stride, config.change.witness_per_camera, {}, std::move(dark_depth), &config.change};
     for (const auto& c : changed.confirmed)
       if (c.before) job.forget.push_back(c.before->points_world);
     std::lock_guard<std::mutex> lock(witness_mutex_);
@@ -177,7 +178,6 @@ std::function<double(const std::vector<Eigen::Vector3d>&, const Eigen::Vector3d&
 
 void MapStage::reset() {
   prefilled_.reset();
-  dark_depth_.reset();
   {
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_.reset();
@@ -197,7 +197,6 @@ void MapStage::reset() {
 
 void MapStage::replace(background::OccupancyMap map) {
   prefilled_.reset();
-  dark_depth_.reset();
   {
     std::lock_guard<std::mutex> lock(witness_mutex_);
     witness_job_.reset();

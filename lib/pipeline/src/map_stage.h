@@ -98,8 +98,11 @@ class MapStage {
   void replace(background::OccupancyMap map);
 
  private:
+  // With `dark_depth` (and change.see_through_dark), sets it to the depth image the comparison
+  // read, for the dark space.
   ChangeOutcome detect_changes(const Frame& frame, const Pose& T, const std::optional<Intrinsics>& K,
-                               const change::Config& config, std::uint32_t camera, bool record_dark);
+                               const change::Config& config, std::uint32_t camera,
+                               std::shared_ptr<const change::DepthView>* dark_depth);
 
   // Guards `map_` between writers and concurrent occupancy readers. `witness_` and `dark_` are read
   // by the change detection and written by witness_frame(), one after the other within a frame.
@@ -111,8 +114,6 @@ class MapStage {
   std::size_t prefill_points_ = 0;     // the size of the cloud it filled for
   change::SurfaceWitness witness_;  // which cameras saw each surface of the map (written by witness_frame())
   change::DarkSpace dark_;          // space rays without a return crossed (written by witness_frame())
-  // The depth image detect_changes() compared, for the dark space; update() hands it on.
-  std::shared_ptr<const change::DepthView> dark_depth_;
   struct WitnessJob {
     CloudConstPtr cloud;  // the points update() inserted
     Pose T;
