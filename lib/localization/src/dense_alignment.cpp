@@ -152,12 +152,14 @@ struct LevelInput {
 // the first one shifted by the row's number (so the rows' samples interleave). Compiled twice, for
 // AVX2 + FMA and for the x86-64 baseline; the loader picks the clone the CPU supports (GCC function
 // multi-versioning), so the binary stays portable. The clones round differently (FMA fuses a
-// multiply and an add), by far less than the sensor's noise.
+// multiply and an add), by far less than the sensor's noise. The quality pass at the final pose
+// (`quality_pass`) sums the geometric inliers' information, for the covariance, instead of the
+// normal equations, which no step follows.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx2,fma", "default")))
 #endif
 Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor, const AlignmentConfig& config,
-               bool keep_information = false, int stride = 1) {
+               bool quality_pass = false, int stride = 1) {
   Pass p;
   const RgbdLevel& ref = in.ref;
   const RgbdLevel& cur = in.cur;
@@ -195,14 +197,14 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
           double J[6];
           point_jacobian(qd, n, J);
           const double info = 1.0 / sigma2;
-          p.system.add(J, r, info * huber_weight(r, sigma2));
+          if (!quality_pass) p.system.add(J, r, info * huber_weight(r, sigma2));
           ++p.correspondences;
           p.depth_sum += zr;
           const double r2 = r * r;
           if (r2 <= kInlierSigmas * kInlierSigmas * sigma2) {
             ++p.inliers;
             p.inlier_sq += r2;
-            if (keep_information) p.information.add_information(J, info);
+            if (quality_pass) p.information.add_information(J, info);
           }
         }
       }
