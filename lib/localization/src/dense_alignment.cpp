@@ -111,7 +111,8 @@ class ResidualHistogram {
  public:
   static constexpr int kBins = 4096;
   void add(double abs_r) {
-    const int b = std::min(static_cast<int>(abs_r * kBins), kBins - 1);
+    // 1 and beyond (and a NaN, which no intensity should give) count in the last bin.
+    const int b = abs_r < 1.0 ? static_cast<int>(abs_r * kBins) : kBins - 1;
     ++bins_[static_cast<std::size_t>(b)];
     ++count_;
   }
