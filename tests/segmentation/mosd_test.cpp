@@ -102,14 +102,16 @@ TEST(Mosd, TableFoundAndObjectsRecalled) {
                 by_group_correct[g], by_group_clusters[g]);
   EXPECT_EQ(tables, scenes) << "the table plane must be found in every scene";
   // Floors at what the run they were set on measured (docs/testing.md, "Real data"): recall
-  // 112/112, precision 112/114 = 0.982; boxes 38/38, stacked boxes 20/20 and 20/21, occluded
-  // objects 16/16 and cylindric objects 38/38 and 38/39. Before the cut between stacked levels
+  // 112/112, precision 112/115 = 0.974; boxes 38/38, stacked boxes 20/20 and 20/22, occluded
+  // objects 16/16 and cylindric objects 38/38 and 38/39. The cut at depth steps (2026-12-03)
+  // parts learn22's middle box from the top box's end face, which the convex split had given
+  // it, and so leaves that face an object of its own (112/114 = 0.982 before). Before the cut between stacked levels
   // (split_stacked), 111/112 both ways: the stack of three in learn21 was one object; the cut
   // also leaves a piece of one box in learn24 and the ledge of the lidded box in learn41 as
   // objects of their own. (Before the occlusion join: 110/112 and 110/115; Euclidean clusters
   // alone: 0.821 / 0.773.)
   EXPECT_EQ(matched, objects);
-  EXPECT_GE(precision, 0.98);
+  EXPECT_GE(precision, 0.973);
   EXPECT_EQ(by_group_matched[3], by_group_objects[3]) << "cylinders, mugs, bowls and pots are found whole";
   EXPECT_GE(by_group_correct[3] + 1, by_group_clusters[3]) << "one piece at most: learn41's ledge";
   EXPECT_EQ(by_group_matched[2], by_group_objects[2]) << "occluded objects are found whole";
@@ -240,11 +242,17 @@ void expect_test_dev(const Config& config, const char* how, const std::vector<De
 
 TEST(Mosd, TestDevMixedScenesAndPiles) {
   SCENEWATCH_REQUIRE_DATA("mosd/test_dev/test43.pcd");
-  expect_test_dev(Config{}, "default", {{"mixed, tuning", 43, 51, 57, 57, 60},
+  expect_test_dev(Config{}, "default", {{"mixed, tuning", 43, 51, 58, 58, 61},
                                         {"piles, tuning", 55, 57, 41, 41, 45},
                                         {"mixed, held out", 52, 54, 17, 17, 19},
-                                        {"piles, held out", 58, 59, 24, 24, 30}});
-  Config unstacked;  // the default before the cut between stacked levels
+                                        {"piles, held out", 58, 59, 26, 26, 31}});
+  Config no_steps;  // the default before the cut at depth steps (2026-12-03)
+  no_steps.split_depth_steps = false;
+  expect_test_dev(no_steps, "split_depth_steps off", {{"mixed, tuning", 43, 51, 57, 57, 60},
+                                                      {"piles, tuning", 55, 57, 41, 41, 45},
+                                                      {"mixed, held out", 52, 54, 17, 17, 19},
+                                                      {"piles, held out", 58, 59, 24, 24, 30}});
+  Config unstacked = no_steps;  // the default before the cut between stacked levels
   unstacked.split_stacked = false;
   expect_test_dev(unstacked, "split_stacked off", {{"mixed, tuning", 43, 51, 53, 53, 55},
                                                    {"piles, tuning", 55, 57, 37, 37, 41},
@@ -258,27 +266,18 @@ TEST(Mosd, TestDevMixedScenesAndPiles) {
                                                                {"piles, held out", 58, 59, 15, 15, 27}});
 }
 
-// Cuts at closed depth steps and colour edges (issue 30, item 1), both off by default: the same
-// split and scoring. Floors and ceilings are what was measured (docs/clutter.md):
-// the depth-step cut changes no figure on test_dev (its steps almost never close around an
-// object-sized region); colour edges find 2 more objects in all (mixed +1 tuning, +2 held out;
-// piles -1 tuning) but make 34 more clusters.
+// Cuts at colour edges (issue 30, item 1), off by default, on top of the default config (which
+// cuts at depth steps since 2026-12-03): the same split and scoring. Floors and ceilings are what
+// was measured (docs/clutter.md): colour edges cut printed objects, 16 more clusters on the
+// tuning mixed scenes for 2 fewer objects found.
 TEST(Mosd, TestDevBoundaryCuts) {
   SCENEWATCH_REQUIRE_DATA("mosd/test_dev/test43.pcd");
-  Config steps;
-  steps.bridge_hidden_support = false;  // as measured in docs/clutter.md, against the largest piece
-  steps.split_stacked = false;
-  steps.split_depth_steps = true;
-  expect_test_dev(steps, "split_depth_steps", {{"mixed, tuning", 43, 51, 53, 53, 55},
-                                               {"piles, tuning", 55, 57, 22, 22, 32},
-                                               {"mixed, held out", 52, 54, 17, 17, 19},
-                                               {"piles, held out", 58, 59, 15, 15, 27}});
-  Config colour = steps;
+  Config colour;
   colour.split_colour_edges = true;
-  expect_test_dev(colour, "split_depth_steps + split_colour_edges", {{"mixed, tuning", 43, 51, 54, 54, 74},
-                                                                     {"piles, tuning", 55, 57, 21, 21, 38},
-                                                                     {"mixed, held out", 52, 54, 19, 19, 23},
-                                                                     {"piles, held out", 58, 59, 15, 15, 32}});
+  expect_test_dev(colour, "split_depth_steps + split_colour_edges", {{"mixed, tuning", 43, 51, 56, 56, 77},
+                                                                     {"piles, tuning", 55, 57, 41, 41, 52},
+                                                                     {"mixed, held out", 52, 54, 19, 19, 24},
+                                                                     {"piles, held out", 58, 59, 25, 25, 35}});
 }
 
 }  // namespace

@@ -109,8 +109,12 @@ DepthSteps::Side DepthSteps::fit(int first, int away) const {
 // noise of the pixel's position carried along the slope (a grazing surface changes range fast
 // across one pixel); or the scatter about the line when that is larger (a shiny or dark surface).
 double DepthSteps::noise(const Side& s, int first, int away) const {
+  return std::sqrt(std::max(model_variance(s, first, away), s.scatter));
+}
+
+double DepthSteps::model_variance(const Side& s, int first, int away) const {
   const double r0 = range(first);
-  if (s.pixels < 2) return params_.sensor.sigma_z(r0);
+  if (s.pixels < 2) return params_.sensor.sigma_z(r0) * params_.sensor.sigma_z(r0);
   // Incidence from the slope: range change per pixel against the lateral spacing of two pixels.
   const Eigen::Vector3f p0 = cloud_[first].getVector3fMap(), p1 = cloud_[first + away].getVector3fMap();
   const Eigen::Vector3f ray = (p0 - origin_).normalized();
@@ -118,7 +122,12 @@ double DepthSteps::noise(const Side& s, int first, int away) const {
   const double incidence = lateral > 0 ? std::atan(std::abs(s.slope) / lateral) : M_PI / 2;
   const double axial = params_.sensor.sigma_z(r0, incidence);
   const double along = params_.sensor.lateral_sigma_px(incidence) * std::abs(s.slope);
-  return std::sqrt(std::max(axial * axial + along * along, s.scatter));
+  return axial * axial + along * along;
+}
+
+bool DepthSteps::clean_rim(const Side& s, int first, int away) const {
+  const double k = params_.noise_sigmas;
+  return s.pixels >= 3 && s.scatter <= k * k * model_variance(s, first, away);
 }
 
 bool DepthSteps::is_step(int a, int offset) const {
@@ -127,11 +136,16 @@ bool DepthSteps::is_step(int a, int offset) const {
   // (most pairs lie on one surface and stop here) ...
   const float ra = range(a), rb = range(b);
   if (std::isnan(ra) || std::isnan(rb)) return false;
-  if (!off_hole(a) || !off_hole(b)) return false;
   if (std::abs(ra - rb) <= params_.noise_sigmas * std::sqrt(2.0) * params_.sensor.sigma_z(std::min(ra, rb))) return false;
   // ... and then the surfaces on its two sides, carried to the boundary, miss each other.
   const Side left = fit(a, -offset);
   const Side right = fit(b, offset);
+  // Beside a hole, a pixel may be the ragged rim of a measurement. It is evidence only when the
+  // surface on each side is measured right up to the pair, over three pixels or more, and lies on its
+  // line within the sensor's noise: the rim of a real surface, not a stereo camera's frayed one.
+  // (A structured-light sensor leaves its projector's shadow beside every occluding edge, so
+  // most object-on-object steps have a hole within a few pixels.)
+  if ((!off_hole(a) || !off_hole(b)) && !(clean_rim(left, a, -offset) && clean_rim(right, b, offset))) return false;
   const double miss = std::abs(left.at_boundary - right.at_boundary);
   const double sl = noise(left, a, -offset), sr = noise(right, b, offset);
   const double sigma = std::sqrt(left.variance * sl * sl + right.variance * sr * sr);

@@ -77,10 +77,11 @@ struct Config {
   /// decides what is a depth step (split_depth_steps) and a level apart (split_stacked).
   SensorModel sensor;
   /// Organized clouds (and unorganized ones through their recovered image): cut the convex parts
-  /// at closed depth steps, a book lying on a book, a thin box on a box (1-3 cm). A step is a jump
-  /// between two pixels whose sides' surfaces, carried to the boundary, miss each other by more
-  /// than 3 sigma of the sensor's noise there; pixels in the noise band of a hole are no evidence.
-  bool split_depth_steps = false;
+  /// at closed depth steps, a box leaning on a can, a book lying on a book, a thin box on a box
+  /// (1-3 cm). A step is a jump between two pixels whose sides' surfaces, carried to the boundary,
+  /// miss each other by more than 3 sigma of the sensor's noise there; beside a hole, only when
+  /// both sides also lie on their lines within that noise (segmentation/src/depth_steps.h).
+  bool split_depth_steps = true;
   /// ... and at closed colour edges that run across a part (two boxes of different print pressed
   /// together): OpenCV's Canny on the colour image, its thresholds at 3 sigma of the image's own
   /// noise (segmentation/src/colour_edges.h).
