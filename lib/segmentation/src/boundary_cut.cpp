@@ -50,11 +50,61 @@ struct PixelLinks {
   std::vector<Crossing> crossings;
 };
 
+// The four neighbours of a pixel, in the order of PixelLinks' open bits: right, below, left, above.
+constexpr std::array<std::array<int, 2>, 4> kSides{{{1, 0}, {0, 1}, {-1, 0}, {0, -1}}};
+
+/// The part's local index of pixel k's neighbour on `side` (kSides), -1 outside the part.
+int neighbour(const std::vector<int>& part, const PartImage& image, int k, int side) {
+  const int i = part[k];
+  return image.find(i % image.width + kSides[side][0], i / image.width + kSides[side][1]);
+}
+
+// Step 1a': the pixels at a step join, round by round, the region most of their placed
+// neighbours (those `open` reaches, with no boundary between) belong to; one with none keeps a
+// region of its own.
+void place_step_pixels(const std::vector<int>& part, const PartImage& image, const std::vector<std::uint8_t>& open,
+                       const std::vector<char>& at_step, UnionFind& pixels) {
+  const int n = static_cast<int>(part.size());
+  std::vector<char> placed(n, 1);
+  std::vector<int> pending;
+  for (int k = 0; k < n; ++k)
+    if (at_step[k]) placed[k] = 0, pending.push_back(k);
+  while (!pending.empty()) {
+    std::vector<std::pair<int, int>> joins;  // (pixel, region root)
+    std::vector<int> still;
+    for (int k : pending) {
+      std::array<int, 4> roots{};
+      std::array<int, 4> votes{};
+      int distinct = 0;
+      for (int side = 0; side < 4; ++side) {
+        if (!(open[k] & (1u << side))) continue;
+        const int other = neighbour(part, image, k, side);
+        if (!placed[other]) continue;
+        const int root = pixels.find(other);
+        int r = 0;
+        while (r < distinct && roots[r] != root) ++r;
+        if (r == distinct) roots[distinct++] = root;
+        ++votes[r];
+      }
+      int best = -1, best_votes = 0;
+      for (int r = 0; r < distinct; ++r)
+        if (votes[r] > best_votes || (votes[r] == best_votes && roots[r] < best)) best = roots[r], best_votes = votes[r];
+      if (best >= 0) joins.emplace_back(k, best);
+      else still.push_back(k);
+    }
+    if (joins.empty()) break;
+    for (const auto& [k, root] : joins) {
+      pixels.unite(k, root);
+      placed[k] = 1;
+    }
+    pending.swap(still);
+  }
+}
+
 // A line of depth steps is decided pair by pair, and one pair along it that misses the test (a
 // pixel at a projector shadow's rim, a corner of a staircase boundary) would join the regions on
 // its two sides. So the pixels at a step (either end of a crossing) take no part in forming the
-// regions; each then joins, round by round, the region most of its placed step-free neighbours
-// belong to (one with none keeps a region of its own). A gap of one pair between crossings of
+// regions and are placed afterwards (place_step_pixels). A gap of one pair between crossings of
 // one line, whose two pixels are both at a step, no longer joins the regions.
 PixelLinks link_pixels(const Cloud& cloud, const std::vector<int>& part, PartImage& image,
                        const Eigen::Vector3d& sensor_origin, const BoundaryTest& is_boundary,
@@ -62,16 +112,14 @@ PixelLinks link_pixels(const Cloud& cloud, const std::vector<int>& part, PartIma
   const int n = static_cast<int>(part.size()), width = image.width;
   const int u0 = image.u0, v0 = image.v0, u1 = image.u1, v1 = image.v1;
   PixelLinks links{UnionFind(n), std::vector<char>(n, 0), {}};
-  // Per pixel, the neighbours it reaches with no boundary between: right, below, left, above.
-  constexpr std::array<std::array<int, 2>, 4> kSides{{{1, 0}, {0, 1}, {-1, 0}, {0, -1}}};
-  std::vector<std::uint8_t> open(n, 0);
+  std::vector<std::uint8_t> open(n, 0);  // per pixel, a bit per side (kSides) with no boundary
   std::vector<char> at_step(n, 0);
   for (int k = 0; k < n; ++k) {
     const int i = part[k], u = i % width, v = i / width;
     links.on_outline[k] = u == u0 || u == u1 || v == v0 || v == v1 || image.at(u - 1, v) < 0 ||
                           image.at(u + 1, v) < 0 || image.at(u, v - 1) < 0 || image.at(u, v + 1) < 0;
     if (is_edge_pixel && is_edge_pixel(i)) continue;
-    for (int side = 0; side < 2; ++side) {
+    for (int side = 0; side < 2; ++side) {  // right and below: each pair once
       const int du = kSides[side][0], dv = kSides[side][1];
       if (u + du > u1 || v + dv > v1) continue;
       const int other = image.at(u + du, v + dv);
@@ -87,52 +135,15 @@ PixelLinks link_pixels(const Cloud& cloud, const std::vector<int>& part, PartIma
       }
     }
   }
-  auto neighbour = [&](int k, int side) {
-    const int i = part[k];
-    return image.find(i % width + kSides[side][0], i / width + kSides[side][1]);
-  };
   for (int k = 0; k < n; ++k) {
     if (at_step[k]) continue;
     for (int side = 0; side < 2; ++side) {
       if (!(open[k] & (1u << side))) continue;
-      const int other = neighbour(k, side);
+      const int other = neighbour(part, image, k, side);
       if (!at_step[other]) links.pixels.unite(k, other);
     }
   }
-  std::vector<char> placed(n, 1);
-  std::vector<int> pending;
-  for (int k = 0; k < n; ++k)
-    if (at_step[k]) placed[k] = 0, pending.push_back(k);
-  while (!pending.empty()) {
-    std::vector<std::pair<int, int>> joins;  // (pixel, region root)
-    std::vector<int> still;
-    for (int k : pending) {
-      std::array<int, 4> roots{};
-      std::array<int, 4> votes{};
-      int distinct = 0;
-      for (int side = 0; side < 4; ++side) {
-        if (!(open[k] & (1u << side))) continue;
-        const int other = neighbour(k, side);
-        if (!placed[other]) continue;
-        const int root = links.pixels.find(other);
-        int r = 0;
-        while (r < distinct && roots[r] != root) ++r;
-        if (r == distinct) roots[distinct++] = root;
-        ++votes[r];
-      }
-      int best = -1, best_votes = 0;
-      for (int r = 0; r < distinct; ++r)
-        if (votes[r] > best_votes || (votes[r] == best_votes && roots[r] < best)) best = roots[r], best_votes = votes[r];
-      if (best >= 0) joins.emplace_back(k, best);
-      else still.push_back(k);
-    }
-    if (joins.empty()) break;
-    for (const auto& [k, root] : joins) {
-      links.pixels.unite(k, root);
-      placed[k] = 1;
-    }
-    pending.swap(still);
-  }
+  place_step_pixels(part, image, open, at_step, links.pixels);
   return links;
 }
 

@@ -143,8 +143,8 @@ bool DepthSteps::is_step(int a, int offset) const {
   // Beside a hole, a pixel may be the ragged rim of a measurement. It is evidence only when the
   // surface on each side is measured right up to the pair, over three pixels or more, and lies on its
   // line within the sensor's noise: the rim of a real surface, not a stereo camera's frayed one.
-  // (A structured-light sensor leaves its projector's shadow beside every occluding edge, so
-  // most object-on-object steps have a hole within a few pixels.)
+  // (A structured-light sensor leaves its projector's shadow beside nearly every occluding edge,
+  // so most object-on-object steps have a hole within a few pixels.)
   if ((!off_hole(a) || !off_hole(b)) && !(clean_rim(left, a, -offset) && clean_rim(right, b, offset))) return false;
   const double miss = std::abs(left.at_boundary - right.at_boundary);
   const double sl = noise(left, a, -offset), sr = noise(right, b, offset);
