@@ -107,11 +107,7 @@ DepthSteps::Side DepthSteps::fit(int first, int away) const {
 
 // The sensor's axial noise at the side's range and incidence (Nguyen's eq. 2), with the lateral
 // noise of the pixel's position carried along the slope (a grazing surface changes range fast
-// across one pixel); or the scatter about the line when that is larger (a shiny or dark surface).
-double DepthSteps::noise(const Side& s, int first, int away) const {
-  return std::sqrt(std::max(model_variance(s, first, away), s.scatter));
-}
-
+// across one pixel), as a variance.
 double DepthSteps::model_variance(const Side& s, int first, int away) const {
   const double r0 = range(first);
   if (s.pixels < 2) return params_.sensor.sigma_z(r0) * params_.sensor.sigma_z(r0);
@@ -125,9 +121,9 @@ double DepthSteps::model_variance(const Side& s, int first, int away) const {
   return axial * axial + along * along;
 }
 
-bool DepthSteps::clean_rim(const Side& s, int first, int away) const {
+bool DepthSteps::clean_rim(const Side& s, double model_variance) const {
   const double k = params_.noise_sigmas;
-  return s.pixels >= 3 && s.scatter <= k * k * model_variance(s, first, away);
+  return s.pixels >= 3 && s.scatter <= k * k * model_variance;
 }
 
 bool DepthSteps::is_step(int a, int offset) const {
@@ -145,10 +141,13 @@ bool DepthSteps::is_step(int a, int offset) const {
   // line within the sensor's noise: the rim of a real surface, not a stereo camera's frayed one.
   // (A structured-light sensor leaves its projector's shadow beside nearly every occluding edge,
   // so most object-on-object steps have a hole within a few pixels.)
-  if ((!off_hole(a) || !off_hole(b)) && !(clean_rim(left, a, -offset) && clean_rim(right, b, offset))) return false;
+  const double model_l = model_variance(left, a, -offset), model_r = model_variance(right, b, offset);
+  if ((!off_hole(a) || !off_hole(b)) && !(clean_rim(left, model_l) && clean_rim(right, model_r))) return false;
   const double miss = std::abs(left.at_boundary - right.at_boundary);
-  const double sl = noise(left, a, -offset), sr = noise(right, b, offset);
-  const double sigma = std::sqrt(left.variance * sl * sl + right.variance * sr * sr);
+  // Each side's pixel noise: the model's, or the scatter about its line when that is larger (a
+  // shiny or dark surface).
+  const double sl2 = std::max(model_l, left.scatter), sr2 = std::max(model_r, right.scatter);
+  const double sigma = std::sqrt(left.variance * sl2 + right.variance * sr2);
   return miss > params_.noise_sigmas * sigma;
 }
 

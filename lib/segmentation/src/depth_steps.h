@@ -53,14 +53,12 @@ class DepthSteps {
   };
   /// The line through pixel `first` and up to kSidePixels - 1 more at `first + k * away`.
   Side fit(int first, int away) const;
-  /// The pixel noise of a side: the sensor's at its range and incidence, or its scatter.
-  double noise(const Side& s, int first, int away) const;
   /// The sensor model's variance of a side's pixels (axial at its range and incidence, plus the
   /// lateral noise carried along its slope), without the side's own scatter.
   double model_variance(const Side& s, int first, int away) const;
   /// A side measured over three pixels or more, scattered about its line within noise_sigmas
-  /// of the model's noise.
-  bool clean_rim(const Side& s, int first, int away) const;
+  /// of the model's noise (its `model_variance`).
+  bool clean_rim(const Side& s, double model_variance) const;
   /// Range of pixel i from the sensor, NaN when invalid or outside the padded rectangle.
   float range(int i) const;
   /// Whether pixel i lies in the padded rectangle, outside a hole's noise band.
