@@ -153,11 +153,11 @@ int run_trajectories(const io::Sequence& seq, const std::vector<Pose>& truth) {
     for (std::size_t i = 0; i < truth.size(); ++i) add_error(eg, g.used[i], truth[i]);
     print_errors("  the same, finest level geometry only", eg, g);
     localization::Config every_pixel;
-    every_pixel.alignment.finest_level_stride = 1;
+    every_pixel.alignment.strides = {1, 1, 1};
     const Trajectory a = run(seq, given, LocalizationMode::kRefine, every_pixel);
     Errors ea;
     for (std::size_t i = 0; i < truth.size(); ++i) add_error(ea, a.used[i], truth[i]);
-    print_errors("  the same, every pixel on the finest level", ea, a);
+    print_errors("  the same, every pixel on every level", ea, a);
   }
   for (unsigned seed : {1u, 2u, 3u}) {
     const auto drifted = localization::with_drift(truth, 0.003, 0.15, seed);
@@ -182,15 +182,16 @@ int run_trajectories(const io::Sequence& seq, const std::vector<Pose>& truth) {
   struct TrackCase {
     const char* label;
     bool photometric_finest;
-    int finest_stride;
+    std::vector<int> strides;
   };
-  for (const TrackCase& c : {TrackCase{"track, no poses, from an empty memory", true, 2},
-                             TrackCase{"  the same, finest level geometry only", false, 2},
-                             TrackCase{"  the same, every pixel on the finest level", true, 1}}) {
+  for (const TrackCase& c : {TrackCase{"track, no poses, from an empty memory", true, {1, 2, 2}},
+                             TrackCase{"  the same, finest level geometry only", false, {1, 2, 2}},
+                             TrackCase{"  the same, every second pixel on the finest level only", true, {1, 1, 2}},
+                             TrackCase{"  the same, every pixel on every level", true, {1, 1, 1}}}) {
     std::vector<std::optional<Pose>> none(truth.size());
     localization::Config lc;
     lc.alignment.photometric_on_finest_level = c.photometric_finest;
-    lc.alignment.finest_level_stride = c.finest_stride;
+    lc.alignment.strides = c.strides;
     const Trajectory t = run(seq, none, LocalizationMode::kTrack, lc);
     std::printf("  %-58s RMSE %5.1f mm over %zu frames (both relative to their first pose) | lost %3zu | %5.1f ms/frame\n",
                 c.label, 1000 * localization::trajectory_rmse_m(t.used, truth), truth.size(), t.lost, median(t.ms));
@@ -247,7 +248,7 @@ int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
   const std::size_t gap = 3;
   std::printf("\nlocalization: frame-to-frame alignment, %zu pairs 0.2 s apart, from the identity, errors against the recording's relative poses\n",
               (seq.frames.size() - gap + 4) / 5);
-  PairResult ours, ours_every_pixel, ours_coarse_photometric, ours_geometric, opencv, gicp, none;
+  PairResult ours, ours_finest_strided, ours_every_pixel, ours_coarse_photometric, ours_geometric, opencv, gicp, none;
   std::vector<double> reference_ms, current_ms;
   localization::AlignmentConfig geometric;
   geometric.photometric_weight = 0;
@@ -255,7 +256,9 @@ int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
   localization::AlignmentConfig finest_geometric = defaults.alignment;
   finest_geometric.photometric_on_finest_level = false;
   localization::AlignmentConfig every_pixel = defaults.alignment;  // the default before 2026-12-02
-  every_pixel.finest_level_stride = 1;
+  every_pixel.strides = {1, 1, 1};
+  localization::AlignmentConfig finest_strided = defaults.alignment;  // the default before 2026-12-03
+  finest_strided.strides = {1, 1, 2};
   const SensorModel sensor;
   for (std::size_t i = 0; i + gap < seq.frames.size(); i += 5) {
     auto a = io::load_sequence_frame(seq, i);
@@ -272,6 +275,9 @@ int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
     ours.ms.push_back(current_ms.back() +
                       time_ms([&] { r = localization::align(ref, cur, Pose::Identity(), sensor, defaults.alignment); }));
     add_error(ours.errors, r.T_reference_current, truth_ab);
+    ours_finest_strided.ms.push_back(current_ms.back() +
+                                     time_ms([&] { r = localization::align(ref, cur, Pose::Identity(), sensor, finest_strided); }));
+    add_error(ours_finest_strided.errors, r.T_reference_current, truth_ab);
     ours_every_pixel.ms.push_back(current_ms.back() +
                                   time_ms([&] { r = localization::align(ref, cur, Pose::Identity(), sensor, every_pixel); }));
     add_error(ours_every_pixel.errors, r.T_reference_current, truth_ab);
@@ -317,7 +323,8 @@ int run_pairs(const io::Sequence& seq, const std::vector<Pose>& truth) {
   }
   print_pair("no alignment (identity)", none);
   print_pair("scenewatch dense RGB-D (default)", ours);
-  print_pair("scenewatch dense, every pixel on the finest level", ours_every_pixel);
+  print_pair("scenewatch dense, every second pixel on the finest level only", ours_finest_strided);
+  print_pair("scenewatch dense, every pixel on every level", ours_every_pixel);
   print_pair("scenewatch dense, finest level geometry only", ours_coarse_photometric);
   print_pair("scenewatch dense, geometry only", ours_geometric);
 #ifdef SCENEWATCH_BENCH_HAS_OPENCV_RGBD

@@ -286,9 +286,11 @@ Status validate(const AlignmentConfig& c) {
   if (!(c.photometric_weight >= 0 && c.photometric_weight <= 100))
     return invalid_argument("localization.photometric_weight: must be in [0, 100]");
   if (!(c.min_gradient >= 0 && c.min_gradient < 1)) return invalid_argument("localization.min_gradient: must be in [0, 1)");
-  if (c.finest_level_stride < 1 || c.finest_level_stride > 4)
-    return invalid_argument("localization.finest_level_stride: 1 to 4 (every pixel to every fourth), got " +
-                            std::to_string(c.finest_level_stride));
+  if (c.strides.size() > 6)
+    return invalid_argument("localization.strides: at most six levels, got " + std::to_string(c.strides.size()));
+  for (int s : c.strides)
+    if (s < 1 || s > 4)
+      return invalid_argument("localization.strides: each 1 to 4 (every pixel to every fourth), got " + std::to_string(s));
   if (!(c.converged_m > 0) || !(c.converged_deg > 0))
     return invalid_argument("localization.converged_m / converged_deg: must be > 0");
   return {};
@@ -307,7 +309,7 @@ Alignment align(const RgbdPyramid& reference, const RgbdPyramid& current, const 
     const int iterations = config.iterations[config.iterations.size() - 1 - l];
     AlignmentConfig level_config = config;
     if (l == 0 && !config.photometric_on_finest_level) level_config.photometric_weight = 0;
-    const int stride = l == 0 ? config.finest_level_stride : 1;
+    const int stride = config.stride_at(l);
     for (int it = 0; it < iterations; ++it) {
       Pass pass = linearise(in, T, sensor, level_config, false, stride);
       ++out.iterations;

@@ -1,5 +1,6 @@
 #include "scenewatch/pipeline/config_loader.h"
 
+#include <limits>
 #include <system_error>
 
 #include "scenewatch/core/yaml_value.h"
@@ -72,6 +73,8 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
   YamlSection s(node, "localization");
   if (auto st = s.check_is_map(); !st) return st;
   std::string mode = localization::mode_name(l.mode);
+  constexpr int kNotGiven = std::numeric_limits<int>::min();
+  int finest_level_stride = kNotGiven;  // the key before `strides`: its last entry
   if (auto st = read_all([&] { return s.read("mode", mode); }, [&] { return s.read("levels", l.pyramid.levels); },
                          [&] { return s.read("finest_halvings", l.pyramid.finest_halvings); },
                          [&] { return s.read("iterations", l.alignment.iterations); },
@@ -79,7 +82,8 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
                          [&] { return s.read("photometric_weight", l.alignment.photometric_weight); },
                          [&] { return s.read("min_gradient", l.alignment.min_gradient); },
                          [&] { return s.read("photometric_on_finest_level", l.alignment.photometric_on_finest_level); },
-                         [&] { return s.read("finest_level_stride", l.alignment.finest_level_stride); },
+                         [&] { return s.read("strides", l.alignment.strides); },
+                         [&] { return s.read("finest_level_stride", finest_level_stride); },
                          [&] { return s.read("min_inlier_fraction", l.min_inlier_fraction); },
                          [&] { return s.read("min_conditioning", l.min_conditioning); },
                          [&] { return s.read("max_correction_m", l.max_correction_m); },
@@ -100,6 +104,13 @@ Status read_localization(const YAML::Node& node, localization::Config& l) {
   auto parsed = localization::parse_mode(mode);
   if (!parsed) return yaml::key_error(s.path("mode"), parsed.error().message);
   l.mode = *parsed;
+  if (finest_level_stride != kNotGiven) {
+    if (finest_level_stride < 1 || finest_level_stride > 4)
+      return yaml::key_error(s.path("finest_level_stride"),
+                             "1 to 4 (every pixel to every fourth), got " + std::to_string(finest_level_stride));
+    if (l.alignment.strides.empty()) l.alignment.strides.push_back(1);
+    l.alignment.strides.back() = finest_level_stride;
+  }
   return s.finish();
 }
 

@@ -26,11 +26,18 @@ struct AlignmentConfig {
   /// aligned on geometry alone, 23 % faster (docs/localization.md); the coarser levels, where the
   /// photometric term widens the basin of convergence, keep it.
   bool photometric_on_finest_level = true;
-  /// The finest level's Gauss-Newton passes take every n-th pixel of a row, shifted by one from
-  /// row to row (a checkerboard at 2); the quality at the final pose (inliers, residual,
-  /// covariance) counts every pixel. 1: every pixel. At 2 the finest passes cost half, and the
-  /// poses stay within 0.1 mm of every pixel's (docs/localization.md).
-  int finest_level_stride = 2;
+  /// Per level, coarsest first as `iterations` (the last entry is level 0): the Gauss-Newton
+  /// passes take every n-th pixel of a row, shifted by one from row to row (a checkerboard at 2);
+  /// levels the list does not reach take every pixel. The quality at the final pose (inliers,
+  /// residual, covariance) counts every pixel. At 2 a level's passes cost half, and the poses stay
+  /// within 0.1 mm of every pixel's (docs/localization.md). The coarsest level (80x60 for a VGA
+  /// frame) keeps every pixel: it sets the basin of convergence.
+  std::vector<int> strides = {1, 2, 2};
+  /// The stride of level `level` (0: the finest).
+  int stride_at(int level) const {
+    const int k = static_cast<int>(strides.size()) - 1 - level;
+    return k >= 0 ? strides[static_cast<std::size_t>(k)] : 1;
+  }
   /// Pixels whose reference intensity gradient is smaller than this (per pixel, 0..1 units) carry
   /// no photometric information and are skipped.
   double min_gradient = 0.01;
