@@ -156,13 +156,101 @@ struct LevelInput {
   double photometric_sigma;
 };
 
+// A batch of a pass's pixels, staged. The pass was one long chain of dependent steps per pixel
+// (the current depth, the projection, the reference's depth and normal at it, its shade), too long
+// for the processor to start the next pixel's loads before this pixel's arithmetic was done, so
+// each pixel waited out its own memory latencies in turn. Staged, each step runs over the whole
+// batch: the projections first, then every lookup into the reference (whose addresses are all
+// known by then, so their loads overlap), then the arithmetic. The same operations in the same
+// order as one pixel at a time, so the same sums to the last bit.
+struct Staged {
+  static constexpr int kSize = 64;
+  int n = 0;
+  // Projected: the current pixel, its point in the reference's frame and where it falls there.
+  std::size_t ic[kSize], ir[kSize];
+  int iu[kSize], iv[kSize];  // the nearest reference pixel, ir's column and row
+  float zc[kSize], qx[kSize], qy[kSize], qz[kSize], x[kSize], y[kSize];
+  // Looked up: the reference's depth and normal at the nearest pixel, its shade there and
+  // interpolated, the current intensity.
+  float zr[kSize], cur_intensity[kSize];
+  Eigen::Vector3f normal[kSize];
+  RgbdLevel::Shade nearest[kSize], at[kSize];
+};
+
+[[gnu::always_inline]] inline void look_up(Staged& b, const RgbdLevel& ref, const RgbdLevel& cur, bool photometric) {
+  for (int k = 0; k < b.n; ++k) {
+    b.zr[k] = ref.depth_m[b.ir[k]];
+    b.normal[k] = ref.normals[b.ir[k]];
+  }
+  if (!photometric) return;
+  for (int k = 0; k < b.n; ++k) {
+    b.nearest[k] = ref.shade[b.ir[k]];
+    b.at[k] = Bilinear(ref.width, b.x[k], b.y[k])(ref.shade);
+    b.cur_intensity[k] = cur.intensity[b.ic[k]];
+  }
+}
+
+// The terms of a staged batch, added to the pass's sums in the batch's order.
+[[gnu::always_inline]] inline void add_terms(const Staged& b, const LevelInput& in, const SensorModel& sensor,
+                                             const AlignmentConfig& config, const PixelRays& ref_rays, bool quality_pass,
+                                             Pass& p) {
+  const float fx = static_cast<float>(in.ref.intrinsics.fx), fy = static_cast<float>(in.ref.intrinsics.fy);
+  const double wphoto = config.photometric_weight;
+  const float min_grad = static_cast<float>(config.min_gradient);
+  for (int k = 0; k < b.n; ++k) {
+    const Eigen::Vector3f q(b.qx[k], b.qy[k], b.qz[k]);
+    const Eigen::Vector3d qd = q.cast<double>();
+    // Geometric: the reference surface at the nearest pixel, its plane.
+    const float zr = b.zr[k];
+    if (zr > 0 && std::isfinite(b.normal[k].x())) {
+      const Eigen::Vector3f d = q - ref_rays.point(b.iu[k], b.iv[k], zr);
+      const float zc = b.zc[k];
+      const double sz_c = sensor.sigma_z(zc), sz_r = sensor.sigma_z(zr);
+      // Compared in squares, as huber_weight(r, sigma2): no square root on this path.
+      const double sigma2 = sz_c * sz_c + sz_r * sz_r;
+      const double gate2 = std::max(in.gate_m * in.gate_m, kGateSigmas * kGateSigmas * sigma2);
+      if (static_cast<double>(d.squaredNorm()) <= gate2) {
+        const Eigen::Vector3d n = b.normal[k].cast<double>();
+        const double r = n.dot(d.cast<double>());
+        double J[6];
+        point_jacobian(qd, n, J);
+        const double info = 1.0 / sigma2;
+        if (!quality_pass) p.system.add(J, r, info * huber_weight(r, sigma2));
+        ++p.correspondences;
+        p.depth_sum += zr;
+        const double r2 = r * r;
+        if (r2 <= kInlierSigmas * kInlierSigmas * sigma2) {
+          ++p.inliers;
+          p.inlier_sq += r2;
+          if (quality_pass) p.information.add_information(J, info);
+        }
+      }
+    }
+    // Photometric: the reference intensity where the point projects, where it has texture.
+    if (wphoto <= 0) continue;
+    const RgbdLevel::Shade& nearest = b.nearest[k];
+    if (std::abs(nearest.grad_x) < min_grad && std::abs(nearest.grad_y) < min_grad) continue;
+    const RgbdLevel::Shade& at = b.at[k];
+    const double r = at.intensity - b.cur_intensity[k];
+    const double bgx = at.grad_x, bgy = at.grad_y;
+    const double iz = 1.0 / qd.z();
+    // Gradient through the projection: a = dpi/dq^T grad.
+    const Eigen::Vector3d a(bgx * fx * iz, bgy * fy * iz, -(bgx * fx * qd.x() + bgy * fy * qd.y()) * iz * iz);
+    double J[6];
+    point_jacobian(qd, a, J);
+    const double s = in.photometric_sigma;
+    p.system.add(J, r, wphoto * huber_weight(r / s) / (s * s));
+    p.photometric_abs.add(std::abs(r));
+  }
+}
+
 // One pass over the current level's pixels at the pose T_rc: every `stride`-th pixel of a row,
-// the first one shifted by the row's number (so the rows' samples interleave). Compiled twice, for
-// AVX2 + FMA and for the x86-64 baseline; the loader picks the clone the CPU supports (GCC function
-// multi-versioning), so the binary stays portable. The clones round differently (FMA fuses a
-// multiply and an add), by far less than the sensor's noise. The quality pass at the final pose
-// (`quality_pass`) sums the geometric inliers' information, for the covariance, instead of the
-// normal equations, which no step follows.
+// the first one shifted by the row's number (so the rows' samples interleave), in staged batches.
+// Compiled twice, for AVX2 + FMA and for the x86-64 baseline; the loader picks the clone the CPU
+// supports (GCC function multi-versioning), so the binary stays portable. The clones round
+// differently (FMA fuses a multiply and an add), by far less than the sensor's noise. The quality
+// pass at the final pose (`quality_pass`) sums the geometric inliers' information, for the
+// covariance, instead of the normal equations, which no step follows.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 __attribute__((target_clones("avx2,fma", "default")))
 #endif
@@ -176,62 +264,42 @@ Pass linearise(const LevelInput& in, const Pose& T_rc, const SensorModel& sensor
   const float fx = static_cast<float>(ref.intrinsics.fx), fy = static_cast<float>(ref.intrinsics.fy);
   const float cx = static_cast<float>(ref.intrinsics.cx), cy = static_cast<float>(ref.intrinsics.cy);
   const double wphoto = config.photometric_weight;
-  const float min_grad = static_cast<float>(config.min_gradient);
   const PixelRays cur_rays(cur), ref_rays(ref);
-  for (int v = 0; v < cur.height; ++v) {
-    for (int u = v % stride; u < cur.width; u += stride) {
-      const std::size_t ic = static_cast<std::size_t>(v) * cur.width + u;
-      const float zc = cur.depth_m[ic];
-      if (zc <= 0) continue;
-      ++p.valid;
-      const Eigen::Vector3f q = R * cur_rays.point(u, v, zc) + t;
-      if (q.z() <= 0) continue;
-      const float x = fx * q.x() / q.z() + cx, y = fy * q.y() / q.z() + cy;
-      if (!(x >= 0 && y >= 0 && x < ref.width - 1 && y < ref.height - 1)) continue;
-      const Eigen::Vector3d qd = q.cast<double>();
-      // Geometric: the reference surface at the nearest pixel, its plane.
-      const int iu = static_cast<int>(x + 0.5f), iv = static_cast<int>(y + 0.5f);
-      const std::size_t ir = static_cast<std::size_t>(iv) * ref.width + iu;
-      const float zr = ref.depth_m[ir];
-      if (zr > 0 && std::isfinite(ref.normals[ir].x())) {
-        const Eigen::Vector3f d = q - ref_rays.point(iu, iv, zr);
-        const double sz_c = sensor.sigma_z(zc), sz_r = sensor.sigma_z(zr);
-        // Compared in squares, as huber_weight(r, sigma2): no square root on this path.
-        const double sigma2 = sz_c * sz_c + sz_r * sz_r;
-        const double gate2 = std::max(in.gate_m * in.gate_m, kGateSigmas * kGateSigmas * sigma2);
-        if (static_cast<double>(d.squaredNorm()) <= gate2) {
-          const Eigen::Vector3d n = ref.normals[ir].cast<double>();
-          const double r = n.dot(d.cast<double>());
-          double J[6];
-          point_jacobian(qd, n, J);
-          const double info = 1.0 / sigma2;
-          if (!quality_pass) p.system.add(J, r, info * huber_weight(r, sigma2));
-          ++p.correspondences;
-          p.depth_sum += zr;
-          const double r2 = r * r;
-          if (r2 <= kInlierSigmas * kInlierSigmas * sigma2) {
-            ++p.inliers;
-            p.inlier_sq += r2;
-            if (quality_pass) p.information.add_information(J, info);
-          }
-        }
+  Staged b;
+  int v = 0, u = 0;
+  while (v < cur.height) {
+    // Stage the next batch of pixels that project into the reference image.
+    b.n = 0;
+    while (v < cur.height && b.n < Staged::kSize) {
+      for (; u < cur.width && b.n < Staged::kSize; u += stride) {
+        const std::size_t ic = static_cast<std::size_t>(v) * cur.width + u;
+        const float zc = cur.depth_m[ic];
+        if (zc <= 0) continue;
+        ++p.valid;
+        const Eigen::Vector3f q = R * cur_rays.point(u, v, zc) + t;
+        if (q.z() <= 0) continue;
+        const float x = fx * q.x() / q.z() + cx, y = fy * q.y() / q.z() + cy;
+        if (!(x >= 0 && y >= 0 && x < ref.width - 1 && y < ref.height - 1)) continue;
+        const int iu = static_cast<int>(x + 0.5f), iv = static_cast<int>(y + 0.5f);
+        const int k = b.n++;
+        b.ic[k] = ic;
+        b.ir[k] = static_cast<std::size_t>(iv) * ref.width + iu;
+        b.iu[k] = iu;
+        b.iv[k] = iv;
+        b.zc[k] = zc;
+        b.qx[k] = q.x();
+        b.qy[k] = q.y();
+        b.qz[k] = q.z();
+        b.x[k] = x;
+        b.y[k] = y;
       }
-      // Photometric: the reference intensity where the point projects, where it has texture.
-      if (wphoto <= 0) continue;
-      const RgbdLevel::Shade& nearest = ref.shade[ir];
-      if (std::abs(nearest.grad_x) < min_grad && std::abs(nearest.grad_y) < min_grad) continue;
-      const RgbdLevel::Shade at = Bilinear(ref.width, x, y)(ref.shade);
-      const double r = at.intensity - cur.intensity[ic];
-      const double bgx = at.grad_x, bgy = at.grad_y;
-      const double iz = 1.0 / qd.z();
-      // Gradient through the projection: a = dpi/dq^T grad.
-      const Eigen::Vector3d a(bgx * fx * iz, bgy * fy * iz, -(bgx * fx * qd.x() + bgy * fy * qd.y()) * iz * iz);
-      double J[6];
-      point_jacobian(qd, a, J);
-      const double s = in.photometric_sigma;
-      p.system.add(J, r, wphoto * huber_weight(r / s) / (s * s));
-      p.photometric_abs.add(std::abs(r));
+      if (u >= cur.width) {
+        ++v;
+        u = v % stride;
+      }
     }
+    look_up(b, ref, cur, wphoto > 0);
+    add_terms(b, in, sensor, config, ref_rays, quality_pass, p);
   }
   return p;
 }
