@@ -97,19 +97,6 @@ struct Bilinear {
   }
 };
 
-// RgbdLevel::point's factors (ray_x, ray_y) per column and per row, computed once a pass instead
-// of two divisions per pixel: the same values, so the same points.
-struct PixelRays {
-  std::vector<float> x, y;
-  explicit PixelRays(const RgbdLevel& level) : x(static_cast<std::size_t>(level.width)), y(static_cast<std::size_t>(level.height)) {
-    for (int u = 0; u < level.width; ++u) x[static_cast<std::size_t>(u)] = level.ray_x(u);
-    for (int v = 0; v < level.height; ++v) y[static_cast<std::size_t>(v)] = level.ray_y(v);
-  }
-  Eigen::Vector3f point(int u, int v, float z) const {
-    return {x[static_cast<std::size_t>(u)] * z, y[static_cast<std::size_t>(v)] * z, z};
-  }
-};
-
 // The magnitudes of a pass's photometric residuals (intensities in [0, 1]), binned finely enough
 // that their median is read to 1/4096 of the intensity range, a sixteenth of one grey level of an
 // 8-bit image: counting them costs one increment a pixel, where keeping them and selecting the

@@ -69,6 +69,7 @@ void add_reference_terms(RgbdLevel& l) {
   l.normals.assign(l.pixels(), Eigen::Vector3f::Constant(nan));
   l.shade.assign(l.pixels(), RgbdLevel::Shade{});
   for (std::size_t i = 0; i < l.pixels(); ++i) l.shade[i].intensity = l.intensity[i];
+  const PixelRays rays(l);  // two divisions fewer in each of a pixel's five points
   for (int v = 1; v + 1 < l.height; ++v) {
     for (int u = 1; u + 1 < l.width; ++u) {
       const std::size_t i = static_cast<std::size_t>(v) * l.width + u;
@@ -78,13 +79,13 @@ void add_reference_terms(RgbdLevel& l) {
       if (z <= 0) continue;
       const float zl = l.depth_m[i - 1], zr = l.depth_m[i + 1], zu = l.depth_m[i - l.width], zd = l.depth_m[i + l.width];
       if (!near_in_depth(z, zl) || !near_in_depth(z, zr) || !near_in_depth(z, zu) || !near_in_depth(z, zd)) continue;
-      const Eigen::Vector3f dx = l.point(u + 1, v, zr) - l.point(u - 1, v, zl);
-      const Eigen::Vector3f dy = l.point(u, v + 1, zd) - l.point(u, v - 1, zu);
+      const Eigen::Vector3f dx = rays.point(u + 1, v, zr) - rays.point(u - 1, v, zl);
+      const Eigen::Vector3f dy = rays.point(u, v + 1, zd) - rays.point(u, v - 1, zu);
       Eigen::Vector3f n = dx.cross(dy);
       const float norm = n.norm();
       if (!(norm > 0)) continue;
       n /= norm;
-      if (n.dot(l.point(u, v, z)) > 0) n = -n;
+      if (n.dot(rays.point(u, v, z)) > 0) n = -n;
       l.normals[i] = n;
     }
   }

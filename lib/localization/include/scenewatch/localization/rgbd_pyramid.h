@@ -34,6 +34,19 @@ struct RgbdLevel {
   float ray_y(int v) const { return static_cast<float>((v - intrinsics.cy) / intrinsics.fy); }
 };
 
+/// RgbdLevel::point's factors (ray_x, ray_y) per column and per row of a level, computed once
+/// instead of two divisions per point: the same values, so the same points.
+struct PixelRays {
+  std::vector<float> x, y;
+  explicit PixelRays(const RgbdLevel& level) : x(static_cast<std::size_t>(level.width)), y(static_cast<std::size_t>(level.height)) {
+    for (int u = 0; u < level.width; ++u) x[static_cast<std::size_t>(u)] = level.ray_x(u);
+    for (int v = 0; v < level.height; ++v) y[static_cast<std::size_t>(v)] = level.ray_y(v);
+  }
+  Eigen::Vector3f point(int u, int v, float z) const {
+    return {x[static_cast<std::size_t>(u)] * z, y[static_cast<std::size_t>(v)] * z, z};
+  }
+};
+
 /// Level 0 is the finest (the input, or the input halved `finest_halvings` times); each further
 /// level halves it again.
 struct RgbdPyramid {
